@@ -1,0 +1,159 @@
+"""Recorded-run repairs: each defect, crafted in a small file, is repaired and reported."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.test_runs_reader import csv_text, warmup, write
+from twin.runs import read_run
+
+
+def kinds(run, column=None):
+    return {f["kind"] for f in run.quality if column is None or f["column"] == column}
+
+
+def one(run, kind, column):
+    found = [f for f in run.quality if f["kind"] == kind and f["column"] == column]
+    assert len(found) == 1, run.quality
+    return found[0]
+
+
+def noisy_warmup(seed=0, sigma=0.05, n=600):
+    cols = warmup(n=n)
+    rng = np.random.default_rng(seed)
+    for k in range(1, 6):
+        cols[f"T{k}_C"] = cols[f"T{k}_C"] + rng.normal(0.0, sigma, n)
+    return cols
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_realistic_noise_is_not_a_defect(tmp_path, seed):
+    run = read_run(write(tmp_path, csv_text(noisy_warmup(seed))))
+    assert run.quality == []
+
+
+def test_duplicate_timestamps_merged(tmp_path):
+    lines = csv_text(warmup()).splitlines()
+    # repeat sample t=20 s (line 22) with a different T1: merged into the mean
+    dup = lines[21].split(",")
+    dup[3] = f"{float(dup[3]) + 1.0:.4f}"
+    lines.insert(22, ",".join(dup))
+    run = read_run(write(tmp_path, "\n".join(lines)))
+    f = one(run, "duplicate_timestamp", "time_s")
+    assert f["rows"] == [23] and f["spans_s"] == [[20.0, 20.0]]
+    assert run.time_s.size == 300
+    expected = 25.0 + 8.0 * (1 - np.exp(-20.0 / 400.0)) + 0.5
+    assert run.T_C[20, 0] == pytest.approx(expected, abs=1e-4)
+
+
+def test_short_dropout_interpolated(tmp_path):
+    cols = warmup()
+    cols["T2_C"][100:110] = np.nan  # 10 s: interpolate
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "dropout", "T2_C")
+    assert f["rows"] == list(range(102, 112)) and f["spans_s"] == [[100.0, 109.0]]
+    exact = 25.0 + 6.0 * (1 - np.exp(-np.arange(100, 110) / 400.0))
+    np.testing.assert_allclose(run.T_C[100:110, 1], exact, atol=2e-3)  # chord of a slow curve
+    assert run.valid["T2_C"].all()
+
+
+def test_long_dropout_excluded(tmp_path):
+    cols = warmup()
+    cols["T4_C"][100:160] = np.nan  # 60 s > 30 s limit
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "long_dropout", "T4_C")
+    assert f["count"] == 60 and "excluded" in f["action"]
+    assert not run.valid["T4_C"][100:160].any() and run.valid["T4_C"][:100].all()
+    assert np.isfinite(run.T_C[:, 3]).all()
+    s = run.at(np.array([50.0, 130.0, 250.0]))
+    assert s.valid["T4_C"].tolist() == [True, False, True]
+
+
+def test_leading_dropout_held_and_flagged(tmp_path):
+    cols = warmup()
+    cols["T5_C"][:5] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert one(run, "dropout", "T5_C")["count"] == 5
+    np.testing.assert_allclose(run.T_C[:5, 4], cols["T5_C"][5], atol=1e-4)
+
+
+def test_time_gaps(tmp_path):
+    cols = warmup(n=400)
+    keep = np.ones(400, dtype=bool)
+    keep[50:60] = False    # 11 s without samples: short gap
+    keep[200:260] = False  # 61 s: long gap
+    cols = {k: v[keep] for k, v in cols.items()}
+    run = read_run(write(tmp_path, csv_text(cols)))
+    short = one(run, "short_gap", "time_s")
+    assert short["spans_s"] == [[49.0, 60.0]]
+    long = one(run, "long_gap", "time_s")
+    assert long["spans_s"] == [[199.0, 260.0]] and run.gaps_s == [(199.0, 260.0)]
+    s = run.at(np.array([55.0, 230.0]))
+    assert s.valid_T[0].all() and not s.valid_T[1].any()
+    b = run.before(np.array([240.0]))
+    assert not b.valid["T1_C"][0]  # the last sample is older than the gap limit
+
+
+def test_spikes_replaced(tmp_path):
+    cols = noisy_warmup()
+    cols["T1_C"][[80, 81, 300]] += [12.0, 11.0, -9.0]
+    cols["ambient_C"][400] += 4.0
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "spike", "T1_C")
+    assert f["rows"] == [82, 83, 302]
+    assert one(run, "spike", "ambient_C")["rows"] == [402]
+    clean = noisy_warmup()["T1_C"]
+    assert np.abs(run.T_C[[80, 81, 300], 0] - clean[[80, 81, 300]]).max() < 0.3
+    assert kinds(run) == {"spike"}
+
+
+def test_speed_steps_are_not_spikes(tmp_path):
+    cols = warmup()
+    cols["speed_rpm"][150:] = 12000.0
+    cols["speed_rpm"][151] = 0.0  # a real (if brief) stop is data, not a spike
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert run.quality == []
+
+
+def test_stuck_sensor_exact_value(tmp_path):
+    cols = noisy_warmup()
+    cols["T2_C"][:] = 25.0
+    cols["T4_C"][300:] = cols["T4_C"][300]  # frozen halfway through the run
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert not run.valid["T2_C"].any()
+    f4 = one(run, "stuck", "T4_C")
+    assert f4["spans_s"] == [[300.0, 599.0]]
+    assert run.valid["T4_C"][:300].all() and not run.valid["T4_C"][300:].any()
+    assert {f["column"] for f in run.quality} == {"T2_C", "T4_C"}
+
+
+def test_stuck_sensor_flat_with_noise(tmp_path):
+    cols = noisy_warmup(n=1200)
+    cols["T3_C"] = 25.0 + np.random.default_rng(5).normal(0, 0.05, 1200)
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert one(run, "stuck", "T3_C")["count"] == 1200
+    assert not run.valid["T3_C"].any()
+
+
+def test_noisy_sensor_smoothed(tmp_path):
+    cols = noisy_warmup()
+    truth = warmup(n=600)["T5_C"]
+    cols["T5_C"] = truth + np.random.default_rng(9).normal(0.0, 0.6, 600)
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "noisy", "T5_C")
+    assert "moving average" in f["action"]
+    inner = slice(20, -20)
+    assert np.std(run.T_C[inner, 4] - truth[inner]) < 0.2  # from 0.6 °C
+    assert kinds(run) == {"noisy"}
+
+
+def test_time_offset_and_ignored_and_empty_columns(tmp_path):
+    cols = warmup()
+    cols["time_s"] = cols["time_s"] + 1000.0
+    cols["vibration_g"] = np.zeros(300)
+    cols["disp_x_um"] = np.full(300, np.nan)
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert run.time_s[0] == 0.0 and run.duration_s == 299.0
+    assert kinds(run) == {"time_offset", "ignored_column", "empty_column"}
+    assert run.disp_um is None

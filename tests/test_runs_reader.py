@@ -1,0 +1,205 @@
+"""Recorded-run reader: schema round trip, hard errors, sampling helpers."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from twin.errors import InputError
+from twin.runs import read_run, write_quality, write_run
+
+HEADER = "time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C"
+
+
+def warmup(n: int = 300, dt: float = 1.0) -> dict[str, np.ndarray]:
+    """A clean exponential warm-up (closed form), 1 Hz by default."""
+    t = np.arange(n) * dt
+    rise = 1.0 - np.exp(-t / 400.0)
+    cols = {"time_s": t, "speed_rpm": np.full(n, 9000.0), "ambient_C": np.full(n, 25.0)}
+    for k, amp in enumerate([8.0, 6.0, 5.0, 4.0, 1.5], start=1):
+        cols[f"T{k}_C"] = 25.0 + amp * rise
+    return cols
+
+
+def csv_text(cols: dict[str, np.ndarray], meta: str = "") -> str:
+    names = list(cols)
+    lines = [",".join(names)]
+    for row in zip(*(cols[n] for n in names), strict=True):
+        lines.append(",".join(f"{v:.4f}" for v in row))
+    return meta + "\n".join(lines) + "\n"
+
+
+def write(tmp_path, text: str, name: str = "run.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_clean_csv_reads_without_findings(tmp_path):
+    cols = warmup()
+    path = write(tmp_path, csv_text(cols, "# name: demo\n# speed_rpm: 9000\n"))
+    before = path.read_bytes()
+    run = read_run(path)
+    assert run.name == "demo"
+    assert run.metadata == {"name": "demo", "speed_rpm": "9000"}
+    assert run.T_C.shape == (300, 5)
+    assert run.coolant_C is None and run.disp_um is None
+    np.testing.assert_allclose(run.T_C[:, 0], cols["T1_C"], atol=1e-4)
+    assert run.quality == []
+    assert all(v.all() for v in run.valid.values())
+    assert path.read_bytes() == before  # the input is never modified
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_round_trip(tmp_path, suffix):
+    cols = warmup()
+    cols["coolant_C"] = np.full(300, 22.0)
+    cols["disp_z_um"] = np.linspace(0.0, 5.0, 300)
+    meta = {"name": "rt", "seed": 7}
+    path = tmp_path / f"run{suffix}"
+    write_run(path, cols, meta)
+    run = read_run(path)
+    assert run.metadata == {"name": "rt", "seed": "7"}
+    for j, k in enumerate(["T1_C", "T2_C", "T3_C", "T4_C", "T5_C"]):
+        np.testing.assert_allclose(run.T_C[:, j], cols[k], atol=1e-4)
+    np.testing.assert_allclose(run.coolant_C, 22.0)
+    np.testing.assert_allclose(run.disp_um[:, 2], cols["disp_z_um"], atol=1e-4)
+    assert np.isnan(run.disp_um[:, 0]).all() and not run.valid["disp_x_um"].any()
+    assert run.valid["disp_z_um"].all()
+
+
+def test_at_interpolates_and_before_is_causal(tmp_path):
+    cols = warmup()
+    run = read_run(write(tmp_path, csv_text(cols)))
+    s = run.at(np.array([10.5, 200.25]))
+    expected = 25.0 + 8.0 * (1.0 - np.exp(-np.array([10.5, 200.25]) / 400.0))
+    np.testing.assert_allclose(s.T_C[:, 0], expected, atol=2e-4)
+    assert s.valid_T.all()
+    b = run.before(np.array([60.0, 60.9, -1.0]))
+    np.testing.assert_array_equal(b.time_s[:2], [60.0, 60.0])
+    assert b.valid["T1_C"].tolist() == [True, True, False]
+    outside = run.at(np.array([1000.0]))
+    assert not outside.valid["T1_C"][0]
+
+
+def test_quality_json_is_serialisable(tmp_path):
+    cols = warmup()
+    cols["T3_C"][100:104] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols).replace("nan", "")))
+    out = tmp_path / "quality.json"
+    write_quality(run, out)
+    doc = json.loads(out.read_text())
+    assert doc["findings"][0]["kind"] == "dropout"
+
+
+# --- hard errors: each names the file, the line and the column --------------------------
+
+def expect_error(path, row, column, words):
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    err = info.value
+    assert err.file == str(path)
+    assert err.row == row
+    assert err.column == column
+    assert words in err.reason, err.reason
+    return err
+
+
+def test_missing_required_column(tmp_path):
+    cols = warmup()
+    del cols["T4_C"]
+    path = write(tmp_path, csv_text(cols, "# a: b\n"))
+    expect_error(path, 2, "T4_C", "missing required column")
+
+
+def test_unparseable_number_names_editor_line(tmp_path):
+    text = csv_text(warmup(), "# name: x\n\n").splitlines()
+    # line 1 metadata, 2 blank, 3 header, 4.. data: sample 10 sits on line 13
+    fields = text[12].split(",")
+    fields[5] = "2x.5"
+    text[12] = ",".join(fields)
+    path = write(tmp_path, "\n".join(text) + "\n")
+    expect_error(path, 13, "T3_C", "cannot read '2x.5'")
+
+
+def test_wrong_field_count(tmp_path):
+    text = csv_text(warmup()).splitlines()
+    text[5] += ",1.0"
+    expect_error(write(tmp_path, "\n".join(text)), 6, None, "expected 8 fields")
+
+
+def test_empty_file(tmp_path):
+    path = write(tmp_path, "")
+    with pytest.raises(InputError, match="empty file"):
+        read_run(path)
+    path = write(tmp_path, "# name: x\n" + HEADER + "\n", "header_only.csv")
+    expect_error(path, 2, None, "no data rows")
+
+
+def test_time_going_back(tmp_path):
+    cols = warmup()
+    cols["time_s"][50] = 10.0
+    expect_error(write(tmp_path, csv_text(cols)), 52, "time_s", "time goes back")
+
+
+def test_too_short_for_two_windows(tmp_path):
+    cols = {k: v[:100] for k, v in warmup().items()}
+    expect_error(write(tmp_path, csv_text(cols)), 101, "time_s", "two 60 s windows")
+
+
+def test_sample_interval_too_long(tmp_path):
+    cols = warmup(n=30, dt=20.0)
+    expect_error(write(tmp_path, csv_text(cols)), None, "time_s", "sample interval")
+
+
+def test_kelvin_column(tmp_path):
+    cols = warmup()
+    cols["T2_C"] = cols["T2_C"] + 273.15
+    expect_error(write(tmp_path, csv_text(cols)), 2, "T2_C", "Kelvin")
+
+
+def test_fahrenheit_ambient(tmp_path):
+    cols = warmup()
+    cols["ambient_C"] = cols["ambient_C"] * 1.8 + 32.0
+    expect_error(write(tmp_path, csv_text(cols)), 2, "ambient_C", "Fahrenheit")
+
+
+def test_fahrenheit_sensor(tmp_path):
+    cols = warmup()
+    cols["T5_C"] = cols["T5_C"] * 1.8 + 32.0
+    expect_error(write(tmp_path, csv_text(cols)), 2, "T5_C", "Fahrenheit")
+
+
+def test_negative_speed(tmp_path):
+    cols = warmup()
+    cols["speed_rpm"][7] = -9000.0
+    expect_error(write(tmp_path, csv_text(cols)), 9, "speed_rpm", "negative speed")
+
+
+def test_required_column_without_values(tmp_path):
+    cols = warmup()
+    cols["ambient_C"][:] = np.nan
+    expect_error(write(tmp_path, csv_text(cols)), 2, "ambient_C", "no values")
+
+
+def test_missing_time(tmp_path):
+    text = csv_text(warmup()).splitlines()
+    text[3] = "," + text[3].split(",", 1)[1]
+    expect_error(write(tmp_path, "\n".join(text)), 4, "time_s", "time is missing")
+
+
+def test_unknown_suffix_and_bad_parquet(tmp_path):
+    with pytest.raises(InputError, match="unknown run format"):
+        read_run(write(tmp_path, "x", "run.txt"))
+    with pytest.raises(InputError, match="Parquet"):
+        read_run(write(tmp_path, "not parquet", "run.parquet"))
+
+
+def test_parquet_hard_error_names_row(tmp_path):
+    cols = warmup()
+    cols["speed_rpm"][4] = -1.0
+    path = tmp_path / "neg.parquet"
+    write_run(path, cols)
+    expect_error(path, 5, "speed_rpm", "negative speed")

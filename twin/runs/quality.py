@@ -1,0 +1,308 @@
+"""Data-quality repairs of a recorded run, each reported as a finding (never silent).
+
+Repaired here, in this order: duplicate timestamps (merged), spikes (robust Hampel-type
+filter), NaN dropouts and short time gaps (linear interpolation up to `max_gap_s`; longer
+ones are interpolated for continuity but excluded from the metrics), noisy sensors
+(centred moving average), stuck sensors (flat while the others move: excluded).  A
+finding is a plain JSON-serialisable dict:
+
+    {"column": "T2_C", "kind": "stuck", "count": 1800, "rows": [3, 4, ...],
+     "spans_s": [[0.0, 1799.0]], "action": "excluded from metrics", "detail": "..."}
+
+`rows` are 1-based file lines (CSV) or data rows (Parquet), at most `MAX_LISTED` of them;
+`count` is the number of samples concerned; `spans_s` are time spans in run time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.ndimage import median_filter, uniform_filter1d
+
+from twin.runs.schema import DISPLACEMENTS, SPEED, TEMPERATURES, TIME
+from twin.runs.table import RawTable
+
+MAX_LISTED = 20
+
+
+@dataclass(frozen=True)
+class QualityConfig:
+    """Thresholds of the repairs (temperatures in °C, displacements in µm, times in s)."""
+
+    max_gap_s: float = 30.0
+    """Dropouts and time gaps up to this long are interpolated; longer ones are excluded."""
+    spike_sigmas: float = 8.0
+    spike_floor_C: float = 0.5
+    spike_floor_um: float = 1.0
+    spike_half_window: int = 5
+    stuck_min_s: float = 60.0
+    stuck_others_move_C: float = 0.5
+    noisy_floor_C: float = 0.25
+    noisy_floor_um: float = 1.0
+    noisy_ratio: float = 5.0
+    smooth_target_C: float = 0.05
+    smooth_target_um: float = 0.1
+    smooth_max_s: float = 30.0
+
+
+@dataclass
+class Repaired:
+    """Repaired columns on the repaired time axis, validity masks and findings."""
+
+    time_s: np.ndarray
+    rows: np.ndarray
+    columns: dict[str, np.ndarray]
+    valid: dict[str, np.ndarray]
+    gaps_s: list[tuple[float, float]] = field(default_factory=list)
+    findings: list[dict] = field(default_factory=list)
+
+
+def finding(column: str, kind: str, action: str, *, rows: np.ndarray | None = None,
+            spans_s: list[tuple[float, float]] | None = None, count: int | None = None,
+            detail: str = "") -> dict:
+    """One data-quality finding as a JSON-serialisable dict."""
+    rows_list = [] if rows is None else [int(r) for r in np.asarray(rows)[:MAX_LISTED]]
+    spans = [[round(float(a), 3), round(float(b), 3)] for a, b in (spans_s or [])[:MAX_LISTED]]
+    return {"column": column, "kind": kind,
+            "count": int(count if count is not None else (0 if rows is None else len(rows))),
+            "rows": rows_list, "spans_s": spans, "action": action, "detail": detail}
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Inclusive (start, end) index pairs of the True runs in a boolean array."""
+    padded = np.concatenate([[False], mask, [False]])
+    edges = np.flatnonzero(np.diff(padded.astype(np.int8)))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def noise_sigma(values: np.ndarray) -> float:
+    """Robust white-noise estimate from second differences (blind to slow trends)."""
+    x = values[~np.isnan(values)]
+    if x.size < 5:
+        return 0.0
+    d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
+    # Var(d2) = 6 σ² for white noise; 1.4826·MAD estimates a standard deviation.
+    return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
+
+
+def _unit_floor(name: str, celsius: float, micron: float) -> float:
+    return micron if name.endswith("_um") else celsius
+
+
+def merge_duplicates(table: RawTable) -> tuple[np.ndarray, np.ndarray, dict, list[dict]]:
+    """Merge samples sharing a timestamp into their mean (NaN-aware)."""
+    time = table.columns[TIME]
+    names = [n for n in table.columns if n != TIME]
+    unique, first, counts = np.unique(time, return_index=True, return_counts=True)
+    if unique.size == time.size:
+        return time.copy(), table.rows.copy(), {n: table.columns[n].copy() for n in names}, []
+    group = np.repeat(np.arange(unique.size), counts)  # time is sorted: groups are contiguous
+    merged = {}
+    for n in names:
+        x = table.columns[n]
+        ok = ~np.isnan(x)
+        total = np.bincount(group, weights=np.where(ok, x, 0.0), minlength=unique.size)
+        number = np.bincount(group, weights=ok.astype(float), minlength=unique.size)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            merged[n] = np.where(number > 0, total / np.maximum(number, 1), np.nan)
+    dropped = np.setdiff1d(np.arange(time.size), first)
+    spans = [(float(t), float(t)) for t in unique[counts > 1]]
+    found = finding(TIME, "duplicate_timestamp",
+                    "merged into one sample (mean of the duplicates)",
+                    rows=table.rows[dropped], spans_s=spans, count=int(dropped.size),
+                    detail=f"{int((counts > 1).sum())} timestamps appear more than once")
+    return unique, table.rows[first], merged, [found]
+
+
+def remove_spikes(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
+                  cfg: QualityConfig) -> tuple[np.ndarray, list[dict]]:
+    """Replace isolated outliers by the running median (Hampel-type filter)."""
+    ok = np.flatnonzero(~np.isnan(x))
+    if ok.size < 2 * cfg.spike_half_window + 1:
+        return x, []
+    v = x[ok]
+    med = median_filter(v, size=2 * cfg.spike_half_window + 1, mode="nearest")
+    floor = _unit_floor(name, cfg.spike_floor_C, cfg.spike_floor_um)
+    threshold = max(cfg.spike_sigmas * noise_sigma(v), floor)
+    spikes = np.abs(v - med) > threshold
+    if not spikes.any():
+        return x, []
+    out = x.copy()
+    idx = ok[spikes]
+    out[idx] = med[spikes]
+    spans = [(float(t[ok[a]]), float(t[ok[b]])) for a, b in _runs(spikes)]
+    return out, [finding(name, "spike", "replaced by the running median of "
+                         f"{2 * cfg.spike_half_window + 1} samples", rows=rows[idx],
+                         spans_s=spans, count=int(idx.size),
+                         detail=f"deviation above {threshold:.3g} from the running median")]
+
+
+def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
+                  cfg: QualityConfig) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+    """Interpolate NaN runs linearly in time; runs longer than `max_gap_s` are excluded."""
+    valid = np.ones(x.size, dtype=bool)
+    missing = np.isnan(x)
+    if not missing.any():
+        return x, valid, []
+    ok = ~missing
+    out = x.copy()
+    # Beyond the first/last value the nearest value is held (np.interp clamps).
+    out[missing] = np.interp(t[missing], t[ok], x[ok])
+    short_rows, long_rows, short_spans, long_spans = [], [], [], []
+    for a, b in _runs(missing):
+        left = t[a - 1] if a > 0 else t[a]
+        right = t[b + 1] if b + 1 < x.size else t[b]
+        if right - left > cfg.max_gap_s:
+            valid[a:b + 1] = False
+            long_rows.append(rows[a:b + 1])
+            long_spans.append((t[a], t[b]))
+        else:
+            short_rows.append(rows[a:b + 1])
+            short_spans.append((t[a], t[b]))
+    found = []
+    if short_rows:
+        r = np.concatenate(short_rows)
+        found.append(finding(name, "dropout", "linearly interpolated in time", rows=r,
+                             spans_s=short_spans, count=r.size,
+                             detail=f"missing values, gaps up to {cfg.max_gap_s:g} s"))
+    if long_rows:
+        r = np.concatenate(long_rows)
+        found.append(finding(name, "long_dropout",
+                             "interpolated for continuity; excluded from metrics", rows=r,
+                             spans_s=long_spans, count=r.size,
+                             detail=f"missing values over more than {cfg.max_gap_s:g} s"))
+    return out, valid, found
+
+
+def time_gaps(t: np.ndarray, rows: np.ndarray,
+              cfg: QualityConfig) -> tuple[list[tuple[float, float]], list[dict]]:
+    """Intervals without samples: short ones are interpolated across, long ones excluded."""
+    dt = np.diff(t)
+    typical = float(np.median(dt))
+    short = np.flatnonzero((dt > 3.0 * typical) & (dt <= cfg.max_gap_s))
+    long = np.flatnonzero(dt > cfg.max_gap_s)
+    found = []
+    if short.size:
+        found.append(finding(TIME, "short_gap", "values interpolated across the gap",
+                             rows=rows[short + 1], count=int(short.size),
+                             spans_s=[(t[i], t[i + 1]) for i in short],
+                             detail=f"no samples for more than 3 typical intervals "
+                                    f"({typical:g} s)"))
+    gaps = [(float(t[i]), float(t[i + 1])) for i in long]
+    if long.size:
+        found.append(finding(TIME, "long_gap", "times inside the gap excluded from metrics",
+                             rows=rows[long + 1], count=int(long.size), spans_s=gaps,
+                             detail=f"no samples for more than {cfg.max_gap_s:g} s"))
+    return gaps, found
+
+
+def smooth_noisy(name: str, t: np.ndarray, x: np.ndarray, sigma: float, others: float,
+                 cfg: QualityConfig) -> tuple[np.ndarray, list[dict]]:
+    """Smooth a sensor far noisier than its peers with a centred moving average."""
+    floor = _unit_floor(name, cfg.noisy_floor_C, cfg.noisy_floor_um)
+    if sigma <= max(floor, cfg.noisy_ratio * others):
+        return x, []
+    target = _unit_floor(name, cfg.smooth_target_C, cfg.smooth_target_um)
+    interval = float(np.median(np.diff(t)))
+    width = int(np.ceil((sigma / target) ** 2))
+    width = max(3, min(width, int(cfg.smooth_max_s / interval)))
+    width += 1 - width % 2  # odd: centred, no time shift
+    out = uniform_filter1d(x, size=width, mode="nearest")
+    unit = "µm" if name.endswith("_um") else "°C"
+    return out, [finding(name, "noisy", f"smoothed by a centred moving average of {width} "
+                         f"samples ({width * interval:g} s)", count=x.size,
+                         spans_s=[(t[0], t[-1])],
+                         detail=f"noise {sigma:.3g} {unit} (others {others:.3g} {unit})")]
+
+
+def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
+               cfg: QualityConfig) -> tuple[dict[str, np.ndarray], list[dict]]:
+    """Temperature sensors that stay flat while the others move (dead thermocouples)."""
+    stuck: dict[str, np.ndarray] = {}
+    found = []
+    names = [n for n in TEMPERATURES if n in raw]
+    for name in names:
+        others = [raw[n] for n in names if n != name]
+        x = raw[name]
+        ok = np.flatnonzero(~np.isnan(x))
+        mask = np.zeros(x.size, dtype=bool)
+        # (a) exactly repeated values for a long stretch while another sensor moves
+        same = np.concatenate([[False], x[ok][1:] == x[ok][:-1]])
+        for a, b in _runs(same):
+            a -= 1  # the run starts at the first of the equal values
+            i0, i1 = ok[a], ok[b]
+            if t[i1] - t[i0] < cfg.stuck_min_s or b - a + 1 < 5:
+                continue
+            moved = max((np.nanmax(o[i0:i1 + 1]) - np.nanmin(o[i0:i1 + 1])
+                         for o in others if np.isfinite(o[i0:i1 + 1]).any()), default=0.0)
+            if moved >= cfg.stuck_others_move_C:
+                mask[i0:i1 + 1] = True
+        # (b) flat within noise over the whole run while the others warm up clearly
+        rise = _rise(t, x)
+        other_rises = [abs(_rise(t, o)) for o in others]
+        if other_rises and np.median(other_rises) >= 2.0 and abs(rise) < 0.02 * np.median(
+                other_rises) and np.nanpercentile(x, 99) - np.nanpercentile(x, 1) < 1.0:
+            mask[:] = True
+        if mask.any():
+            stuck[name] = mask
+            spans = [(t[a], t[b]) for a, b in _runs(mask)]
+            found.append(finding(name, "stuck", "excluded from metrics and correction inputs",
+                                 rows=rows[mask], spans_s=spans, count=int(mask.sum()),
+                                 detail="flat while the other temperature sensors move"))
+    return stuck, found
+
+
+def _rise(t: np.ndarray, x: np.ndarray) -> float:
+    """Change between the first and last 10 % of the run (medians, NaN-aware)."""
+    edge = t[0] + 0.1 * (t[-1] - t[0]), t[-1] - 0.1 * (t[-1] - t[0])
+    head, tail = x[t <= edge[0]], x[t >= edge[1]]
+    if not np.isfinite(head).any() or not np.isfinite(tail).any():
+        return 0.0
+    return float(np.nanmedian(tail) - np.nanmedian(head))
+
+
+def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
+    """Apply every repair to a validated table and collect the findings."""
+    cfg = cfg or QualityConfig()
+    time, rows, columns, findings = merge_duplicates(table)
+    if time[0] != 0.0:
+        findings.append(finding(TIME, "time_offset", f"run time counted from the first "
+                                f"sample (time_s - {time[0]:g})", count=0,
+                                detail=f"first sample at {time[0]:g} s"))
+        time = time - time[0]
+
+    for name in [n for n in columns if np.isnan(columns[n]).all()]:
+        # Only optional columns can be empty here (validation rejects empty required ones).
+        findings.append(finding(name, "empty_column", "column ignored", count=time.size,
+                                detail="no values in the whole run"))
+        del columns[name]
+    raw = {n: v.copy() for n, v in columns.items()}
+    valid: dict[str, np.ndarray] = {}
+    for name, x in columns.items():
+        if name != SPEED:  # speed steps are real; a spindle speed is a command, not noise
+            x, found = remove_spikes(name, time, x, rows, cfg)
+            findings += found
+        x, valid[name], found = fill_dropouts(name, time, x, rows, cfg)
+        findings += found
+        columns[name] = x
+
+    gaps, found = time_gaps(time, rows, cfg)
+    findings += found
+
+    sigmas = {n: noise_sigma(raw[n]) for n in columns}
+    for group in (TEMPERATURES, DISPLACEMENTS, ("ambient_C",), ("coolant_C",)):
+        present = [n for n in group if n in columns]
+        for name in present:
+            peers = [sigmas[n] for n in present if n != name]
+            others = float(np.median(peers)) if peers else 0.0
+            columns[name], found = smooth_noisy(name, time, columns[name], sigmas[name],
+                                                others, cfg)
+            findings += found
+
+    stuck, found = find_stuck(time, raw, rows, cfg)
+    findings += found
+    for name, mask in stuck.items():
+        valid[name] &= ~mask
+    return Repaired(time_s=time, rows=rows, columns=columns, valid=valid, gaps_s=gaps,
+                    findings=findings)

@@ -1,0 +1,117 @@
+"""Hard errors of a recorded run: problems no repair can honestly fix.
+
+Each raises `InputError` naming the file, the row (1-based line in a CSV file) and the
+column.  Anything a repair can fix (duplicates, dropouts, spikes, stuck or noisy sensors)
+is left to `twin.runs.quality`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from twin.errors import InputError
+from twin.runs.schema import (
+    AMBIENT,
+    CELSIUS_COLUMNS,
+    COOLANT,
+    MAX_SAMPLE_INTERVAL_S,
+    REQUIRED,
+    SPEED,
+    TEMPERATURES,
+    TIME,
+    WINDOW_S,
+)
+from twin.runs.table import RawTable
+
+KELVIN_MEDIAN_C = 200.0
+"""A °C column whose median exceeds this is Kelvin: no spindle part runs at 200 °C."""
+FAHRENHEIT_AIR_RANGE_C = (45.0, 130.0)
+"""Ambient air or coolant with a median in this range is Fahrenheit (59–95 °F rooms)."""
+
+
+def check_structure(table: RawTable) -> None:
+    """Required columns present, each with values, time readable and non-decreasing."""
+    for name in REQUIRED:
+        if name not in table.columns:
+            raise InputError("missing required column", file=table.file, row=table.header_row,
+                             column=name)
+    for name in REQUIRED:
+        if np.isnan(table.columns[name]).all():
+            raise InputError("column has no values", file=table.file,
+                             row=int(table.rows[0]), column=name)
+    time = table.columns[TIME]
+    missing = np.flatnonzero(np.isnan(time))
+    if missing.size:
+        raise InputError("time is missing", file=table.file, row=int(table.rows[missing[0]]),
+                         column=TIME)
+    back = np.flatnonzero(np.diff(time) < 0)
+    if back.size:
+        i = int(back[0])
+        raise InputError(
+            f"time goes back from {time[i]:g} s (line {table.rows[i]}) to {time[i + 1]:g} s; "
+            "samples must be in time order", file=table.file, row=int(table.rows[i + 1]),
+            column=TIME)
+
+
+def check_values(table: RawTable) -> None:
+    """Sample rate, duration, speed sign and temperature units."""
+    time = table.columns[TIME]
+    unique_time = np.unique(time)
+    duration = float(unique_time[-1] - unique_time[0])
+    if duration < 2 * WINDOW_S:
+        raise InputError(
+            f"the run lasts {duration:g} s; the twin needs at least two {WINDOW_S:g} s "
+            f"windows ({2 * WINDOW_S:g} s)", file=table.file, row=int(table.rows[-1]),
+            column=TIME)
+    interval = float(np.median(np.diff(unique_time)))
+    if interval > MAX_SAMPLE_INTERVAL_S:
+        raise InputError(
+            f"median sample interval {interval:g} s is longer than {MAX_SAMPLE_INTERVAL_S:g} s "
+            "(at least one sample per 10 s is needed)", file=table.file, column=TIME)
+
+    speed = table.columns[SPEED]
+    negative = np.flatnonzero(speed < 0)
+    if negative.size:
+        i = int(negative[0])
+        raise InputError(f"negative speed {speed[i]:g} rpm", file=table.file,
+                         row=int(table.rows[i]), column=SPEED)
+
+    for name in CELSIUS_COLUMNS:
+        if name in table.columns:
+            _check_celsius(table, name)
+
+
+def _check_celsius(table: RawTable, name: str) -> None:
+    values = table.columns[name]
+    finite = values[~np.isnan(values)]
+    if finite.size == 0:
+        return
+    below = np.flatnonzero(values < -273.15)
+    if below.size:
+        i = int(below[0])
+        raise InputError(f"{values[i]:g} °C is below absolute zero", file=table.file,
+                         row=int(table.rows[i]), column=name)
+    median = float(np.median(finite))
+    first = int(np.flatnonzero(~np.isnan(values))[0])
+    row = int(table.rows[first])
+    if median > KELVIN_MEDIAN_C:
+        raise InputError(
+            f"values look like Kelvin (median {median:.2f}); the column must be in °C "
+            f"(subtract 273.15)", file=table.file, row=row, column=name)
+    lo, hi = FAHRENHEIT_AIR_RANGE_C
+    if name in (AMBIENT, COOLANT) and lo <= median <= hi:
+        raise InputError(
+            f"values look like Fahrenheit (median {median:.1f}, an implausible air/coolant "
+            "temperature in °C); the column must be in °C", file=table.file, row=row,
+            column=name)
+    if name in TEMPERATURES:
+        # A run starts near ambient; a sensor reading 1.8·ambient + 32 at the start,
+        # far above the ambient, is logging Fahrenheit.
+        ambient = table.columns[AMBIENT]
+        a0 = np.nanmedian(ambient[:5]) if np.isfinite(ambient[:5]).any() else np.nan
+        t0 = float(np.median(finite[:5]))
+        if np.isfinite(a0) and t0 > a0 + 25.0 and abs(t0 - (1.8 * a0 + 32.0)) < 2.0:
+            raise InputError(
+                f"values look like Fahrenheit (starts at {t0:.1f} with ambient {a0:.1f} °C "
+                f"= {1.8 * a0 + 32:.1f} °F); the column must be in °C", file=table.file,
+                row=row, column=name)
