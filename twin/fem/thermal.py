@@ -39,6 +39,8 @@ def element_for(order: int):  # noqa: ANN201 - skfem element instance
 
 
 def _finite(value: float, what: str) -> float:
+    if callable(value):  # a field f(r, z): checked where it is evaluated
+        return 0.0
     value = float(value)
     if not math.isfinite(value):
         raise ValueError(f"{what} must be finite, got {value!r}")
@@ -52,6 +54,8 @@ class ThermalLoads:
     sources             region → volumetric heat W/m³
     convection          boundary → (h W/(m²K), T∞ °C)
     flux                boundary → heat flux into the body W/m²
+    (source densities, fluxes, bulk and fixed temperatures may also be fields given as
+    functions f(r, z) of numpy arrays, like APDL tabular loads)
     contact_resistance  interface → R m²K/W (interfaces not listed are perfectly bonded
                         at a negligible R; see ThermalProblem.PERFECT_CONTACT_R)
     fixed_temperature   boundary → T °C
@@ -128,6 +132,7 @@ class ThermalProblem:
         self.capacity_data = c_data
         self._facet_bases: dict[str, FacetBasis] = {}
         self._source_vectors: dict[str, np.ndarray] = {}
+        self._region_bases: dict[str, Basis] = {}
         self._facet_loads: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------ operators
@@ -195,6 +200,7 @@ class ThermalProblem:
                 elements=self.mesh.region(region),
                 intorder=self.intorder,
             )
+            self._region_bases[region] = sub
             self._source_vectors[region] = asm(forms.unit_load, sub)
         return self._source_vectors[region]
 
@@ -208,7 +214,7 @@ class ThermalProblem:
         for boundary, t in loads.fixed_temperature.items():
             d = self.basis.get_dofs(facets=self.mesh.boundary(boundary)).flatten()
             dofs.append(d)
-            values.append(np.full(d.size, float(t)))
+            values.append(_field_values(t, self.basis.doflocs[:, d], f"boundary {boundary!r}"))
         if loads.fixed_dofs is not None:
             d = np.asarray(loads.fixed_dofs[0], dtype=np.int64)
             if d.size and (d.min() < 0 or d.max() >= self.n_dofs):
@@ -221,23 +227,48 @@ class ThermalProblem:
         last = d.size - 1 - np.unique(d[::-1], return_index=True)[1]
         return d[last], v[last]
 
-    def system(self, loads: ThermalLoads) -> tuple[np.ndarray, np.ndarray]:
-        """Conductance data K (on the shared pattern, W/K) and load vector f (W)."""
+    def _weighted_load(self, value, basis: Basis, unit: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
+        """∫ value·v 2πr over a (facet) basis; `unit` is the cached load of value = 1."""
+        if not callable(value):
+            return float(value) * unit
+        x = basis.global_coordinates().value
+        return asm(forms.unit_load_weighted, basis, s=_field_values(value, x, what))
+
+    def load_parts(self, loads: ThermalLoads) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+        """Film/interface coefficients and the load vectors (W) by kind.
+
+        Returns (coefficients of the unit operators, {"sources", "flux", "convection"}).
+        """
         coeff: dict[str, float] = {}
-        f = np.zeros(self.n_dofs)
+        parts = {k: np.zeros(self.n_dofs) for k in ("sources", "flux", "convection")}
         for region, q in loads.sources.items():
-            f += q * self.source_vector(region)
+            unit = self.source_vector(region)
+            basis = self._region_bases[region] if callable(q) else None
+            parts["sources"] += self._weighted_load(q, basis, unit, f"region {region!r}")
         for boundary, q in loads.flux.items():
-            f += q * self.facet_load(boundary)
+            unit = self.facet_load(boundary)
+            parts["flux"] += self._weighted_load(
+                q, self.facet_basis(boundary), unit, f"boundary {boundary!r}"
+            )
         for boundary, (h, t_inf) in loads.convection.items():
-            coeff[self._boundary_terms(boundary)] = h
-            f += h * t_inf * self._facet_loads[boundary]
+            coeff[self._boundary_terms(boundary)] = float(h)
+            parts["convection"] += float(h) * self._weighted_load(
+                t_inf,
+                self.facet_basis(boundary),
+                self._facet_loads[boundary],
+                f"boundary {boundary!r}",
+            )
         for name in loads.contact_resistance:
             self.mesh.interface(name)
         for name in self.mesh.interfaces:
             r = loads.contact_resistance.get(name, self.PERFECT_CONTACT_R)
-            coeff[f"interface:{name}"] = 1.0 / r
-        return self.conduction_data + self.ops.data(coeff), f
+            coeff[f"interface:{name}"] = 1.0 / float(r)
+        return coeff, parts
+
+    def system(self, loads: ThermalLoads) -> tuple[np.ndarray, np.ndarray]:
+        """Conductance data K (on the shared pattern, W/K) and load vector f (W)."""
+        coeff, parts = self.load_parts(loads)
+        return self.conduction_data + self.ops.data(coeff), sum(parts.values())
 
     # --------------------------------------------------------------- solves
     def steady(self, loads: ThermalLoads) -> np.ndarray:
@@ -270,20 +301,19 @@ class ThermalProblem:
         round-off for an exact linear solve.  `heat_in_W` = sources + flux,
         `heat_out_W` = convection out + heat drawn by fixed temperatures.
         """
-        k_data, f = self.system(loads)
+        coeff, parts = self.load_parts(loads)
         T_theta = theta * T_new + (1.0 - theta) * T_old
         C = self.ops.csr(self.capacity_data)
         stored = float((C @ (T_new - T_old)).sum() / dt)
-        sources = sum(q * self.source_vector(r).sum() for r, q in loads.sources.items())
-        flux = sum(q * self.facet_load(b).sum() for b, q in loads.flux.items())
-        convection_out = 0.0
-        for b, (h, t_inf) in loads.convection.items():
-            m_b = self.ops.csr(self.ops.data({self._boundary_terms(b): 1.0}))
-            convection_out += h * float((m_b @ T_theta).sum() - t_inf * self._facet_loads[b].sum())
+        sources = float(parts["sources"].sum())
+        flux = float(parts["flux"].sum())
+        films = {k: c for k, c in coeff.items() if k.startswith("film:")}
+        convection_out = float((self.ops.matrix(films) @ T_theta).sum() - parts["convection"].sum())
         dofs, _ = self.fixed(loads)
         fixed_in = 0.0
         if dofs.size:
-            residual = C @ (T_new - T_old) / dt + self.ops.csr(k_data) @ T_theta - f
+            K = self.ops.csr(self.conduction_data + self.ops.data(coeff))
+            residual = C @ (T_new - T_old) / dt + K @ T_theta - sum(parts.values())
             fixed_in = float(residual[dofs].sum())
         residual_w = sources + flux + fixed_in - convection_out - stored
         return {
@@ -324,6 +354,18 @@ def probe_matrix(basis: Basis, points: np.ndarray) -> sp.csr_matrix:
         bad = points[:, np.where(outside)[0][0]]
         raise ValueError(f"probe point (r={bad[0]:.6g}, z={bad[1]:.6g}) m is outside the mesh")
     return sp.csr_matrix(basis.probes(points))
+
+
+def _field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
+    """A constant or a field f(r, z) evaluated at points (2, ...), checked finite."""
+    if callable(value):
+        out = np.asarray(value(points[0], points[1]), dtype=float)
+        out = np.broadcast_to(out, points.shape[1:]).astype(float)
+    else:
+        out = np.full(points.shape[1:], float(value))
+    if not np.all(np.isfinite(out)):
+        raise ValueError(f"{what}: load field is not finite")
+    return out
 
 
 class _LinearSolve:
