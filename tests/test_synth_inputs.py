@@ -1,0 +1,171 @@
+"""Emulator inputs and sensor models: scenario TOML, speed profile, lag, noise, faults."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.errors import InputError
+from twin.plant.profile import read_speed_profile
+from twin.plant.scenario import load_scenario, parse_scenario
+from twin.plant.sensors import add_noise, apply_faults, first_order_lag
+from twin.plant.timetable import StepTable, TimeTable
+from twin.plant.truth import default_tables, preload_factor, truth_tables
+
+SCENARIO = """\
+[bearing_heat.front]            # multiplier on the nominal (Palmgren) heat of that bearing
+time_s = [0, 300, 1800]
+factor = [1.00, 1.12, 1.04]
+[contact_resistance.rear]
+time_s = [0, 1800]
+factor = [1.0, 0.8]
+[coolant]
+time_s = [0, 1800]
+inlet_C = [22.0, 23.5]
+[ambient]
+time_s = [0, 1800]
+ambient_C = [24.0, 25.0]
+[sensors]
+noise_C = 0.05
+lag_s = 8.0
+noise_um = 0.1
+[faults]
+stuck = ["T2"]
+dropouts = [{sensor = "T4", start_s = 600, end_s = 660}]
+spikes = [{sensor = "T1", time_s = 100, size = 6.0}]
+"""
+
+
+def test_design_example_scenario_parses(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(SCENARIO)
+    s = load_scenario(path)
+    assert s.bearing_heat.front.table()(150.0) == pytest.approx(1.06)
+    assert s.bearing_heat.rear is None
+    assert s.coolant.table()(900.0) == pytest.approx(22.75)
+    assert s.faults.stuck == ["T2_C"] and s.faults.dropouts[0].sensor == "T4_C"
+    assert load_scenario(None).sensors.lag_s == 8.0
+
+
+@pytest.mark.parametrize("text, row, column, words", [
+    ("[bearing_heat.front]\ntime_s = [0, 300]\nfactor = [1.0]\n", 1, "bearing_heat.front",
+     "1 values for 2 times"),
+    ("[sensors]\nlag_s = 8\nnoise_c = 1\n", 3, "sensors.noise_c", "unknown key"),
+    ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck", "unknown sensor"),
+    ("\n[coolant]\ntime_s = [0]\ninlet_C = [300]\n", 4, "coolant.inlet_C.0", "less than"),
+    ("[contact_resistance.front]\ntime_s = [0, 60]\nfactor = [1.0, 0.0]\n", 3,
+     "contact_resistance.front.factor.1", "greater than 0"),
+    ("[ambient]\ntime_s = [0, 0]\nambient_C = [20, 21]\n", 1, "ambient", "increasing"),
+    ("[faults]\ndropouts = [{sensor = \"T1\", start_s = 60, end_s = 10}]\n", 2,
+     "faults.dropouts.0", "end_s"),
+    ("x = [\n", 1, None, "not valid TOML"),
+])
+def test_bad_scenarios(text, row, column, words):
+    with pytest.raises(InputError) as info:
+        parse_scenario(text, "bad.toml")
+    assert info.value.file == "bad.toml"
+    assert (info.value.row, info.value.column) == (row, column)
+    assert words in info.value.reason
+
+
+def test_speed_profile(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("# warm-up then full speed\ntime_s,speed_rpm,ambient_C\n0,6000,24\n"
+                    "600,12000,24.5\n")
+    p = read_speed_profile(path)
+    np.testing.assert_array_equal(p.speed_rpm(np.array([0, 599.9, 600, 5000])),
+                                  [6000, 6000, 12000, 12000])
+    assert p.ambient_C(700.0) == 24.5
+    assert p.speed_rpm.changes_in(0.0, 1800.0).tolist() == [600.0]
+
+
+@pytest.mark.parametrize("text, row, column", [
+    ("time_s,speed\n0,1\n", 1, "speed_rpm"),
+    ("time_s,speed_rpm\n0,9000\n60,fast\n", 3, "speed_rpm"),
+    ("time_s,speed_rpm\n0,9000\n0,8000\n", 3, "time_s"),
+    ("time_s,speed_rpm\n0,-1\n", 2, "speed_rpm"),
+    ("time_s,speed_rpm,ambient_C\n0,9000,298\n", 2, "ambient_C"),
+    ("time_s,speed_rpm\n", 1, None),
+])
+def test_bad_speed_profiles(tmp_path, text, row, column):
+    path = tmp_path / "p.csv"
+    path.write_text(text)
+    with pytest.raises(InputError) as info:
+        read_speed_profile(path)
+    assert (info.value.row, info.value.column) == (row, column)
+
+
+def test_tables():
+    t = TimeTable([0, 100], [1.0, 2.0])
+    np.testing.assert_allclose(t([-5, 50, 500]), [1.0, 1.5, 2.0])
+    s = StepTable([0, 100], [1.0, 2.0])
+    np.testing.assert_allclose(s([50, 100, 500]), [1.0, 2.0, 2.0])
+    with pytest.raises(ValueError):
+        TimeTable([0, 0], [1, 2])
+
+
+def test_lag_matches_closed_forms():
+    tau, dt = 8.0, 1.0
+    t = np.arange(0.0, 120.0, dt)
+    # ramp x = m t from rest: y = m (t − τ (1 − e^(−t/τ)))
+    y = first_order_lag(0.1 * t, dt, tau)
+    np.testing.assert_allclose(y, 0.1 * (t - tau * (1 - np.exp(-t / tau))), atol=1e-12)
+    # a sensor started 5 K colder than a constant truth relaxes as 5 e^(−t/τ)
+    y = first_order_lag(np.full((t.size, 2), 30.0), dt, tau, y0=np.array([25.0, 30.0]))
+    np.testing.assert_allclose(y[:, 0], 30.0 - 5.0 * np.exp(-t / tau), atol=1e-12)
+    np.testing.assert_allclose(y[:, 1], 30.0)
+    np.testing.assert_array_equal(first_order_lag(t, dt, 0.0), t)
+
+
+def test_noise_statistics_and_determinism():
+    x = np.zeros(20000)
+    a = add_noise(np.random.default_rng(3), x, 0.05)
+    b = add_noise(np.random.default_rng(3), x, 0.05)
+    np.testing.assert_array_equal(a, b)
+    assert np.std(a) == pytest.approx(0.05, rel=0.03)
+
+
+def test_faults():
+    s = parse_scenario(SCENARIO)
+    t = np.arange(0.0, 900.0)
+    cols = {f"T{k}_C": 25.0 + 0.01 * t for k in range(1, 6)}
+    out = apply_faults(t, cols, s.faults)
+    assert (out["T2_C"] == 25.0).all()
+    assert np.isnan(out["T4_C"][600:661]).all() and np.isfinite(out["T4_C"][:600]).all()
+    assert np.isfinite(out["T4_C"][661:]).all()
+    assert out["T1_C"][100] == pytest.approx(25.0 + 1.0 + 6.0)
+    assert out["T3_C"] is not cols["T3_C"] and (cols["T2_C"] == 25.0 + 0.01 * t).all()
+
+
+def test_preload_factor_shape():
+    t = np.arange(0.0, 1801.0, 10.0)
+    f = preload_factor(t, np.full(t.size, 9000.0), 0.10, 0.07, 90.0, 550.0)
+    peak = int(np.argmax(f))
+    assert f[0] == 1.0
+    assert 60.0 <= t[peak] <= 400.0 and 1.03 < f[peak] < 1.10  # builds up early ...
+    assert f[-1] < f[peak] - 0.02  # ... then relaxes
+    assert np.all(np.abs(f - 1.0) < 0.10)
+    slow = preload_factor(t, np.full(t.size, 3000.0), 0.10, 0.07, 90.0, 550.0)
+    assert np.max(slow) - 1.0 < np.max(f) - 1.0  # smaller swing at lower speed
+    assert preload_factor(t, np.zeros(t.size), 0.1, 0.07, 90.0, 550.0).tolist() == [1.0] * t.size
+
+
+def test_default_truth_is_seeded_and_overridable():
+    def speed(t):
+        return np.full(np.shape(t), 9000.0)
+
+    def ambient(t):
+        return np.full(np.shape(t), 25.0)
+
+    a = default_tables(np.random.default_rng(1), 1800.0, speed, ambient, 22.0)
+    b = default_tables(np.random.default_rng(1), 1800.0, speed, ambient, 22.0)
+    c = default_tables(np.random.default_rng(2), 1800.0, speed, ambient, 22.0)
+    np.testing.assert_array_equal(a.H_front.values, b.H_front.values)
+    assert not np.array_equal(a.H_front.values, c.H_front.values)
+    for table in (a.H_front, a.H_rear, a.R_front, a.R_rear):
+        assert np.all(np.abs(table.values - 1.0) <= 0.15)
+    assert 0.0 < np.abs(a.x_um.values).max() < 5.0
+    assert a.coolant_C(0.0) == pytest.approx(22.0) and a.ambient_C(0.0) == pytest.approx(25.0)
+    merged = truth_tables(parse_scenario(SCENARIO), a)
+    assert merged.H_front(300.0) == pytest.approx(1.12)
+    assert merged.H_rear is a.H_rear and merged.R_rear(1800.0) == pytest.approx(0.8)

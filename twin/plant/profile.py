@@ -1,0 +1,82 @@
+"""Speed profile CSV of the emulator: `time_s, speed_rpm[, ambient_C]`.
+
+A speed (and ambient, if given) holds until the next row; before the first row the first
+row's values hold.  `#` lines are comments.  Rows are numbered as lines in an editor.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import InputError
+from twin.plant.timetable import StepTable
+
+
+@dataclass(frozen=True)
+class SpeedProfile:
+    speed_rpm: StepTable
+    ambient_C: StepTable | None = None
+
+
+def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
+    """Read a speed profile; errors name the file, line and column."""
+    file = str(path)
+    try:
+        lines = Path(path).read_text(encoding="utf-8-sig").split("\n")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read speed profile: {exc}", file=file) from None
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[tuple[int, list[str]]] = []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        fields = [f.strip() for f in next(csv.reader([line]))]
+        if header is None:
+            header, header_line = fields, number
+        else:
+            rows.append((number, fields))
+    if header is None:
+        raise InputError("empty speed profile", file=file)
+    for name in ("time_s", "speed_rpm"):
+        if name not in header:
+            raise InputError("missing required column", file=file, row=header_line, column=name)
+    wanted = ["time_s", "speed_rpm"] + (["ambient_C"] if "ambient_C" in header else [])
+    if not rows:
+        raise InputError("no rows after the header", file=file, row=header_line)
+    values = np.empty((len(rows), len(wanted)))
+    for k, (number, fields) in enumerate(rows):
+        if len(fields) != len(header):
+            raise InputError(f"expected {len(header)} fields, found {len(fields)}", file=file,
+                             row=number)
+        for j, name in enumerate(wanted):
+            cell = fields[header.index(name)]
+            try:
+                value = float(cell)
+            except ValueError:
+                raise InputError(f"cannot read {cell!r} as a number", file=file, row=number,
+                                 column=name) from None
+            if not math.isfinite(value):
+                raise InputError(f"{cell!r} is not a finite number", file=file, row=number,
+                                 column=name)
+            values[k, j] = value
+        time, speed = values[k, 0], values[k, 1]
+        if time < 0:
+            raise InputError("time must be ≥ 0", file=file, row=number, column="time_s")
+        if k and time <= values[k - 1, 0]:
+            raise InputError("time must increase from row to row", file=file, row=number,
+                             column="time_s")
+        if speed < 0:
+            raise InputError(f"negative speed {speed:g} rpm", file=file, row=number,
+                             column="speed_rpm")
+        if len(wanted) == 3 and not -30.0 <= values[k, 2] <= 60.0:
+            raise InputError(f"ambient {values[k, 2]:g} °C is outside -30..60 °C", file=file,
+                             row=number, column="ambient_C")
+    ambient = StepTable(values[:, 0], values[:, 2]) if len(wanted) == 3 else None
+    return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient)

@@ -1,0 +1,239 @@
+"""Scenario TOML of the emulated spindle (shared DESIGN.md, "Emulator inputs").
+
+Every table is a time series linearly interpolated in time; anything left out takes the
+emulator's default (see `twin.plant.truth`), so an evaluator can pin exactly the truth
+factors a test case needs:
+
+    [bearing_heat.front]            # multiplier on the nominal (Palmgren) heat
+    time_s = [0, 300, 1800]
+    factor = [1.00, 1.12, 1.04]
+    [contact_resistance.rear]       # multiplier on the nominal ring/sleeve resistance
+    [coolant]      time_s, inlet_C  # inlet temperature °C
+    [ambient]      time_s, ambient_C   (overrides --ambient)
+    [xy_drift]     time_s, x_um, y_um  (radial drift an axisymmetric model cannot explain)
+    [sensors]      noise_C, lag_s, noise_um
+    [faults]       stuck = ["T2"], dropouts = [{sensor, start_s, end_s}],
+                   spikes = [{sensor, time_s, size}]   (size in °C or µm)
+    [model]        size_factor     (mesh refinement of the truth model; < 1 is finer)
+
+Unknown keys are errors (a typo must not silently fall back to a default).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tomllib
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from twin.errors import InputError
+from twin.plant.timetable import TimeTable
+
+SENSOR_COLUMNS = {
+    "T1": "T1_C", "T2": "T2_C", "T3": "T3_C", "T4": "T4_C", "T5": "T5_C",
+    "ambient": "ambient_C", "coolant": "coolant_C",
+    "disp_x": "disp_x_um", "disp_y": "disp_y_um", "disp_z": "disp_z_um",
+}
+_BY_COLUMN = {c: c for c in SENSOR_COLUMNS.values()}
+
+
+def sensor_column(name: str) -> str:
+    """Run column of a sensor named in a scenario (`T2` or `T2_C`, `disp_z`, ...)."""
+    column = SENSOR_COLUMNS.get(name) or _BY_COLUMN.get(name)
+    if column is None:
+        raise ValueError(f"unknown sensor {name!r}; expected one of {', '.join(SENSOR_COLUMNS)}")
+    return column
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+Times = Annotated[list[Annotated[float, Field(ge=0.0)]], Field(min_length=1)]
+
+
+class _Table(_Strict):
+    time_s: Times
+
+    def _check_lengths(self, *names: str) -> None:
+        if any(t1 <= t0 for t0, t1 in zip(self.time_s, self.time_s[1:], strict=False)):
+            raise ValueError("time_s must be strictly increasing")
+        for name in names:
+            if len(getattr(self, name)) != len(self.time_s):
+                raise ValueError(f"{name} has {len(getattr(self, name))} values for "
+                                 f"{len(self.time_s)} times")
+
+
+class FactorTable(_Table):
+    factor: list[Annotated[float, Field(gt=0.0, le=10.0)]]
+
+    @model_validator(mode="after")
+    def _lengths(self) -> FactorTable:
+        self._check_lengths("factor")
+        return self
+
+    def table(self) -> TimeTable:
+        return TimeTable(self.time_s, self.factor)
+
+
+Celsius = Annotated[float, Field(ge=-30.0, le=60.0)]
+
+
+class CoolantTable(_Table):
+    inlet_C: list[Celsius]
+
+    @model_validator(mode="after")
+    def _lengths(self) -> CoolantTable:
+        self._check_lengths("inlet_C")
+        return self
+
+    def table(self) -> TimeTable:
+        return TimeTable(self.time_s, self.inlet_C)
+
+
+class AmbientTable(_Table):
+    ambient_C: list[Celsius]
+
+    @model_validator(mode="after")
+    def _lengths(self) -> AmbientTable:
+        self._check_lengths("ambient_C")
+        return self
+
+    def table(self) -> TimeTable:
+        return TimeTable(self.time_s, self.ambient_C)
+
+
+Microns = Annotated[float, Field(ge=-100.0, le=100.0)]
+
+
+class XYDriftTable(_Table):
+    x_um: list[Microns]
+    y_um: list[Microns]
+
+    @model_validator(mode="after")
+    def _lengths(self) -> XYDriftTable:
+        self._check_lengths("x_um", "y_um")
+        return self
+
+
+class PerBearing(_Strict):
+    front: FactorTable | None = None
+    rear: FactorTable | None = None
+
+
+class Sensors(_Strict):
+    noise_C: Annotated[float, Field(ge=0.0, le=5.0)] = 0.05
+    lag_s: Annotated[float, Field(ge=0.0, le=600.0)] = 8.0
+    noise_um: Annotated[float, Field(ge=0.0, le=10.0)] = 0.1
+
+
+class _SensorRef(_Strict):
+    sensor: str
+
+    @field_validator("sensor")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        return sensor_column(name)
+
+
+class Dropout(_SensorRef):
+    start_s: Annotated[float, Field(ge=0.0)]
+    end_s: Annotated[float, Field(ge=0.0)]
+
+    @model_validator(mode="after")
+    def _order(self) -> Dropout:
+        if self.end_s <= self.start_s:
+            raise ValueError("end_s must be after start_s")
+        return self
+
+
+class Spike(_SensorRef):
+    time_s: Annotated[float, Field(ge=0.0)]
+    size: float = 5.0
+
+
+class Faults(_Strict):
+    stuck: list[str] = []
+    dropouts: list[Dropout] = []
+    spikes: list[Spike] = []
+
+    @field_validator("stuck")
+    @classmethod
+    def _known(cls, names: list[str]) -> list[str]:
+        return [sensor_column(n) for n in names]
+
+
+class ModelOptions(_Strict):
+    size_factor: Annotated[float, Field(gt=0.2, le=2.0)] = 0.7
+
+
+class Scenario(_Strict):
+    """A parsed scenario; `None` tables take the emulator's seeded defaults."""
+
+    bearing_heat: PerBearing = PerBearing()
+    contact_resistance: PerBearing = PerBearing()
+    coolant: CoolantTable | None = None
+    ambient: AmbientTable | None = None
+    xy_drift: XYDriftTable | None = None
+    sensors: Sensors = Sensors()
+    faults: Faults = Faults()
+    model: ModelOptions = ModelOptions()
+
+
+def _line_of(text: str, loc: tuple) -> int | None:
+    """Best-effort line of a dotted location (`bearing_heat.front.factor`) in TOML text."""
+    keys = [str(k) for k in loc if not isinstance(k, int)]
+    lines = text.split("\n")
+    start = 0
+    table_len = 0
+    for n in range(len(keys), 0, -1):  # the deepest [a.b] header that exists
+        header = re.compile(r"^\s*\[\s*" + r"\s*\.\s*".join(map(re.escape, keys[:n])) + r"\s*\]")
+        hit = next((i for i, ln in enumerate(lines) if header.match(ln)), None)
+        if hit is not None:
+            start, table_len = hit, n
+            break
+    rest = keys[table_len:]
+    if rest:
+        key = re.compile(r"^\s*" + re.escape(rest[0]) + r"\s*=")
+        for i in range(start + (1 if table_len else 0), len(lines)):
+            if table_len and i > start and lines[i].lstrip().startswith("["):
+                break
+            if key.match(lines[i]):
+                return i + 1
+    return start + 1 if table_len else None
+
+
+def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
+    """Parse scenario TOML text; errors name the file, line and dotted key."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        match = re.search(r"line (\d+)", str(exc))
+        row = getattr(exc, "lineno", None) or (int(match.group(1)) if match else None)
+        if row is None and "end of document" in str(exc):
+            row = text.rstrip("\n").count("\n") + 1
+        raise InputError(f"not valid TOML: {exc}", file=file, row=row) from None
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = tuple(err["loc"])
+        message = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            message = "unknown key (check the spelling)"
+        raise InputError(message, file=file, row=_line_of(text, loc),
+                         column=".".join(str(k) for k in loc) or None) from None
+
+
+def load_scenario(path: str | os.PathLike[str] | None) -> Scenario:
+    """Read a scenario file (None: every default)."""
+    if path is None:
+        return Scenario()
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read scenario: {exc}", file=str(path)) from None
+    return parse_scenario(text, str(path))

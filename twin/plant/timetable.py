@@ -1,0 +1,74 @@
+"""Time tables: a value given at a few times, read at any time.
+
+`TimeTable` interpolates linearly (scenario tables: factors, coolant, ambient drift);
+`StepTable` holds each value until the next time (speed profiles: a commanded speed).
+Both hold their end values outside the table.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+
+def _check(time_s: np.ndarray, values: np.ndarray, what: str) -> None:
+    if time_s.ndim != 1 or time_s.size == 0:
+        raise ValueError(f"{what}: time_s must be a non-empty list")
+    if values.shape != time_s.shape:
+        raise ValueError(f"{what}: {values.size} values for {time_s.size} times")
+    if not (np.isfinite(time_s).all() and np.isfinite(values).all()):
+        raise ValueError(f"{what}: times and values must be finite numbers")
+    if np.any(np.diff(time_s) <= 0):
+        raise ValueError(f"{what}: time_s must be strictly increasing")
+
+
+@dataclass(frozen=True)
+class TimeTable:
+    """Piecewise-linear function of time (s), constant beyond its ends."""
+
+    time_s: np.ndarray
+    values: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "time_s", np.asarray(self.time_s, dtype=float))
+        object.__setattr__(self, "values", np.asarray(self.values, dtype=float))
+        _check(self.time_s, self.values, "time table")
+
+    @classmethod
+    def constant(cls, value: float) -> TimeTable:
+        return cls(np.array([0.0]), np.array([float(value)]))
+
+    def __call__(self, t: ArrayLike) -> np.ndarray:
+        return np.interp(np.asarray(t, dtype=float), self.time_s, self.values)
+
+    def shifted(self, offset: float) -> TimeTable:
+        """The same table with `offset` added to every value."""
+        return TimeTable(self.time_s, self.values + offset)
+
+
+@dataclass(frozen=True)
+class StepTable:
+    """Piecewise-constant function of time: each value holds until the next time."""
+
+    time_s: np.ndarray
+    values: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "time_s", np.asarray(self.time_s, dtype=float))
+        object.__setattr__(self, "values", np.asarray(self.values, dtype=float))
+        _check(self.time_s, self.values, "step table")
+
+    @classmethod
+    def constant(cls, value: float) -> StepTable:
+        return cls(np.array([0.0]), np.array([float(value)]))
+
+    def __call__(self, t: ArrayLike) -> np.ndarray:
+        i = np.searchsorted(self.time_s, np.asarray(t, dtype=float), side="right") - 1
+        return self.values[np.clip(i, 0, self.values.size - 1)]
+
+    def changes_in(self, t0: float, t1: float) -> np.ndarray:
+        """Times in (t0, t1) where the value changes (solver steps should break there)."""
+        inside = (self.time_s > t0) & (self.time_s < t1)
+        return self.time_s[inside]
