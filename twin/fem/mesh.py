@@ -232,7 +232,8 @@ class AxiMesh:
             next_node += nodes.size
             new_points.append(points[:, nodes])
             node_map.extend(nodes.tolist())
-            lookup = -np.ones(n_glued, dtype=np.int64)
+            # sized to every node so far: side-b cells may hold copies from an earlier split
+            lookup = -np.ones(next_node, dtype=np.int64)
             lookup[nodes] = copies
             b_cells = np.where(cell_region == side_b)[0]
             sub = new_cells[:, b_cells]

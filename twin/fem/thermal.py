@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
@@ -109,7 +110,8 @@ class ThermalProblem:
         # one pattern for every operator: all cells plus the interface couplings (built
         # from the mass matrix: its entries are all positive, so none cancels to zero)
         pattern = asm(forms.capacity, self.basis)
-        self._jumps: dict[str, tuple[sp.csr_matrix, FacetBasis]] = {}
+        self._interface_factors: dict[str, tuple[sp.csc_matrix, np.ndarray]] = {}
+        self._base_factorizations: dict[tuple, _BaseFactorization] = {}
         iface_ops = {}
         for name, iface in mesh.interfaces.items():
             iface_ops[name] = self._interface_operator(name, iface.facets_a, iface.facets_b)
@@ -165,6 +167,12 @@ class ThermalProblem:
                 (np.r_[dofs_a, dofs_a], np.r_[dofs_a, dofs_b[idx]]),
             ),
             shape=(n, n),
+        )
+        # low-rank form K_i = U M U^T (U: n × m jump columns, M: facet mass on side a),
+        # used to update a factorization when only this interface's resistance changes
+        self._interface_factors[name] = (
+            sp.csc_matrix(jump.T)[:, dofs_a],
+            m_a[dofs_a][:, dofs_a].toarray(),
         )
         return (jump.T @ m_a @ jump).tocsr()
 
@@ -402,18 +410,73 @@ class _LinearSolve:
         return x
 
 
+class _BaseFactorization:
+    """A factorized step matrix and its response to the interface jump columns.
+
+    When a new window changes only contact resistances (and sources, which touch just the
+    right-hand side), A_new = A_base + U W Uᵀ with U the interface jump columns (a few
+    dozen) and W = blockdiag(θ·Δ(1/R_i)·M_i).  Woodbury then gives
+        A_new⁻¹ b = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A_base⁻¹ b,  Z = A_base⁻¹ U,
+    so the window needs no sparse factorization at all.
+    """
+
+    def __init__(self, solver: _LinearSolve, coefficients: dict[str, float], U: sp.csc_matrix):
+        self.solver = solver
+        self.coefficients = coefficients
+        self.U = U
+        self.Z = solver.lu.solve(U.toarray()) if U.shape[1] else np.zeros((U.shape[0], 0))
+        self.UtZ = U.T @ self.Z
+
+
 class ThermalStepper:
-    """θ-method time stepping with a fixed Δt and fixed loads: one factorization."""
+    """θ-method time stepping with a fixed Δt and fixed loads.
+
+    The step matrix C/Δt + θK is factorized once per distinct set of film coefficients
+    (they change with speed); a window that changes only the contact resistances reuses
+    that factorization through a low-rank (Woodbury) update of the interface terms.
+    """
 
     def __init__(self, problem: ThermalProblem, loads: ThermalLoads, dt: float, theta: float):
         self.problem, self.loads, self.dt, self.theta = problem, loads, dt, theta
-        k_data, self.f = problem.system(loads)
+        coeff, parts = problem.load_parts(loads)
+        self.f = sum(parts.values())
+        k_data = problem.conduction_data + problem.ops.data(coeff)
         c_data = problem.capacity_data / dt
         ops = problem.ops
-        dofs, values = problem.fixed(loads)
-        self._solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
         self._explicit = ops.csr(c_data - (1.0 - theta) * k_data)
+        self._update = None
+        dofs, values = problem.fixed(loads)
+        if dofs.size or not problem.mesh.interfaces:
+            self._solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
+            return
+        films = tuple(sorted((k, v) for k, v in coeff.items() if k.startswith("film:")))
+        key = (dt, theta, films)
+        base = problem._base_factorizations.get(key)
+        iface = {k: v for k, v in coeff.items() if k.startswith("interface:")}
+        if base is None:
+            if len(problem._base_factorizations) >= 8:  # bound memory: drop the oldest
+                problem._base_factorizations.pop(next(iter(problem._base_factorizations)))
+            U = sp.hstack([problem._interface_factors[n][0] for n in problem.mesh.interfaces])
+            solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
+            base = _BaseFactorization(solver, iface, sp.csc_matrix(U))
+            problem._base_factorizations[key] = base
+        self._solver = base.solver
+        blocks = [
+            theta
+            * (iface[f"interface:{n}"] - base.coefficients[f"interface:{n}"])
+            * problem._interface_factors[n][1]
+            for n in problem.mesh.interfaces
+        ]
+        if any(np.any(b) for b in blocks):
+            W = sla.block_diag(*blocks)
+            capacitance = np.eye(W.shape[0]) + W @ base.UtZ
+            self._update = (base, W, sla.lu_factor(capacitance))
 
     def step(self, T: np.ndarray) -> np.ndarray:
         """Advance one Δt from nodal temperature T (°C)."""
-        return self._solver.solve(self._explicit @ T + self.f)
+        y = self._solver.solve(self._explicit @ T + self.f)
+        if self._update is None:
+            return y
+
+        base, W, lu = self._update
+        return y - base.Z @ sla.lu_solve(lu, W @ (base.U.T @ y))
