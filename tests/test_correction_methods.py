@@ -1,0 +1,166 @@
+"""The per-window correction methods, closed loop on a lumped plant with a known truth."""
+
+import numpy as np
+import pytest
+
+from twin.correction import (
+    BoundaryValues,
+    OpenLoop,
+    RatioCorrection,
+    WindowFeatures,
+    make_corrector,
+)
+from twin.correction.features import rise_over_window, window_line_fit
+from twin.correction.toy_plant import ToyPlant
+
+PLANT = ToyPlant()
+SPEED = 9000.0
+AMBIENT = 25.0
+TRUE_HEAT = np.array([1.10, 0.90])  # truth / nominal
+TRUE_RES = np.array([1.30, 0.80])
+
+
+def _measured(seed=0, noise=0.05):
+    t = np.arange(0, 1801, 2.0)
+    H = PLANT.nominal_heat_W_m3(SPEED) * TRUE_HEAT
+    R = PLANT.nominal_resistance_m2K_W(SPEED) * TRUE_RES
+    T = PLANT.simulate(t, SPEED, AMBIENT, H, R)
+    return t, T + np.random.default_rng(seed).normal(0, noise, T.shape)
+
+
+def _nominal():
+    return BoundaryValues(*PLANT.nominal_heat_W_m3(SPEED), *PLANT.nominal_resistance_m2K_W(SPEED))
+
+
+def _twin(method, t_meas, T_meas, windows=30):
+    """Window-by-window twin of the plant driven by `method`; returns values and errors."""
+    nominal = _nominal()
+    prev = nominal
+    sim_t, sim_T = [0.0], [np.full(5, AMBIENT)]
+    history = []
+    for k in range(windows):
+        start = 60.0 * k
+        seen = t_meas <= start
+        f = WindowFeatures(k, start, SPEED, AMBIENT, t_meas[seen], T_meas[seen],
+                           np.array(sim_t), np.array(sim_T), nominal, prev)
+        c = method.correct(f)
+        prev = c.values
+        history.append(np.array(c.values) / np.array(nominal))
+        steps = start + np.arange(0, 61, 4.0)
+        T = PLANT.simulate(steps, SPEED, AMBIENT, np.array(c.values[:2]),
+                           np.array(c.values[2:]), initial_C=sim_T[-1])
+        sim_t += list(steps[1:])
+        sim_T += list(T[1:])
+    sim_t, sim_T = np.array(sim_t), np.array(sim_T)
+    truth = PLANT.simulate(sim_t, SPEED, AMBIENT, PLANT.nominal_heat_W_m3(SPEED) * TRUE_HEAT,
+                           PLANT.nominal_resistance_m2K_W(SPEED) * TRUE_RES)
+    late = sim_t > 600
+    return np.array(history), np.abs(sim_T - truth)[late].mean(axis=0)
+
+
+def test_open_loop_returns_nominal():
+    t, T = _measured()
+    values, _ = _twin(OpenLoop(), t, T, windows=12)
+    assert np.all(values == 1.0)
+
+
+def test_ratio_recovers_truth_and_beats_open_loop():
+    t, T = _measured()
+    _, err_open = _twin(OpenLoop(), t, T)
+    values, err_ratio = _twin(RatioCorrection(), t, T)
+    # the front ring (T1) is 0.5 K off open loop; the ratio twin is at least 3x closer
+    assert err_open[0] > 0.3
+    assert err_ratio[0] < err_open[0] / 3
+    assert np.all(err_ratio[:4] < err_open[:4])
+    late = values[-10:].mean(axis=0)
+    assert late[0] == pytest.approx(TRUE_HEAT[0], abs=0.03)
+    assert late[1] == pytest.approx(TRUE_HEAT[1], abs=0.04)
+    assert late[2] == pytest.approx(TRUE_RES[0], abs=0.1)
+
+
+def test_ratio_is_causal_and_window0_is_nominal():
+    t, T = _measured()
+    nominal = _nominal()
+    sim_t = np.arange(0, 301, 4.0)
+    sim_T = PLANT.simulate(sim_t, SPEED, AMBIENT, np.array(nominal[:2]), np.array(nominal[2:]))
+    method = RatioCorrection()
+    f_past = WindowFeatures(5, 300.0, SPEED, AMBIENT, t[t <= 300], T[t <= 300], sim_t, sim_T,
+                            nominal, nominal)
+    future = T.copy()
+    future[t > 300] += 50.0  # whatever happens later must not matter
+    f_all = WindowFeatures(5, 300.0, SPEED, AMBIENT, t, future, sim_t, sim_T, nominal, nominal)
+    assert tuple(method.correct(f_past)) == tuple(method.correct(f_all))
+    f0 = WindowFeatures(0, 0.0, SPEED, AMBIENT, t[:1], T[:1], sim_t[:1], sim_T[:1],
+                        nominal, nominal)
+    assert tuple(method.correct(f0)) == tuple(nominal)
+
+
+def test_ratio_dead_sensor_keeps_previous_value():
+    t, T = _measured()
+    nominal = _nominal()
+    previous = BoundaryValues(*(np.array(nominal) * 1.07))
+    T = T.copy()
+    T[:, 0] = np.nan  # T1 lost: front heat and front resistance have no signal
+    sim_t = np.arange(0, 601, 4.0)
+    sim_T = PLANT.simulate(sim_t, SPEED, AMBIENT, np.array(nominal[:2]), np.array(nominal[2:]))
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[t <= 600], T[t <= 600], sim_t, sim_T,
+                       nominal, previous)
+    c = RatioCorrection().correct(f)
+    assert c.H_front_W_m3 == pytest.approx(previous.H_front_W_m3)
+    assert c.R_front_m2K_W == pytest.approx(previous.R_front_m2K_W)
+    assert c.C_H[0] == pytest.approx(1.0)
+
+
+def test_speed_change_carries_the_factor():
+    t, T = _measured()
+    nominal_old = _nominal()
+    nominal_new = BoundaryValues(*(np.array(nominal_old) * [2, 2, 1, 1]))
+    previous = BoundaryValues(*(np.array(nominal_old) * 1.1))
+    # the twin matched the measurement exactly: every ratio neutral
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[t <= 600], T[t <= 600], t[t <= 600],
+                       T[t <= 600], nominal_new, previous, previous_nominal=nominal_old)
+    c = RatioCorrection().correct(f)
+    ratio = np.array(c.values) / np.array(nominal_new)
+    assert ratio[:2] == pytest.approx([1.1, 1.1], rel=1e-9)
+    # the resistances also see the (small) Eq. 5 pressure change over the last window
+    assert ratio[2:] == pytest.approx([1.1, 1.1], rel=0.01)
+
+
+def test_correction_unpacks_and_reports_factors():
+    nominal = _nominal()
+    previous = BoundaryValues(*(np.array(nominal) * 0.5))
+    f = WindowFeatures(3, 180.0, SPEED, AMBIENT, np.zeros(1), np.zeros((1, 5)), np.zeros(1),
+                       np.zeros((1, 5)), nominal, previous)
+    H_front, H_rear, R_front, R_rear = OpenLoop().correct(f)
+    assert (H_front, H_rear, R_front, R_rear) == tuple(nominal)
+    assert OpenLoop().correct(f).C_H == (2.0, 2.0)
+
+
+def test_make_corrector_names():
+    assert make_corrector("open_loop").name == "open_loop"
+    assert make_corrector("ratio").name == "ratio"
+    with pytest.raises(ValueError, match="needs a model"):
+        make_corrector("bpnn")
+    with pytest.raises(ValueError, match="unknown correction method"):
+        make_corrector("magic")
+
+
+def test_window_line_fit_on_a_line():
+    t = np.arange(0, 121, 2.0)
+    T = np.column_stack([20 + 0.01 * t, np.full(t.size, 30.0)])
+    T[5, 0] = np.nan
+    level, rise = window_line_fit(t, T, 120.0, 60.0)
+    assert level == pytest.approx([21.2, 30.0])
+    assert rise == pytest.approx([0.6, 0.0], abs=1e-12)
+    assert np.isnan(rise_over_window(t[:1], T[:1], 0.0)).all()
+
+
+def test_paper_literal_law_is_worse_in_closed_loop():
+    # the documented reason the default gains differ from the paper's literal product
+    from twin.correction.methods import PAPER_GAINS
+
+    t, T = _measured()
+    values_paper, err_paper = _twin(RatioCorrection(gains=PAPER_GAINS), t, T)
+    values_default, err_default = _twin(RatioCorrection(), t, T)
+    assert err_paper[0] > 2 * err_default[0]
+    assert np.std(values_paper[-10:, 0]) > 3 * np.std(values_default[-10:, 0])

@@ -1,0 +1,73 @@
+"""`twin train`: train the correction networks on recorded runs; `twin model-info`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from twin.cli import command
+
+
+@command("train")
+def train(
+    runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on."),
+    out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
+    epochs: int = typer.Option(5000, "--epochs", min=1, help="Maximum Rprop epochs."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the 80/20 split and the weights."),
+    paper_config: bool = typer.Option(
+        False, "--paper-config",
+        help="Save the paper's configuration (linear hidden, logistic output, logistic "
+        "scaling of X/1e6) instead of the default (tanh hidden, standardised factors).",
+    ),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
+) -> None:
+    """Train the 6-10-1 heat and 6-12-1 contact-resistance networks of both bearings.
+
+    Writes MODEL and, beside it, MODEL.report.json and MODEL.report.html (loss curves, R²
+    of both configurations, predicted vs target).
+    """
+    from twin.correction.modelfile import save_model
+    from twin.correction.network import DEFAULT, PAPER
+    from twin.correction.report import write_report
+    from twin.correction.samples import SampleSet, build_samples
+    from twin.correction.training import train_model
+    from twin.correction.training_data import default_simulator, run_curves
+    from twin.runs import read_run
+
+    simulator = default_simulator()
+    sets = []
+    for path in runs:
+        run = read_run(path)
+        if not quiet:
+            typer.echo(f"simulating {path.name} …", err=True)
+        sets.append(build_samples(run_curves(run, simulator)))
+    samples = SampleSet.concatenate(sets)
+    chosen = PAPER if paper_config else DEFAULT
+    meta = {"runs": [str(p) for p in runs], "simulation": getattr(simulator, "__name__", "")}
+    results = {}
+    for config in (DEFAULT, PAPER):
+        if not quiet:
+            typer.echo(f"training ({config.name} configuration) on {len(samples)} samples …",
+                       err=True)
+        results[config.name] = train_model(samples, config=config, epochs=epochs, seed=seed,
+                                           metadata=meta)
+    save_model(results[chosen.name].model, out)
+    json_path, html_path = write_report(out, results, chosen.name)
+    if not quiet:
+        for output, row in results[chosen.name].r2_table().items():
+            typer.echo(f"{output:18s} R² {row['r2_value']:.4f} (factor {row['r2_factor']:.3f})")
+        typer.echo(f"wrote {out}, {json_path.name}, {html_path.name}")
+
+
+@command("model-info")
+def model_info(model: Path = typer.Argument(..., help="Correction model file.")) -> None:
+    """Check a correction model file and print what it was trained on and how well."""
+    from twin.correction.modelfile import load_model
+
+    m = load_model(model)
+    meta = m.metadata
+    typer.echo(f"{model}: {meta.get('config')} configuration, {meta.get('samples')} samples, "
+               f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}")
+    for output, r2 in (meta.get("r2") or {}).items():
+        typer.echo(f"  {output:18s} R² {r2.get('value')}  factor R² {r2.get('factor')}")

@@ -1,0 +1,228 @@
+"""What a correction method sees of one window, and the network input vectors built from it.
+
+Window k covers [60k, 60k + 60) s.  Causality: everything here was measured (or simulated
+by the twin) at or before the window start; a method's output is a forecast of the
+boundary values for the window to come.
+
+Sensor columns follow the recorded-run schema: T1 front-bearing outer ring, T2 front
+sleeve, T3 rear-bearing outer ring, T4 rear sleeve, T5 housing (REFERENCE.md §1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+WINDOW_S = 60.0
+"""Correction window (s): the paper corrects every 60 s."""
+
+BEARINGS: tuple[str, ...] = ("front", "rear")
+RING_SENSOR = {"front": 0, "rear": 2}
+"""Column of the bearing's outer-ring key point (T1 front, T3 rear)."""
+SLEEVE_SENSOR = {"front": 1, "rear": 3}
+"""Column of the sleeve sensor next to the ring (T2 front, T4 rear)."""
+
+OUTPUTS: tuple[str, ...] = ("heat_front", "heat_rear", "resistance_front", "resistance_rear")
+"""The four networks / corrected values, in BoundaryValues order."""
+
+HIDDEN_SIZES = {"heat": 10, "resistance": 12}
+"""Hidden neurons of the paper's networks: heat 6-10-1, contact resistance 6-12-1."""
+
+INPUT_NAMES = {
+    "heat": (
+        "speed_rpm",
+        "ambient_C",
+        "measured_ring_C",
+        "simulated_ring_C",
+        "run_time_s",
+        "nominal_heat_W_m3",
+    ),
+    "resistance": (
+        "speed_rpm",
+        "ambient_C",
+        "measured_ring_to_sleeve_C",
+        "simulated_ring_to_sleeve_C",
+        "run_time_s",
+        "nominal_resistance_m2K_W",
+    ),
+}
+"""Six inputs per network (the paper's choice).  The heat networks see the ring (key-point)
+temperature; the resistance networks see the ring-to-sleeve drop, which carries the
+contact-resistance signal."""
+
+TARGET_UNITS = {"heat": "W/m³", "resistance": "m²K/W"}
+
+
+def kind_of(output: str) -> str:
+    """'heat' or 'resistance' for an output name such as 'heat_front'."""
+    return output.split("_", 1)[0]
+
+
+def bearing_of(output: str) -> str:
+    """'front' or 'rear' for an output name such as 'heat_front'."""
+    return output.split("_", 1)[1]
+
+
+class BoundaryValues(NamedTuple):
+    """The four corrected boundary values of one window."""
+
+    H_front_W_m3: float
+    H_rear_W_m3: float
+    R_front_m2K_W: float
+    R_rear_m2K_W: float
+
+
+@dataclass(frozen=True)
+class WindowFeatures:
+    """Inputs of one correction step (window `window`, starting at `start_s`).
+
+    measured_time_s (n,), measured_C (n, 5): the recorded T1..T5 up to the window start
+    (later samples, if passed, are ignored: causality).  NaN marks a missing sample.
+    simulated_time_s (m,), simulated_C (m, 5): the twin's own T1..T5 at its solver steps up
+    to the window start (m may be 0 or 1 before the first window).
+    nominal: Eq. 1 / Eq. 4 values at the current speed; previous: last window's values
+    (equal to nominal for window 0); previous_nominal: the nominal values the previous
+    window had (None: unchanged), so a correction can carry over a speed change as a factor.
+    """
+
+    window: int
+    start_s: float
+    speed_rpm: float
+    ambient_C: float
+    measured_time_s: np.ndarray
+    measured_C: np.ndarray
+    simulated_time_s: np.ndarray
+    simulated_C: np.ndarray
+    nominal: BoundaryValues
+    previous: BoundaryValues
+    window_s: float = WINDOW_S
+    previous_nominal: BoundaryValues | None = None
+    """Nominal values of the previous window, if the speed changed since (else = nominal)."""
+
+    def __post_init__(self) -> None:
+        pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))
+        for name, rows in pairs:
+            values = getattr(self, f"{name}_C")
+            if np.ndim(values) != 2 or np.shape(values)[1] != 5 or len(values) != len(rows):
+                raise ValueError(f"WindowFeatures.{name}_C must be ({len(rows)}, 5)")
+        if not all(v > 0 for v in self.nominal):
+            raise ValueError("WindowFeatures.nominal values must be positive")
+        if not all(v > 0 for v in self.previous):
+            raise ValueError("WindowFeatures.previous values must be positive")
+
+    def measured_now(self) -> np.ndarray:
+        """T1..T5 measured: the last finite sample at or before the window start (°C)."""
+        return last_at_or_before(self.measured_time_s, self.measured_C, self.start_s)
+
+    def simulated_now(self) -> np.ndarray:
+        """T1..T5 of the twin at the window start (°C)."""
+        return last_at_or_before(self.simulated_time_s, self.simulated_C, self.start_s)
+
+    def measured_initial(self) -> np.ndarray:
+        """T1..T5 at the start of the run: the first finite sample of each sensor (°C)."""
+        return first_finite(self.measured_C)
+
+    def network_inputs(self) -> dict[str, np.ndarray]:
+        """The (1, 6) input row of each network for this window."""
+        return network_inputs(
+            speed_rpm=[self.speed_rpm],
+            ambient_C=[self.ambient_C],
+            run_time_s=[self.start_s],
+            measured_C=self.measured_now()[None, :],
+            simulated_C=self.simulated_now()[None, :],
+            nominal=np.asarray(self.nominal, dtype=float)[None, :],
+        )
+
+
+def last_at_or_before(time_s: ArrayLike, values: ArrayLike, t_s: float) -> np.ndarray:
+    """Per column, the last finite value sampled at or before t_s (NaN if there is none)."""
+    time = np.asarray(time_s, dtype=float)
+    vals = np.asarray(values, dtype=float).reshape(time.size, -1)
+    out = np.full(vals.shape[1], np.nan)
+    usable = time <= t_s + 1e-9
+    for j in range(vals.shape[1]):
+        idx = np.flatnonzero(usable & np.isfinite(vals[:, j]))
+        if idx.size:
+            out[j] = vals[idx[-1], j]
+    return out
+
+
+def first_finite(values: ArrayLike) -> np.ndarray:
+    """Per column, the first finite value (NaN if there is none)."""
+    vals = np.asarray(values, dtype=float)
+    out = np.full(vals.shape[1], np.nan)
+    for j in range(vals.shape[1]):
+        idx = np.flatnonzero(np.isfinite(vals[:, j]))
+        if idx.size:
+            out[j] = vals[idx[0], j]
+    return out
+
+
+def window_line_fit(
+    time_s: ArrayLike, values: ArrayLike, end_s: float, window_s: float = WINDOW_S
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per column, (level at end_s in °C, rise over the span in K) of a least-squares line
+    through the finite samples in (end_s − window_s, end_s].
+
+    Sensor noise averages out instead of entering a two-point difference at full size.
+    A column with a single sample gives that sample as level and NaN rise; with none, NaN.
+    """
+    time = np.asarray(time_s, dtype=float)
+    vals = np.asarray(values, dtype=float).reshape(time.size, -1)
+    in_span = (time > end_s - window_s - 1e-9) & (time <= end_s + 1e-9)
+    level = np.full(vals.shape[1], np.nan)
+    rise = np.full(vals.shape[1], np.nan)
+    for j in range(vals.shape[1]):
+        ok = in_span & np.isfinite(vals[:, j])
+        t = time[ok]
+        if t.size == 1:
+            level[j] = vals[ok, j][0]
+        if t.size < 2 or np.ptp(t) <= 0:
+            continue
+        t_mean = t.mean()
+        slope, mean = np.polyfit(t - t_mean, vals[ok, j], 1)
+        level[j] = mean + slope * (end_s - t_mean)
+        rise[j] = slope * window_s
+    return level, rise
+
+
+def rise_over_window(
+    time_s: ArrayLike, values: ArrayLike, end_s: float, window_s: float = WINDOW_S
+) -> np.ndarray:
+    """Per column, the rise (K) over (end_s − window_s, end_s] of `window_line_fit`."""
+    return window_line_fit(time_s, values, end_s, window_s)[1]
+
+
+def network_inputs(
+    *,
+    speed_rpm: ArrayLike,
+    ambient_C: ArrayLike,
+    run_time_s: ArrayLike,
+    measured_C: ArrayLike,
+    simulated_C: ArrayLike,
+    nominal: ArrayLike,
+) -> dict[str, np.ndarray]:
+    """The (N, 6) input matrix of each of the four networks (columns as in INPUT_NAMES).
+
+    measured_C, simulated_C: (N, 5) T1..T5; nominal: (N, 4) in BoundaryValues order.
+    """
+    speed = np.asarray(speed_rpm, dtype=float)
+    amb = np.asarray(ambient_C, dtype=float)
+    time = np.asarray(run_time_s, dtype=float)
+    meas = np.asarray(measured_C, dtype=float)
+    sim = np.asarray(simulated_C, dtype=float)
+    nom = np.asarray(nominal, dtype=float)
+    out = {}
+    for i, output in enumerate(OUTPUTS):
+        bearing = bearing_of(output)
+        ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
+        if kind_of(output) == "heat":
+            m, s = meas[:, ring], sim[:, ring]
+        else:
+            m = meas[:, ring] - meas[:, sleeve]
+            s = sim[:, ring] - sim[:, sleeve]
+        out[output] = np.column_stack([speed, amb, m, s, time, nom[:, i]])
+    return out

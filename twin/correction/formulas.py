@@ -1,0 +1,247 @@
+"""Analytic corrections of bearing heat and bearing/sleeve contact resistance.
+
+The reference paper's Eq. 2, 3, 5 and 6 (shared REFERENCE.md §1), restated:
+
+- Eq. 2, first heat correction:  H' = (t_m − t_amb) / (t_f − t_amb) · H
+- Eq. 3, second heat correction: C_H = Δt_m / Δt_f,  H'' = C_H · H'
+- Eq. 5, pressure correction of the contact resistance (interpretation below): R'
+- Eq. 6, second resistance correction: C_C = Δt_m / Δt_f,  R'' = C_C · R'
+
+t_m is measured, t_f simulated ("FEM") at the bearing's key point; H and R are the values
+the simulation that produced t_f used.  In the online twin that is the previous window's
+value, so the corrections act as a multiplicative feedback and leave a value that already
+matches the measurement unchanged.
+
+Interpretations (the paper is terse or garbled here):
+
+- Eq. 3's Δt is the temperature *rise over one window* (60 s), so C_H reacts to the current
+  heating rate while Eq. 2 reacts to the accumulated rise.
+- Eq. 6's Δt is the temperature *drop across the contact*, ring minus sleeve
+  (T1 − T2 front, T3 − T4 rear): at a contact the drop is heat flux × resistance, the
+  direct signal of the resistance.  Measured drop larger than simulated → resistance too low.
+- Eq. 5: Eq. 4 gives R ∝ P^−0.68 (r/(R·k) = 10^5.6 (P/E)^0.68).  The contact pressure of an
+  interference fit is proportional to the interference, so a thermal change Δδ of the radial
+  interference δ0 changes the pressure by ΔP/P = Δδ/δ0 and
+  R' = R · (1 + Δδ/δ0)^−0.68, with Δδ = r_fit · (α_ring · (T_ring − T_0) − α_sleeve ·
+  (T_sleeve − T_0)): a ring hotter than its sleeve tightens the fit and lowers R.  Relative
+  to a reference state that already had a pressure factor, the ratio of the two factors is
+  applied.
+
+Guards (`RatioGuards`): a ratio of two small, noisy numbers is meaningless, so a ratio whose
+denominator is below a documented floor, whose terms have opposite signs (one heating, one
+cooling), or that is not finite (missing sensor) gives the neutral factor 1; every ratio is
+clipped to documented limits; corrected values stay within a band around the nominal value,
+which is positive, so no correction can produce a non-positive heat or resistance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+CONTACT_PRESSURE_EXPONENT = 0.68
+"""Exponent of (P/E) in the contact-resistance correlation (REFERENCE.md §1, Eq. 4)."""
+
+
+@dataclass(frozen=True)
+class RatioGuards:
+    """Limits that keep the ratio corrections finite, positive and calm.
+
+    The floors are about ten times the sensor noise of a thermocouple channel (0.05 °C)
+    so that a ratio is only taken when both rises are signal, not noise.
+    """
+
+    min_total_rise_C: float = 0.5
+    """Eq. 2: simulated rise over ambient below this (the first seconds of a run) → factor 1."""
+    min_window_rise_C: float = 0.1
+    """Eq. 3: simulated rise over one window below this (near balance) → factor 1."""
+    min_contact_drop_C: float = 0.1
+    """Eq. 6: simulated ring-to-sleeve drop below this → factor 1."""
+    total_ratio_limits: tuple[float, float] = (0.5, 2.0)
+    """Clip of the Eq. 2 ratio."""
+    window_ratio_limits: tuple[float, float] = (0.8, 1.25)
+    """Clip of C_H (Eq. 3): one window may change the heat by at most this factor."""
+    contact_ratio_limits: tuple[float, float] = (0.8, 1.25)
+    """Clip of C_C (Eq. 6)."""
+    value_limits: tuple[float, float] = (0.2, 5.0)
+    """Corrected H and R stay within these multiples of their nominal (Eq. 1 / Eq. 4) value."""
+    min_relative_pressure: float = 0.1
+    """Eq. 5: floor of P'/P = 1 + Δδ/δ0 (a fit that opens would make R infinite)."""
+
+    def __post_init__(self) -> None:
+        for name in ("min_total_rise_C", "min_window_rise_C", "min_contact_drop_C",
+                     "min_relative_pressure"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"RatioGuards.{name} must be positive")
+        for name in ("total_ratio_limits", "window_ratio_limits", "contact_ratio_limits",
+                     "value_limits"):
+            low, high = getattr(self, name)
+            if not 0 < low <= 1 <= high:
+                raise ValueError(f"RatioGuards.{name} must satisfy 0 < low <= 1 <= high")
+
+
+DEFAULT_GUARDS = RatioGuards()
+
+
+@dataclass(frozen=True)
+class ContactFit:
+    """Interference fit of a bearing outer ring in its sleeve (for Eq. 5).
+
+    Defaults: outer-ring radius of a 7014-size angular-contact bearing, a light radial
+    interference, GCr15 ring and steel-45 sleeve expansion (REFERENCE.md §2).
+    """
+
+    fit_radius_m: float = 0.055
+    interference_m: float = 4e-6
+    """Radial interference δ0 of the cold fit (m)."""
+    alpha_ring_per_K: float = 13.3e-6
+    alpha_sleeve_per_K: float = 12.2e-6
+
+    def __post_init__(self) -> None:
+        for name in ("fit_radius_m", "interference_m", "alpha_ring_per_K", "alpha_sleeve_per_K"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"ContactFit.{name} must be positive")
+
+
+def guarded_ratio(
+    numerator: ArrayLike,
+    denominator: ArrayLike,
+    *,
+    min_denominator: float,
+    limits: tuple[float, float],
+) -> np.ndarray:
+    """numerator / denominator, or 1 where that ratio carries no information.
+
+    Neutral (1) where |denominator| < min_denominator, where the two have opposite signs or
+    the numerator is zero, or where either is not finite; otherwise clipped to `limits`.
+    """
+    num = np.asarray(numerator, dtype=float)
+    den = np.asarray(denominator, dtype=float)
+    usable = np.isfinite(num) & np.isfinite(den) & (np.abs(den) >= min_denominator)
+    safe_den = np.where(usable, den, 1.0)
+    ratio = np.where(usable, num / safe_den, 1.0)
+    ratio = np.where(ratio > 0, ratio, 1.0)
+    return np.clip(ratio, limits[0], limits[1])
+
+
+def total_rise_ratio(
+    measured_C: ArrayLike,
+    simulated_C: ArrayLike,
+    ambient_C: ArrayLike,
+    guards: RatioGuards = DEFAULT_GUARDS,
+) -> np.ndarray:
+    """Eq. 2 factor (t_m − t_amb) / (t_f − t_amb), guarded."""
+    amb = np.asarray(ambient_C, dtype=float)
+    return guarded_ratio(
+        np.asarray(measured_C, dtype=float) - amb,
+        np.asarray(simulated_C, dtype=float) - amb,
+        min_denominator=guards.min_total_rise_C,
+        limits=guards.total_ratio_limits,
+    )
+
+
+def window_rise_ratio(
+    measured_rise_C: ArrayLike,
+    simulated_rise_C: ArrayLike,
+    guards: RatioGuards = DEFAULT_GUARDS,
+) -> np.ndarray:
+    """Eq. 3 coefficient C_H = Δt_m / Δt_f of the rises over one window, guarded."""
+    return guarded_ratio(
+        measured_rise_C,
+        simulated_rise_C,
+        min_denominator=guards.min_window_rise_C,
+        limits=guards.window_ratio_limits,
+    )
+
+
+def contact_drop_ratio(
+    measured_drop_C: ArrayLike,
+    simulated_drop_C: ArrayLike,
+    guards: RatioGuards = DEFAULT_GUARDS,
+) -> np.ndarray:
+    """Eq. 6 coefficient C_C = Δt_m / Δt_f of the ring-to-sleeve drops, guarded."""
+    return guarded_ratio(
+        measured_drop_C,
+        simulated_drop_C,
+        min_denominator=guards.min_contact_drop_C,
+        limits=guards.contact_ratio_limits,
+    )
+
+
+def heat_first_correction(
+    heat_W_m3: ArrayLike,
+    measured_C: ArrayLike,
+    simulated_C: ArrayLike,
+    ambient_C: ArrayLike,
+    guards: RatioGuards = DEFAULT_GUARDS,
+) -> np.ndarray:
+    """Eq. 2: H' = (t_m − t_amb)/(t_f − t_amb) · H  [W/m³]."""
+    return np.asarray(heat_W_m3, dtype=float) * total_rise_ratio(
+        measured_C, simulated_C, ambient_C, guards
+    )
+
+
+def heat_second_correction(first_W_m3: ArrayLike, C_H: ArrayLike) -> np.ndarray:
+    """Eq. 3: H'' = C_H · H'  [W/m³]."""
+    return np.asarray(first_W_m3, dtype=float) * np.asarray(C_H, dtype=float)
+
+
+def contact_pressure_factor(
+    ring_rise_K: ArrayLike,
+    sleeve_rise_K: ArrayLike,
+    fit: ContactFit = ContactFit(),
+    guards: RatioGuards = DEFAULT_GUARDS,
+) -> np.ndarray:
+    """Eq. 5 factor (P'/P)^−0.68 = (1 + Δδ/δ0)^−0.68 of a fit whose ring and sleeve have
+    warmed by the given rises (K) since assembly (in practice: since the run started cold).
+
+    Non-finite rises (a missing sensor) give the neutral factor 1.
+    """
+    ring = np.asarray(ring_rise_K, dtype=float)
+    sleeve = np.asarray(sleeve_rise_K, dtype=float)
+    delta_m = fit.fit_radius_m * (fit.alpha_ring_per_K * ring - fit.alpha_sleeve_per_K * sleeve)
+    relative_pressure = 1.0 + delta_m / fit.interference_m
+    relative_pressure = np.where(np.isfinite(relative_pressure), relative_pressure, 1.0)
+    relative_pressure = np.maximum(relative_pressure, guards.min_relative_pressure)
+    return relative_pressure ** (-CONTACT_PRESSURE_EXPONENT)
+
+
+def resistance_first_correction(
+    resistance_m2K_W: ArrayLike,
+    pressure_factor_now: ArrayLike,
+    pressure_factor_reference: ArrayLike = 1.0,
+) -> np.ndarray:
+    """Eq. 5: R' = R · f(now) / f(reference)  [m²K/W].
+
+    `pressure_factor_reference` is the factor of the state R belongs to: 1 for the cold
+    nominal value of Eq. 4, the previous window's factor for a value already corrected.
+    """
+    return (
+        np.asarray(resistance_m2K_W, dtype=float)
+        * np.asarray(pressure_factor_now, dtype=float)
+        / np.asarray(pressure_factor_reference, dtype=float)
+    )
+
+
+def resistance_second_correction(first_m2K_W: ArrayLike, C_C: ArrayLike) -> np.ndarray:
+    """Eq. 6: R'' = C_C · R'  [m²K/W]."""
+    return np.asarray(first_m2K_W, dtype=float) * np.asarray(C_C, dtype=float)
+
+
+def limit_to_nominal(
+    value: ArrayLike, nominal: ArrayLike, guards: RatioGuards = DEFAULT_GUARDS
+) -> np.ndarray:
+    """Clip a corrected heat or resistance into `guards.value_limits` × its nominal value.
+
+    Non-finite values become the nominal value.
+    """
+    nom = np.asarray(nominal, dtype=float)
+    if np.any(~(nom > 0)):
+        raise ValueError("nominal heat and resistance must be positive")
+    low, high = guards.value_limits
+    val = np.asarray(value, dtype=float)
+    # a non-finite value (e.g. a network fed a NaN) falls back to the nominal value
+    val = np.where(np.isfinite(val), val, nom)
+    return np.clip(val, low * nom, high * nom)

@@ -1,0 +1,226 @@
+"""The three correction methods of the twin: `open_loop`, `ratio` and `bpnn`.
+
+Each is a small object with one method, `correct(features) -> Correction`, called once per
+60 s window with only data from before the window (see `WindowFeatures`).  A `Correction`
+unpacks like the 4-tuple (H_front, H_rear, R_front, R_rear) and also carries the factors
+C_H and C_C relative to the previous window, for `corrections.csv`.
+
+    method = make_corrector("ratio")                  # or "open_loop", or "bpnn" with model=
+    H_front, H_rear, R_front, R_rear = method.correct(features)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from twin.correction.features import (
+    BEARINGS,
+    OUTPUTS,
+    RING_SENSOR,
+    SLEEVE_SENSOR,
+    BoundaryValues,
+    WindowFeatures,
+    window_line_fit,
+)
+from twin.correction.formulas import (
+    DEFAULT_GUARDS,
+    ContactFit,
+    RatioGuards,
+    contact_drop_ratio,
+    contact_pressure_factor,
+    heat_second_correction,
+    limit_to_nominal,
+    resistance_first_correction,
+    resistance_second_correction,
+    total_rise_ratio,
+    window_rise_ratio,
+)
+
+METHODS: tuple[str, ...] = ("open_loop", "ratio", "bpnn")
+
+PAPER_GAINS = (1.0, 1.0, 1.0)
+"""H = H_prev · (Eq. 2 ratio) · C_H and R = R' · C_C literally.  In closed loop on the lumped
+test plant (tests/test_correction_methods.py) that law oscillates window to window (±20 %,
+T1 error 0.4 K against 0.05 K): the total-rise ratio and the window-rise ratio estimate the
+same heat error and their product applies it twice, and C_H from a 60 s rise of ~0.1 K
+is mostly sensor noise.  The default therefore applies Eq. 2 in full, Eq. 3 not at all
+(C_H is still reported), and Eq. 6 with exponent 0.5 (the drop of the rear bearing is only a
+few tenths of a kelvin, so its ratio is noisy)."""
+
+
+@dataclass(frozen=True)
+class Correction:
+    """Boundary values for one window (W/m³, m²K/W) and their factors on the previous window."""
+
+    H_front_W_m3: float
+    H_rear_W_m3: float
+    R_front_m2K_W: float
+    R_rear_m2K_W: float
+    C_H: tuple[float, float] = (1.0, 1.0)
+    """(front, rear) heat of this window / heat of the previous window."""
+    C_C: tuple[float, float] = (1.0, 1.0)
+    """(front, rear) resistance of this window / resistance of the previous window."""
+
+    @property
+    def values(self) -> BoundaryValues:
+        return BoundaryValues(
+            self.H_front_W_m3, self.H_rear_W_m3, self.R_front_m2K_W, self.R_rear_m2K_W
+        )
+
+    def __iter__(self) -> Iterator[float]:
+        return iter(self.values)
+
+    @classmethod
+    def relative_to(
+        cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues
+    ) -> Correction:
+        v = [float(x) for x in values]
+        p = [float(x) for x in previous]
+        return cls(*v, C_H=(v[0] / p[0], v[1] / p[1]), C_C=(v[2] / p[2], v[3] / p[3]))
+
+
+class Corrector(Protocol):
+    """Anything that turns a window's features into its four boundary values."""
+
+    name: str
+
+    def correct(self, features: WindowFeatures) -> Correction: ...
+
+
+@dataclass(frozen=True)
+class OpenLoop:
+    """No correction: the nominal values (Eq. 1 heat, Eq. 4 resistance) at the current speed."""
+
+    name: str = "open_loop"
+
+    def correct(self, features: WindowFeatures) -> Correction:
+        return Correction.relative_to(features.nominal, features.previous)
+
+
+@dataclass(frozen=True)
+class RatioCorrection:
+    """The analytic online correction (Eq. 2, 3, 5, 6) applied to the previous window's values.
+
+    The twin's simulated temperatures at the window start were produced with the previous
+    window's values, so those are the H and R the ratios correct (REFERENCE.md §1):
+
+        H = H_prev · (t_m − t_amb)/(t_f − t_amb) · C_H,   C_H = rise_m / rise_f over the last window
+        R = R_prev · f_P(now)/f_P(prev) · C_C,            C_C = drop_m / drop_f ring-to-sleeve
+
+    By default the factors enter with the exponents `gains` = (1, 0, 0.5), see PAPER_GAINS.
+    Levels and rises are least-squares lines over the last window (noise-robust); f_P is the Eq. 5
+    pressure factor from the measured ring and sleeve rises since the run start.  Every
+    factor is guarded (see `RatioGuards`) and the result kept within the guards' band
+    around the nominal value.  A speed change rescales the previous values by the change of
+    the nominal ones, so the correction carries over as a factor.
+    """
+
+    guards: RatioGuards = DEFAULT_GUARDS
+    fits: tuple[ContactFit, ContactFit] = (ContactFit(), ContactFit(fit_radius_m=0.0425))
+    gains: tuple[float, float, float] = (1.0, 0.0, 0.5)
+    """Exponents on the Eq. 2, Eq. 3 and Eq. 6 factors; `PAPER_GAINS` is the paper's law."""
+    name: str = "ratio"
+
+    def correct(self, features: WindowFeatures) -> Correction:
+        f = features
+        g = self.guards
+        if f.window == 0:
+            # nothing measured yet that the twin could be compared with
+            return Correction.relative_to(f.nominal, f.previous)
+        # levels and rises from a line through the last window: the measured samples are
+        # noisy, and ratios of noisy differences would swing the correction window to window
+        meas_now, meas_rise = window_line_fit(
+            f.measured_time_s, f.measured_C, f.start_s, f.window_s
+        )
+        sim_now, sim_rise = window_line_fit(
+            f.simulated_time_s, f.simulated_C, f.start_s, f.window_s
+        )
+        meas_now = np.where(np.isfinite(meas_now), meas_now, f.measured_now())
+        sim_now = np.where(np.isfinite(sim_now), sim_now, f.simulated_now())
+        meas_initial = f.measured_initial()
+        meas_prev = meas_now - meas_rise
+        nominal = np.asarray(f.nominal, dtype=float)
+        a, b, c = self.gains
+        values = np.empty(4)
+        for k, bearing in enumerate(BEARINGS):
+            ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
+            # the previous window's value, carried to the current speed's nominal level
+            prev_nominal = f.nominal if f.previous_nominal is None else f.previous_nominal
+            speed_scale = nominal / np.asarray(prev_nominal, dtype=float)
+            H_prev = f.previous[k] * _carry(speed_scale[k])
+            R_prev = f.previous[2 + k] * _carry(speed_scale[2 + k])
+            H1 = H_prev * total_rise_ratio(meas_now[ring], sim_now[ring], f.ambient_C, g) ** a
+            C_H = window_rise_ratio(meas_rise[ring], sim_rise[ring], g) ** b
+            values[k] = limit_to_nominal(heat_second_correction(H1, C_H), nominal[k], g)
+            fp_now = contact_pressure_factor(
+                meas_now[ring] - meas_initial[ring], meas_now[sleeve] - meas_initial[sleeve],
+                self.fits[k], g,
+            )
+            fp_prev = contact_pressure_factor(
+                meas_prev[ring] - meas_initial[ring], meas_prev[sleeve] - meas_initial[sleeve],
+                self.fits[k], g,
+            )
+            R1 = resistance_first_correction(R_prev, fp_now, fp_prev)
+            C_C = contact_drop_ratio(
+                meas_now[ring] - meas_now[sleeve], sim_now[ring] - sim_now[sleeve], g
+            ) ** c
+            # the drop is heat flux × resistance: the part of the drop ratio explained by
+            # this window's heat correction is not put on the resistance
+            values[2 + k] = resistance_second_correction(R1, C_C / (values[k] / H_prev) ** c)
+        values = limit_to_nominal(values, nominal, g)
+        return Correction.relative_to(values, f.previous)
+
+
+def _carry(scale: float) -> float:
+    # nominal values follow the speed; the previous values follow them proportionally
+    return float(scale) if np.isfinite(scale) and scale > 0 else 1.0
+
+
+@dataclass(frozen=True)
+class BpnnCorrection:
+    """The trained networks (one heat and one resistance network per bearing).
+
+    Inference is plain numpy on the loaded weights (no torch needed at replay time).
+    Non-finite network inputs (a dead sensor) fall back to the previous window's value; the
+    output is kept within the guards' band around the nominal value.
+    """
+
+    model: object = field(repr=False)
+    guards: RatioGuards = DEFAULT_GUARDS
+    name: str = "bpnn"
+
+    def correct(self, features: WindowFeatures) -> Correction:
+        inputs = features.network_inputs()
+        nominal = np.asarray(features.nominal, dtype=float)
+        previous = np.asarray(features.previous, dtype=float)
+        values = np.empty(4)
+        for i, output in enumerate(OUTPUTS):
+            x = inputs[output]
+            if not np.all(np.isfinite(x)):
+                values[i] = previous[i]
+                continue
+            values[i] = float(self.model.predict(output, x)[0])
+        values = limit_to_nominal(values, nominal, self.guards)
+        return Correction.relative_to(values, features.previous)
+
+
+def make_corrector(name: str, model: object | str | Path | None = None) -> Corrector:
+    """The correction method called `name`; `bpnn` needs a model (object or model-file path)."""
+    if name == "open_loop":
+        return OpenLoop()
+    if name == "ratio":
+        return RatioCorrection()
+    if name == "bpnn":
+        if model is None:
+            raise ValueError("the bpnn correction needs a model")
+        if isinstance(model, str | Path):
+            from twin.correction.modelfile import load_model
+
+            model = load_model(model)
+        return BpnnCorrection(model)
+    raise ValueError(f"unknown correction method {name!r}; expected one of {', '.join(METHODS)}")

@@ -1,0 +1,175 @@
+"""The correction model file: the four networks in one safetensors file.
+
+Tensors `<output>.<part>` (output in OUTPUTS; part in PARTS) in float64, and in the
+safetensors header one metadata entry `spindle_twin` holding JSON: format and version,
+the configuration, input names and units, hidden sizes, training runs, R², seed, and a
+SHA-256 of the tensor data.  Loading reads only tensors and JSON (no unpickling), checks
+every name, shape, value and the checksum, and raises `InputError` naming the file and
+what is wrong.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from twin.correction.features import HIDDEN_SIZES, INPUT_NAMES, OUTPUTS, TARGET_UNITS, kind_of
+from twin.correction.network import CONFIGS, TrainedNet
+from twin.errors import InputError
+
+FORMAT = "spindle-twin-correction"
+VERSION = 1
+METADATA_KEY = "spindle_twin"
+PARTS = ("hidden_weight", "hidden_bias", "output_weight", "output_bias",
+         "x_offset", "x_scale", "y_offset", "y_scale")
+
+
+@dataclass(frozen=True)
+class CorrectionModel:
+    """The four trained networks and what is known about their training."""
+
+    nets: dict[str, TrainedNet]
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def predict(self, output: str, x: ArrayLike) -> np.ndarray:
+        """Corrected values of `output` (e.g. 'heat_front') for input rows x (N, 6)."""
+        return self.nets[output].predict(x)
+
+    @property
+    def config_name(self) -> str:
+        return self.nets[OUTPUTS[0]].config.name
+
+
+def _expected_shape(part: str, hidden: int) -> tuple[int, ...]:
+    return {
+        "hidden_weight": (hidden, 6), "hidden_bias": (hidden,), "output_weight": (1, hidden),
+        "output_bias": (1,), "x_offset": (6,), "x_scale": (6,), "y_offset": (1,),
+        "y_scale": (1,),
+    }[part]
+
+
+def _digest(tensors: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256()
+    for name in sorted(tensors):
+        h.update(name.encode())
+        h.update(np.ascontiguousarray(tensors[name], dtype="<f8").tobytes())
+    return h.hexdigest()
+
+
+def save_model(model: CorrectionModel, path: str | Path) -> Path:
+    """Write the model atomically (temporary file in the same folder, then rename)."""
+    from safetensors.numpy import save
+
+    path = Path(path)
+    tensors = {
+        f"{output}.{part}": np.ascontiguousarray(getattr(model.nets[output], part), dtype="<f8")
+        for output in OUTPUTS
+        for part in PARTS
+    }
+    config = model.nets[OUTPUTS[0]].config
+    meta = dict(model.metadata)
+    meta.update(
+        format=FORMAT,
+        version=VERSION,
+        config=config.name,
+        outputs=list(OUTPUTS),
+        hidden_sizes={o: model.nets[o].hidden_size for o in OUTPUTS},
+        inputs={o: list(INPUT_NAMES[kind_of(o)]) for o in OUTPUTS},
+        units={o: TARGET_UNITS[kind_of(o)] for o in OUTPUTS},
+        sha256=_digest(tensors),
+    )
+    data = save(tensors, metadata={METADATA_KEY: json.dumps(meta, sort_keys=True)})
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def load_model(path: str | Path) -> CorrectionModel:
+    """Read and check a model file; any problem raises InputError naming the file."""
+    from safetensors import SafetensorError
+    from safetensors.numpy import load
+
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read the model file: {exc.strerror}", file=str(path)) from None
+    try:
+        tensors = load(raw)
+        header_len = int.from_bytes(raw[:8], "little")
+        header = json.loads(raw[8 : 8 + header_len])
+    except (SafetensorError, ValueError, UnicodeDecodeError) as exc:
+        raise InputError(f"not a readable safetensors model file ({exc})", file=str(path)) from None
+    try:
+        meta = json.loads(header.get("__metadata__", {})[METADATA_KEY])
+    except (KeyError, TypeError, json.JSONDecodeError):
+        raise InputError(
+            f"no '{METADATA_KEY}' metadata: not a spindle-twin correction model", file=str(path)
+        ) from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        raise InputError(f"metadata format is not {FORMAT!r}", file=str(path))
+    if meta.get("version") != VERSION:
+        raise InputError(
+            f"model version {meta.get('version')!r} is not supported (expected {VERSION})",
+            file=str(path),
+        )
+    config = CONFIGS.get(meta.get("config"))
+    if config is None:
+        raise InputError(f"unknown network configuration {meta.get('config')!r}", file=str(path))
+    if meta.get("outputs") != list(OUTPUTS):
+        raise InputError(f"outputs must be {list(OUTPUTS)}", file=str(path))
+
+    expected = {f"{o}.{p}" for o in OUTPUTS for p in PARTS}
+    missing, extra = sorted(expected - set(tensors)), sorted(set(tensors) - expected)
+    if missing or extra:
+        what = "; ".join(
+            s for s in (f"missing tensors {missing}" if missing else "",
+                        f"unexpected tensors {extra}" if extra else "") if s
+        )
+        raise InputError(what, file=str(path))
+    nets = {}
+    for output in OUTPUTS:
+        hidden = meta.get("hidden_sizes", {}).get(output)
+        if hidden != HIDDEN_SIZES[kind_of(output)]:
+            raise InputError(
+                f"{output}: hidden size {hidden!r}, expected {HIDDEN_SIZES[kind_of(output)]}",
+                file=str(path),
+            )
+        parts = {}
+        for part in PARTS:
+            name = f"{output}.{part}"
+            array = tensors[name]
+            want = _expected_shape(part, hidden)
+            if array.shape != want:
+                raise InputError(
+                    f"tensor {name!r} has shape {list(array.shape)}, expected {list(want)}",
+                    file=str(path),
+                )
+            if array.dtype != np.float64:
+                raise InputError(f"tensor {name!r} is {array.dtype}, expected float64",
+                                 file=str(path))
+            if not np.all(np.isfinite(array)):
+                raise InputError(f"tensor {name!r} holds non-finite values", file=str(path))
+            if part in ("x_scale", "y_scale") and np.any(array == 0):
+                raise InputError(f"tensor {name!r} holds a zero scale", file=str(path))
+            parts[part] = array
+        nets[output] = TrainedNet(config, **parts)
+    if meta.get("sha256") != _digest(tensors):
+        raise InputError("checksum mismatch: the weights were modified or damaged",
+                         file=str(path))
+    return CorrectionModel(nets, meta)

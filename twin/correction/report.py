@@ -1,0 +1,152 @@
+"""The training report written beside a model: JSON figures and a self-contained HTML page
+with loss curves, the R² table (both configurations) and predicted-vs-target plots."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twin.correction.features import OUTPUTS, TARGET_UNITS, kind_of
+from twin.correction.training import TrainingResult
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def report_paths(model_path: str | Path) -> tuple[Path, Path]:
+    """(JSON, HTML) report paths beside the model: MODEL.report.json, MODEL.report.html."""
+    p = Path(model_path)
+    return p.with_name(p.name + ".report.json"), p.with_name(p.name + ".report.html")
+
+
+def _figure_png(fig: Any) -> str:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
+def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, str]]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    images = []
+    fig, axes = plt.subplots(1, 4, figsize=(16, 3.4))
+    for ax, output in zip(axes, OUTPUTS, strict=True):
+        for name, res in results.items():
+            h = res.outputs[output].history
+            ax.semilogy(h.train_mse, label=f"{name} train")
+            ax.semilogy(h.test_mse, "--", label=f"{name} test")
+        ax.set_title(output)
+        ax.set_xlabel("epoch")
+        ax.set_ylabel("MSE (scaled)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    images.append(("Loss curves (training and held-out 20 %)", _figure_png(fig)))
+    plt.close(fig)
+
+    for name, res in results.items():
+        fig, axes = plt.subplots(1, 4, figsize=(16, 3.6))
+        for ax, output in zip(axes, OUTPUTS, strict=True):
+            r = res.outputs[output]
+            ax.plot(r.test_target, r.test_predicted, ".", ms=3)
+            lo = float(np.nanmin(r.test_target))
+            hi = float(np.nanmax(r.test_target))
+            ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+            ax.set_title(f"{output}  R²={r.r2_value:.4f}")
+            unit = TARGET_UNITS[kind_of(output)]
+            ax.set_xlabel(f"target [{unit}]")
+            ax.set_ylabel(f"predicted [{unit}]")
+        fig.tight_layout()
+        images.append((f"Predicted vs target, held-out samples ({name})", _figure_png(fig)))
+        plt.close(fig)
+    return images
+
+
+def write_report(
+    model_path: str | Path, results: dict[str, TrainingResult], chosen: str
+) -> tuple[Path, Path]:
+    """Write MODEL.report.json and MODEL.report.html; `results` maps configuration name to
+    its training result, `chosen` names the one saved as the model."""
+    json_path, html_path = report_paths(model_path)
+    summary = {
+        "model": Path(model_path).name,
+        "chosen_config": chosen,
+        "configs": {
+            name: {
+                "seconds": res.seconds,
+                "r2": res.r2_table(),
+                "final_train_mse": {o: float(r.history.train_mse[-1])
+                                    for o, r in res.outputs.items()},
+                "final_test_mse": {o: float(r.history.test_mse[-1])
+                                   for o, r in res.outputs.items()},
+            }
+            for name, res in results.items()
+        },
+        "metadata": results[chosen].model.metadata,
+    }
+    _atomic_write(json_path, json.dumps(summary, indent=2, default=_jsonable).encode())
+
+    rows = []
+    for output in OUTPUTS:
+        cells = "".join(
+            f"<td>{res.outputs[output].r2_value:.5f}</td><td>{res.outputs[output].r2_factor:.4f}</td>"
+            f"<td>{res.outputs[output].history.epochs}</td>"
+            for res in results.values()
+        )
+        rows.append(f"<tr><th>{output}</th>{cells}</tr>")
+    head = "".join(
+        f"<th>{html.escape(n)}{' (saved)' if n == chosen else ''}: R² value</th>"
+        f"<th>R² factor</th><th>epochs</th>"
+        for n in results
+    )
+    images = "".join(
+        f"<h2>{html.escape(title)}</h2><img src='data:image/png;base64,{png}'>"
+        for title, png in _plots(results)
+    )
+    meta = results[chosen].model.metadata
+    page = f"""<!doctype html><html><head><meta charset="utf-8">
+<title>Correction model training report</title>
+<style>body{{font-family:sans-serif;margin:2em}} td,th{{padding:2px 8px;text-align:right}}
+table{{border-collapse:collapse}} tr:nth-child(even){{background:#f2f2f2}}
+img{{max-width:100%}}</style>
+</head><body>
+<h1>Correction model: {html.escape(Path(model_path).name)}</h1>
+<p>{meta.get("samples")} samples from {len(meta.get("training_runs", []))} runs; 80/20 random
+split, seed {meta.get("seed")}; Rprop, learning rate {meta.get("learning_rate")}, at most
+{meta.get("epochs_max")} epochs, goal MSE {meta.get("goal_mse")}.
+R² value: on the corrected value (the paper's figure, > 0.99 there); R² factor: on
+value/nominal, the part of the correction the nominal (speed-dependent) value does not
+already explain. The random split puts neighbouring windows of one run on both sides, so
+both are optimistic for unseen runs.</p>
+<table><tr><th>output</th>{head}</tr>{"".join(rows)}</table>
+<p>Training time: {", ".join(f"{n} {r.seconds:.1f} s" for n, r in results.items())}.</p>
+{images}
+</body></html>"""
+    _atomic_write(html_path, page.encode())
+    return json_path, html_path
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return str(x)
