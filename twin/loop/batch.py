@@ -1,0 +1,154 @@
+"""Batch replay: many runs, local processes or a dask.distributed cluster, resumable.
+
+One failing run never stops the others: its error is recorded in summary.json
+("failed") and the batch goes on.  A finished run folder carries a `.done.json` token
+(input and model digests, methods), written last; --resume skips runs whose token
+matches.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from twin.errors import InputError
+from twin.loop.metrics import mean_metrics
+from twin.loop.outputs import write_json_atomic
+from twin.loop.runfiles import is_done, replay_run_to_dir, resume_token, run_name
+
+
+@dataclass(frozen=True)
+class ReplayJob:
+    run_path: str
+    out_root: str
+    methods: tuple[str, ...]
+    model_path: str | None
+    snapshots: str
+
+
+@dataclass
+class BatchResult:
+    accuracies: list[dict] = field(default_factory=list)
+    failed: list[dict] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+
+    @property
+    def exit_code(self) -> int:
+        if any(f["kind"] == "internal" for f in self.failed):
+            return 1
+        return 2 if self.failed else 0
+
+
+def run_job(job: ReplayJob) -> dict:
+    """Replay one run; never raises: returns {"ok": accuracy} or {"error": ...}."""
+    try:
+        acc = replay_run_to_dir(
+            job.run_path, job.out_root, job.methods, job.model_path, job.snapshots
+        )
+        return {"ok": acc}
+    except InputError as exc:
+        return {
+            "error": str(exc),
+            "kind": "input",
+            "run": run_name(job.run_path),
+            "path": job.run_path,
+        }
+    except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
+        return {
+            "error": f"{type(exc).__name__}: {exc}",
+            "kind": "internal",
+            "run": run_name(job.run_path),
+            "path": job.run_path,
+        }
+
+
+def replay_batch(
+    runs: Sequence[str | Path],
+    out_root: str | Path,
+    methods: Sequence[str],
+    model_path: str | None,
+    jobs: int = 1,
+    dask_address: str | None = None,
+    snapshots: str = "none",
+    resume: bool = False,
+    progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
+) -> BatchResult:
+    out_root = Path(out_root)
+    out_root.mkdir(parents=True, exist_ok=True)
+    names = [run_name(r) for r in runs]
+    dupes = {n for n in names if names.count(n) > 1}
+    if dupes:
+        raise InputError(f"two runs share the output folder name {sorted(dupes)[0]!r}")
+    result = BatchResult()
+    todo: list[ReplayJob] = []
+    for path in runs:
+        path = str(path)
+        if resume and Path(path).is_file():
+            out_dir = out_root / run_name(path)
+            try:
+                done = is_done(out_dir, resume_token(path, methods, model_path))
+            except OSError:
+                done = False
+            if done:
+                result.accuracies.append(json.loads((out_dir / "accuracy.json").read_text()))
+                result.skipped.append(run_name(path))
+                if progress:
+                    progress(run_name(path), "skipped")
+                continue
+        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots))
+
+    for outcome in _execute(todo, jobs, dask_address, progress):
+        if "ok" in outcome:
+            result.accuracies.append(outcome["ok"])
+        else:
+            result.failed.append(outcome)
+    order = {n: i for i, n in enumerate(names)}
+    result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
+    write_summary(out_root, result.accuracies, result.failed)
+    return result
+
+
+def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress):  # noqa: ANN001, ANN202
+    if dask_address:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+
+        with Client(dask_address, timeout="20s") as client:
+            futures = client.map(run_job, todo, pure=False)
+            for fut in dask_completed(futures):
+                outcome = fut.result()
+                _tell(progress, outcome)
+                yield outcome
+        return
+    if jobs <= 1 or len(todo) <= 1:
+        for job in todo:
+            outcome = run_job(job)
+            _tell(progress, outcome)
+            yield outcome
+        return
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(run_job, job) for job in todo]
+        for fut in as_completed(futures):
+            outcome = fut.result()
+            _tell(progress, outcome)
+            yield outcome
+
+
+def _tell(progress, outcome: dict) -> None:  # noqa: ANN001
+    if progress is None:
+        return
+    if "ok" in outcome:
+        progress(outcome["ok"]["run"], "done")
+    else:
+        progress(outcome["run"], f"failed: {outcome['error']}")
+
+
+def write_summary(out_root: Path, accuracies: list[dict], failed: list[dict]) -> dict:
+    summary = {"runs": accuracies, "mean": mean_metrics(accuracies)}
+    if failed:
+        summary["failed"] = failed
+    write_json_atomic(Path(out_root) / "summary.json", summary)
+    return summary

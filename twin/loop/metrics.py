@@ -1,0 +1,87 @@
+"""Accuracy metrics of a replay (shared DESIGN.md, "accuracy.json").
+
+Every metric is taken over the solver steps after the first window (the first window
+has no correction yet), against the measurement at the same time, skipping samples the
+data-quality check excluded (NaN in the measured arrays).
+
+- temperature accuracy (the reference paper's style, °C):
+      100 · (1 − mean_i,k |T_twin − T_meas| / |T_meas|)
+- temperature-rise accuracy (stricter):
+      100 · (1 − Σ|T_twin − T_meas| / Σ|T_meas − T_meas(0)|)
+- deformation accuracy, axial nose drift:
+      100 · (1 − Σ|δ_twin − δ_meas| / Σ|δ_meas|)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+SENSORS = ("T1", "T2", "T3", "T4", "T5")
+
+
+def _nan_to_none(value: float) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def accuracy_metrics(
+    time_s: np.ndarray,
+    T_twin_C: np.ndarray,
+    T_meas_C: np.ndarray,
+    T_meas0_C: np.ndarray,
+    drift_twin_um: np.ndarray,
+    drift_meas_um: np.ndarray | None,
+    first_window_end_s: float = 60.0,
+) -> dict:
+    """Metrics of one method on one run.
+
+    time_s (k,), T_twin_C / T_meas_C (k, 5), T_meas0_C (5,) measured at the run start,
+    drift_twin_um / drift_meas_um (k,) axial nose drift (None: not measured).
+    """
+    after = np.asarray(time_s) > first_window_end_s - 1e-9
+    tw = np.asarray(T_twin_C, float)[after]
+    tm = np.asarray(T_meas_C, float)[after]
+    ok = np.isfinite(tm) & np.isfinite(tw)
+    err = np.where(ok, np.abs(tw - tm), 0.0)
+    n = int(ok.sum())
+    if n == 0:
+        raise ValueError("no valid temperature samples after the first window")
+    temp_acc = 100.0 * (1.0 - float(np.sum(np.where(ok, err / np.abs(tm), 0.0))) / n)
+    rise = np.where(ok, np.abs(tm - np.asarray(T_meas0_C, float)[None, :]), 0.0)
+    rise_acc = 100.0 * (1.0 - err.sum() / rise.sum()) if rise.sum() > 0 else math.nan
+    rmse = {}
+    for i, name in enumerate(SENSORS):
+        col = ok[:, i]
+        rmse[name] = _nan_to_none(
+            float(np.sqrt(np.mean(err[col, i] ** 2))) if col.any() else math.nan
+        )
+    out = {
+        "temperature_accuracy_pct": float(temp_acc),
+        "temperature_rise_accuracy_pct": _nan_to_none(rise_acc),
+        "deformation_accuracy_pct": None,
+        "rmse_C": rmse,
+        "rmse_um": None,
+        "max_abs_C": float(err.max()),
+    }
+    if drift_meas_um is not None:
+        dm = np.asarray(drift_meas_um, float)[after]
+        dt = np.asarray(drift_twin_um, float)[after]
+        okd = np.isfinite(dm) & np.isfinite(dt)
+        if okd.any() and np.abs(dm[okd]).sum() > 0:
+            e = np.abs(dt[okd] - dm[okd])
+            out["deformation_accuracy_pct"] = float(100.0 * (1.0 - e.sum() / np.abs(dm[okd]).sum()))
+            out["rmse_um"] = float(np.sqrt(np.mean(e**2)))
+    return out
+
+
+def mean_metrics(runs: list[dict]) -> dict:
+    """Per method, the mean of each scalar metric over the runs that have it."""
+    methods: dict[str, dict[str, list[float]]] = {}
+    for run in runs:
+        for method, metrics in run.get("methods", {}).items():
+            bucket = methods.setdefault(method, {})
+            for key, value in metrics.items():
+                if isinstance(value, int | float) and value is not None and math.isfinite(value):
+                    bucket.setdefault(key, []).append(float(value))
+    return {m: {k: float(np.mean(v)) for k, v in d.items()} for m, d in methods.items()}

@@ -1,0 +1,187 @@
+"""The twin loop: replay one recorded run with one correction method.
+
+For each 60 s window k, covering [60k, 60k + 60) s, using only data measured before the
+window starts:
+
+    features (speed, ambient, T1..T5 measured and simulated so far, run time)
+      → correction (open_loop | ratio | bpnn) → H_front, H_rear, R_front, R_rear
+      → window deck (apdl_like) → 15 backward-Euler steps of 4 s in the persistent session
+      → T1..T5 and the nose drift per step (probes), fields at the window end
+
+The temperature state carries over from window to window.  The run starts from a uniform
+field at the mean of the first measured T1..T5 (a spindle at rest has equalised), which
+is also the zero of the drift: the recorded drift is taken as measured from the start.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from twin.correction.features import BoundaryValues, WindowFeatures
+from twin.correction.methods import Correction, Corrector
+from twin.runs import RecordedRun
+from twin.spindle.conditions import BoundaryConditions, nominal_conditions
+from twin.spindle.model import SpindleModel
+
+WINDOW_S = 60.0
+STEP_S = 4.0
+STEPS_PER_WINDOW = 15
+
+
+@dataclass
+class WindowRecord:
+    """What one window used and produced."""
+
+    window: int
+    start_s: float
+    speed_rpm: float
+    ambient_C: float
+    correction: Correction
+    nominal: BoundaryValues
+    deck: str | None = None
+
+
+@dataclass
+class MethodReplay:
+    """Time series of one method on one run (solver steps, 4 s apart)."""
+
+    method: str
+    time_s: np.ndarray
+    T_twin_C: np.ndarray  # (k, 5)
+    drift_z_um: np.ndarray  # (k,) axial nose drift
+    drift_r_um: np.ndarray  # (k,) radial growth at the nose
+    windows: list[WindowRecord]
+    fields: dict[float, np.ndarray] = field(default_factory=dict)  # window-end T fields
+    T_initial_C: float = 20.0
+    wall_s: float = 0.0
+
+
+WindowSolver = Callable[[BoundaryConditions, Correction, np.ndarray, float, int], tuple]
+"""(conditions, correction, T_start, start_s, window) → (T per step (15, n), deck text)."""
+
+
+def direct_window_solver(model: SpindleModel) -> WindowSolver:
+    """Solve a window straight on twin.fem (no deck); the reference for the deck path."""
+
+    def solve(
+        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int
+    ) -> tuple[np.ndarray, str | None]:
+        loads = bc.to_thermal_loads(
+            H_front=corr.H_front_W_m3,
+            H_rear=corr.H_rear_W_m3,
+            R_front=corr.R_front_m2K_W,
+            R_rear=corr.R_rear_m2K_W,
+        )
+        stepper = model.thermal.transient(loads, STEP_S)
+        out = np.empty((STEPS_PER_WINDOW, T.size))
+        for i in range(STEPS_PER_WINDOW):
+            T = stepper.step(T)
+            out[i] = T
+        return out, None
+
+    return solve
+
+
+def n_windows(run: RecordedRun) -> int:
+    """Whole 60 s windows the run covers."""
+    return int(np.floor(run.duration_s / WINDOW_S + 1e-9))
+
+
+def initial_temperature_C(run: RecordedRun) -> float:
+    first = run.before(np.array([run.time_s[0]]))
+    T0 = np.where(first.valid_T[0], first.T_C[0], np.nan)
+    if not np.any(np.isfinite(T0)):
+        return float(first.ambient_C[0])
+    return float(np.nanmean(T0))
+
+
+def replay_method(
+    run: RecordedRun,
+    model: SpindleModel,
+    corrector: Corrector,
+    solver: WindowSolver | None = None,
+    keep_fields: bool = True,
+    on_window: Callable[[int, int], None] | None = None,
+) -> MethodReplay:
+    """Replay `run` with one correction method; see the module doc."""
+    t_wall = time.perf_counter()
+    solver = solver or direct_window_solver(model)
+    windows = n_windows(run)
+    if windows < 2:
+        raise ValueError(f"{run.name}: a replay needs at least two 60 s windows of data")
+    T0 = initial_temperature_C(run)
+    T = np.full(model.n_dofs, T0)
+
+    measured_T = np.where(run.valid_T, run.T_C, np.nan)
+    starts = WINDOW_S * np.arange(windows)
+    state = run.before(starts)
+    n_steps = windows * STEPS_PER_WINDOW
+    time_s = STEP_S * np.arange(1, n_steps + 1)
+    sim_T = np.empty((n_steps + 1, 5))
+    sim_T[0] = model.sensor_matrix @ T
+    sim_time = np.r_[0.0, time_s]
+    drift = np.empty((n_steps, 2))
+    records: list[WindowRecord] = []
+    fields: dict[float, np.ndarray] = {}
+    previous: BoundaryValues | None = None
+    previous_nominal: BoundaryValues | None = None
+
+    for k in range(windows):
+        start = float(starts[k])
+        speed = float(state.speed_rpm[k])
+        ambient = float(state.ambient_C[k])
+        coolant = None if state.coolant_C is None else float(state.coolant_C[k])
+        # the nominal model is open loop: it sees its own bearing temperatures only
+        T_now = sim_T[k * STEPS_PER_WINDOW]
+        bc = nominal_conditions(
+            model,
+            speed,
+            ambient,
+            coolant,
+            T_bearings_C=(float(T_now[0]), float(T_now[2])),
+            T_sleeves_C=(float(T_now[1]), float(T_now[3])),
+        )
+        nominal = BoundaryValues(bc.H_front, bc.H_rear, bc.R_front, bc.R_rear)
+        upto = run.time_s <= start
+        n_sim = k * STEPS_PER_WINDOW + 1
+        features = WindowFeatures(
+            window=k,
+            start_s=start,
+            speed_rpm=speed,
+            ambient_C=ambient,
+            measured_time_s=run.time_s[upto],
+            measured_C=measured_T[upto],
+            simulated_time_s=sim_time[:n_sim],
+            simulated_C=sim_T[:n_sim],
+            nominal=nominal,
+            previous=previous or nominal,
+            previous_nominal=previous_nominal,
+        )
+        corr = corrector.correct(features)
+        steps, deck = solver(bc, corr, T, start, k)
+        T = steps[-1]
+        sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
+        sim_T[sl.start + 1 : sl.stop + 1] = (model.sensor_matrix @ steps.T).T
+        drift[sl] = 1e6 * ((steps - T0) @ model.probe_vectors.T)
+        records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck))
+        if keep_fields:
+            fields[start + WINDOW_S] = T.copy()
+        previous, previous_nominal = corr.values, nominal
+        if on_window is not None:
+            on_window(k + 1, windows)
+
+    return MethodReplay(
+        method=corrector.name,
+        time_s=time_s,
+        T_twin_C=sim_T[1:],
+        drift_z_um=drift[:, 0],
+        drift_r_um=drift[:, 1],
+        windows=records,
+        fields=fields,
+        T_initial_C=T0,
+        wall_s=time.perf_counter() - t_wall,
+    )

@@ -1,0 +1,244 @@
+"""Replay one recorded run with every requested method and write its output folder.
+
+Layout under DIR/<run-name>/ (shared DESIGN.md):
+    keypoints.csv      time_s, method, T1..T5 twin and measured, nose drift twin/measured
+    corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C
+    accuracy.json      per-method metrics (twin.loop.metrics)
+    quality.json       data-quality findings of the recorded run
+    decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/)
+    fields/*.vtu + fields.pvd   the primary method's field at every window end
+    snapshots/*.png             field pictures (--snapshots end|every)
+    .done.json                  written last: what --resume checks
+The primary method is bpnn when it runs, else the last method listed.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from twin.loop.metrics import SENSORS, accuracy_metrics
+from twin.loop.outputs import (
+    write_csv_atomic,
+    write_json_atomic,
+    write_pvd_atomic,
+    write_text_atomic,
+    write_vtu_atomic,
+)
+from twin.loop.replay import MethodReplay, replay_method
+
+DONE_FILE = ".done.json"
+SNAPSHOT_CHOICES = ("none", "end", "every")
+
+
+def file_digest(path: str | Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def run_name(path: str | Path) -> str:
+    return Path(path).stem
+
+
+def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None) -> dict:
+    """What must match for a finished run folder to be reused by --resume."""
+    token = {"input_sha256": file_digest(path), "methods": list(methods)}
+    if "bpnn" in methods and model_path is not None:
+        token["model_sha256"] = file_digest(model_path)
+    return token
+
+
+def is_done(out_dir: Path, token: dict) -> bool:
+    try:
+        return json.loads((out_dir / DONE_FILE).read_text()) == token
+    except (OSError, ValueError):
+        return False
+
+
+def primary_method(methods: Sequence[str]) -> str:
+    return "bpnn" if "bpnn" in methods else methods[-1]
+
+
+def replay_run_to_dir(
+    run_path: str | Path,
+    out_root: str | Path,
+    methods: Sequence[str],
+    model_path: str | None,
+    snapshots: str = "none",
+    spindle=None,  # noqa: ANN001 - a loaded SpindleModel to reuse, or None
+    on_window: Callable[[str, int, int], None] | None = None,
+) -> dict:
+    """Replay one run with `methods`, write its folder, return its accuracy.json dict."""
+    from twin.correction.methods import make_corrector
+    from twin.runs import read_run, write_quality
+
+    if snapshots not in SNAPSHOT_CHOICES:
+        raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
+    run = read_run(run_path)
+    model = spindle if spindle is not None else default_spindle()
+    out_dir = Path(out_root) / run_name(run_path)
+    token = resume_token(run_path, methods, model_path)
+    (out_dir / DONE_FILE).unlink(missing_ok=True)
+
+    correctors = [make_corrector(m, model_path if m == "bpnn" else None) for m in methods]
+    primary = primary_method(methods)
+    results: dict[str, MethodReplay] = {}
+    for corrector in correctors:
+        callback = None
+        if on_window is not None:
+            callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
+        results[corrector.name] = replay_method(
+            run,
+            model,
+            corrector,
+            keep_fields=corrector.name == primary,
+            on_window=callback,
+            solver=deck_solver(model),
+        )
+
+    first = next(iter(results.values()))
+    measured = run.at(first.time_s)
+    meas_T = np.where(measured.valid_T, measured.T_C, np.nan)
+    meas_drift = None
+    if measured.disp_um is not None and "disp_z_um" in measured.valid:
+        meas_drift = np.where(measured.valid["disp_z_um"], measured.disp_um[:, 2], np.nan)
+    start = run.before(np.array([run.time_s[0]]))
+    meas_T0 = np.where(start.valid_T[0], start.T_C[0], np.nan)
+    if np.any(~np.isfinite(meas_T0)):  # a sensor that starts invalid: its first good value
+        good = np.where(run.valid_T, run.T_C, np.nan)
+        for i in np.where(~np.isfinite(meas_T0))[0]:
+            finite = np.isfinite(good[:, i])
+            meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
+
+    accuracy = {
+        "run": run.name,
+        "speed_rpm": float(np.mean(run.speed_rpm)),
+        "ambient_C": float(np.mean(run.ambient_C)),
+        "duration_s": float(run.duration_s),
+        "methods": {
+            name: accuracy_metrics(r.time_s, r.T_twin_C, meas_T, meas_T0, r.drift_z_um, meas_drift)
+            for name, r in results.items()
+        },
+    }
+
+    _write_keypoints(out_dir / "keypoints.csv", results, meas_T, meas_drift)
+    _write_corrections(out_dir / "corrections.csv", results)
+    write_quality(run, out_dir / "quality.json")
+    for name, r in results.items():
+        deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
+        for w in r.windows:
+            if w.deck is not None:
+                write_text_atomic(deck_dir / f"window_{w.window:03d}.inp", w.deck)
+    _write_fields(out_dir, model, results[primary])
+    if snapshots != "none":
+        from twin.loop.snapshot import render_snapshot
+
+        r = results[primary]
+        times = sorted(r.fields)
+        chosen = times if snapshots == "every" else times[-1:]
+        for t in chosen:
+            render_snapshot(
+                model,
+                r.fields[t],
+                out_dir / "snapshots" / f"{primary}_t{t:05.0f}s.png",
+                title=f"{run.name} · {primary} · t = {t:.0f} s",
+                T_initial_C=r.T_initial_C,
+            )
+    write_json_atomic(out_dir / "accuracy.json", accuracy)
+    write_json_atomic(out_dir / DONE_FILE, token)
+    return accuracy
+
+
+def _write_keypoints(
+    path: Path, results: dict[str, MethodReplay], meas_T: np.ndarray, meas_drift: np.ndarray | None
+) -> None:
+    header = ["time_s", "method"]
+    header += [f"{s}_twin_C" for s in SENSORS] + [f"{s}_meas_C" for s in SENSORS]
+    header += ["disp_z_twin_um", "disp_z_meas_um", "disp_r_twin_um", "disp_r_meas_um"]
+    rows = []
+    nan = float("nan")
+    for name, r in results.items():
+        for i, t in enumerate(r.time_s):
+            rows.append(
+                [
+                    float(t),
+                    name,
+                    *r.T_twin_C[i],
+                    *meas_T[i],
+                    r.drift_z_um[i],
+                    nan if meas_drift is None else meas_drift[i],
+                    r.drift_r_um[i],
+                    nan,
+                ]
+            )
+    write_csv_atomic(path, header, rows)
+
+
+def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
+    header = [
+        "window",
+        "method",
+        "start_s",
+        "speed_rpm",
+        "H_front",
+        "H_rear",
+        "R_front",
+        "R_rear",
+        "C_H_front",
+        "C_H_rear",
+        "C_C_front",
+        "C_C_rear",
+    ]
+    rows = []
+    for name, r in results.items():
+        for w in r.windows:
+            c = w.correction
+            rows.append(
+                [
+                    w.window,
+                    name,
+                    w.start_s,
+                    w.speed_rpm,
+                    c.H_front_W_m3,
+                    c.H_rear_W_m3,
+                    c.R_front_m2K_W,
+                    c.R_rear_m2K_W,
+                    *c.C_H,
+                    *c.C_C,
+                ]
+            )
+    write_csv_atomic(path, header, rows)
+
+
+def _write_fields(out_dir: Path, model, r: MethodReplay) -> None:  # noqa: ANN001
+    from twin.fields import field_mesh
+
+    entries = []
+    for t in sorted(r.fields):
+        name = f"fields/{r.method}_t{t:05.0f}s.vtu"
+        write_vtu_atomic(out_dir / name, field_mesh(model, r.fields[t], r.T_initial_C))
+        entries.append((t, name))
+    write_pvd_atomic(out_dir / "fields.pvd", entries)
+
+
+@functools.cache
+def default_spindle():  # noqa: ANN201
+    """The bundled reference spindle, loaded once per process (a batch worker reuses it)."""
+    from twin.spindle.model import SpindleModel
+
+    return SpindleModel.load()
+
+
+def deck_solver(model):  # noqa: ANN001, ANN201
+    """The window solver the loop uses (the apdl_like deck path once wired)."""
+    from twin.loop.replay import direct_window_solver
+
+    return direct_window_solver(model)
