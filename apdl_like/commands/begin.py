@@ -1,0 +1,109 @@
+"""Begin-level and anywhere commands: processors, titles, *SET, *GET."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.commands import ANY, Call, command
+from apdl_like.errors import ApdlError
+from apdl_like.expressions import is_parameter_name
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+
+def _enter(processor: str):  # noqa: ANN202
+    def enter(s: Session, c: Call) -> None:
+        s.processor = processor
+
+    return enter
+
+
+command("/PREP7", ANY, 0)(_enter("PREP7"))
+command("/SOLU", ANY, 0)(_enter("SOLU"))
+command("/POST1", ANY, 0)(_enter("POST1"))
+command("FINISH", ANY, 0)(_enter("BEGIN"))
+
+
+@command("/COM", ANY, 1)
+def com(s: Session, c: Call) -> None:
+    s.say(c.raw(1))
+
+
+@command("/TITLE", ANY, 1)
+def title(s: Session, c: Call) -> None:
+    s.title = c.raw(1)
+
+
+command("/STITLE", ANY, 1)(lambda s, c: None)
+# output controls that archives and MAPDL decks carry; they change nothing here
+for _name in ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VERIFY", "/OUTPUT",
+              "/NERR", "/SHOW", "/CONFIG", "/FILNAME", "/CLEAR"):
+    command(_name, ANY, 10)(lambda s, c: None)
+
+
+@command("*SET", ANY, 11)
+def star_set(s: Session, c: Call) -> None:
+    name = c.raw(1).upper()
+    if not is_parameter_name(name):
+        raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
+    if not c.given(2):
+        s.params.pop(name, None)
+        return
+    if c.raw(2).startswith("'"):
+        raise ApdlError("character parameters are not supported (numeric parameters only)")
+    if c.count() > 2:
+        raise ApdlError("array parameters are not supported (one value per *SET)")
+    s.params[name] = c.num(2, what="VALUE")
+
+
+_STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
+
+
+@command("*GET", ANY, 8)
+def star_get(s: Session, c: Call) -> None:
+    """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM ...)."""
+    name = c.raw(1).upper()
+    if not is_parameter_name(name):
+        raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
+    entity = c.label(2)
+    item, sub = c.label(4), c.label(5)
+    db = s.db
+    if entity not in ("NODE", "ELEM"):
+        raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
+    if item == "NUM":
+        table = db.nodes if entity == "NODE" else db.elements
+        ids = table.ids[table.selected]
+        if sub == "COUNT":
+            value = float(ids.size)
+        elif sub in ("MAX", "MIN"):
+            value = float(ids.max() if sub == "MAX" else ids.min()) if ids.size else 0.0
+        else:
+            raise ApdlError(f"field 5: NUM takes MAX, MIN or COUNT, got {sub or '(empty)'!r}")
+    elif entity == "ELEM":
+        raise ApdlError(f"field 4: ELEM supports NUM only, got {item or '(empty)'!r}")
+    else:
+        n = c.int(3, what="node number")
+        if item == "TEMP":
+            value = s.nodal_result("TEMP", n)
+        elif item == "U":
+            if sub not in ("X", "Y"):
+                raise ApdlError(f"field 5: U takes X or Y, got {sub or '(empty)'!r}")
+            value = s.nodal_result("U" + sub, n)
+        elif item == "S":
+            if sub not in _STRESS:
+                raise ApdlError(f"field 5: S takes X, Y, Z, XY or EQV, got {sub or '(empty)'!r}")
+            value = s.nodal_result(_STRESS[sub], n)
+        elif item == "LOC":
+            if sub not in ("X", "Y", "Z"):
+                raise ApdlError(f"field 5: LOC takes X, Y or Z, got {sub or '(empty)'!r}")
+            i = s._node_index(n)
+            value = 0.0 if sub == "Z" else float(db.nodes.xy[i, 0 if sub == "X" else 1])
+        else:
+            raise ApdlError(f"field 4: NODE item must be TEMP, U, S, LOC or NUM, got "
+                            f"{item or '(empty)'!r}")
+    if not np.isfinite(value):
+        raise ApdlError("the requested value is not a finite number")
+    s.params[name] = float(value)

@@ -1,0 +1,285 @@
+"""Loads (valid in /PREP7 and /SOLU): D, SF, SFE, BF, BFE, IC, TUNIF, BFUNIF, TREF.
+
+Every load command is a *record*: the entities it touches remember its id, so a later
+command on a subset overrides only that subset, and the solver can turn each record back
+into one region or boundary of the FEM mesh (see `apdl_like.fem_bridge`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.commands import LOADS, Call, command
+from apdl_like.commands.selection import component, component_mask
+from apdl_like.errors import ApdlError
+from apdl_like.fem_bridge import pair_keys
+from apdl_like.solve import fem_model
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+
+def node_targets(s: Session, c: Call, i: int = 1, end_field: int | None = None) -> np.ndarray:
+    """Node indices named by field i: ALL (selected), a component, or a number [NEND, NINC]."""
+    nodes = s.db.nodes
+    text = c.label(i)
+    if not text:
+        raise ApdlError(f"field {i} (node) is required")
+    if text == "ALL":
+        return np.nonzero(nodes.selected)[0]
+    if text == "P":
+        raise ApdlError("graphical picking (P) is not available in a deck")
+    if text[0].isalpha() and text.upper() in s.db.components:
+        comp = component(s, text)
+        if comp.entity != "NODE":
+            raise ApdlError(f"component {text} holds elements, not nodes")
+        return np.nonzero(component_mask(s, comp))[0]
+    if text[0].isalpha() and not any(ch in text for ch in "+-*/(") and \
+            text.upper() not in s.params:
+        raise ApdlError(f"field {i}: {text} is neither ALL, a component, nor a parameter")
+    first = c.int(i, what="node")
+    nums = np.array([first])
+    if end_field is not None and c.given(end_field):
+        last = c.int(end_field, what="NEND")
+        step = c.int(end_field + 1, 1, what="NINC")
+        if step < 1:
+            raise ApdlError(f"field {end_field + 1} (NINC) must be ≥ 1")
+        if (last - first) // step > 10_000_000:
+            raise ApdlError("node range too long")
+        nums = np.arange(first, last + 1, step)
+    idx = nodes.index(nums)
+    if np.any(idx < 0):
+        raise ApdlError(f"node {int(nums[np.nonzero(idx < 0)[0][0]])} does not exist")
+    return idx
+
+
+def element_targets(s: Session, c: Call, i: int = 1) -> np.ndarray:
+    el = s.db.elements
+    text = c.label(i)
+    if not text:
+        raise ApdlError(f"field {i} (element) is required")
+    if text == "ALL":
+        return np.nonzero(el.selected)[0]
+    if text == "P":
+        raise ApdlError("graphical picking (P) is not available in a deck")
+    if text[0].isalpha() and text.upper() in s.db.components:
+        comp = component(s, text)
+        if comp.entity != "ELEM":
+            raise ApdlError(f"component {text} holds nodes, not elements")
+        return np.nonzero(component_mask(s, comp))[0]
+    if text[0].isalpha() and not any(ch in text for ch in "+-*/(") and \
+            text.upper() not in s.params:
+        raise ApdlError(f"field {i}: {text} is neither ALL, a component, nor a parameter")
+    num = c.int(i, what="element")
+    idx = el.index(num)
+    if idx[0] < 0:
+        raise ApdlError(f"element {num} does not exist")
+    return idx
+
+
+_D_LABELS = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",), "ALL": ("d_ux", "d_uy")}
+
+
+@command("D", LOADS, 11)
+def d(s: Session, c: Call) -> None:
+    labels = [c.label(2)] + [c.label(i) for i in range(7, 12) if c.given(i)]
+    for lab in labels:
+        if lab not in _D_LABELS:
+            raise ApdlError(f"DOF label must be TEMP, UX, UY or ALL, got {lab or '(empty)'!r}")
+    value = c.num(3, 0.0, what="VALUE")
+    if c.given(4) and c.num(4) != 0.0:
+        raise ApdlError("field 4 (VALUE2, imaginary part) is not supported")
+    idx = node_targets(s, c, 1, end_field=5)
+    arrays = s.db.nodes.arrays
+    for lab in labels:
+        for key in _D_LABELS[lab]:
+            arrays[key][idx] = value
+    s.note_load(c)
+
+
+@command("DDELE", LOADS, 5)
+def ddele(s: Session, c: Call) -> None:
+    lab = c.label(2, "ALL")
+    keys = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",),
+            "ALL": ("d_temp", "d_ux", "d_uy")}.get(lab)
+    if keys is None:
+        raise ApdlError(f"field 2: DOF label must be TEMP, UX, UY or ALL, got {lab!r}")
+    idx = node_targets(s, c, 1, end_field=3)
+    for key in keys:
+        s.db.nodes.arrays[key][idx] = np.nan
+
+
+def _faces_on_nodes(s: Session, idx: np.ndarray) -> np.ndarray:
+    fem = fem_model(s)
+    mask = np.zeros(len(s.db.nodes.ids), bool)
+    mask[idx] = True
+    return np.nonzero(mask[fem.face_nodes[0]] & mask[fem.face_nodes[1]])[0]
+
+
+def _set_face_load(s: Session, faces: np.ndarray, lab: str, v1: float | None,
+                   v2: float | None) -> None:
+    f = s.db.faces
+    rec = s.db.next_record()
+    if lab == "CONV":
+        if v1 is not None:
+            if v1 < 0.0:
+                raise ApdlError(f"film coefficient must be ≥ 0, got {v1!r}")
+            f.conv_h[faces] = v1
+        if v2 is not None:
+            f.conv_bulk[faces] = v2
+        f.conv_record[faces] = rec
+    else:
+        f.hflux[faces] = v1
+        f.hflux_record[faces] = rec
+
+
+@command("SF", LOADS, 4)
+def sf(s: Session, c: Call) -> None:
+    lab = c.label(2)
+    if lab not in ("CONV", "HFLUX"):
+        raise ApdlError(f"field 2: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
+    v1 = c.num(3, what="VALUE")
+    v2 = c.num(4, what="VALUE2 (bulk temperature)") if lab == "CONV" else None
+    faces = _faces_on_nodes(s, node_targets(s, c, 1))
+    if faces.size == 0:
+        raise ApdlError("no exterior element face has all its nodes in the node set")
+    _set_face_load(s, faces, lab, v1, v2)
+    s.note_load(c)
+
+
+@command("SFDELE", LOADS, 2)
+def sfdele(s: Session, c: Call) -> None:
+    lab = c.label(2, "ALL")
+    if lab not in ("CONV", "HFLUX", "ALL"):
+        raise ApdlError(f"field 2 must be CONV, HFLUX or ALL, got {lab!r}")
+    faces = _faces_on_nodes(s, node_targets(s, c, 1))
+    f = s.db.faces
+    if lab in ("CONV", "ALL"):
+        f.conv_h[faces], f.conv_bulk[faces], f.conv_record[faces] = np.nan, np.nan, -1
+    if lab in ("HFLUX", "ALL"):
+        f.hflux[faces], f.hflux_record[faces] = np.nan, -1
+
+
+def _element_faces(s: Session, elems: np.ndarray, lkey: int) -> np.ndarray:
+    db = s.db
+    fem = fem_model(s)
+    nodes = db.elements.nodes[elems]
+    tri6 = np.array([db.element_types[int(t)].triangle6 for t in db.elements.type[elems]], bool)
+    corners = nodes[:, :4].copy()
+    corners[tri6, 3] = corners[tri6, 2]
+    if lkey == 3:
+        a, b = corners[:, 2], corners[:, 3]
+        a = np.where(tri6, corners[:, 2], a)
+        b = np.where(tri6, corners[:, 0], b)
+    else:
+        a, b = {1: (corners[:, 0], corners[:, 1]), 2: (corners[:, 1], corners[:, 2]),
+                4: (corners[:, 3], corners[:, 0])}[lkey]
+    if np.any(a == b):
+        bad = int(db.elements.ids[elems[np.nonzero(a == b)[0][0]]])
+        raise ApdlError(f"face {lkey} of element {bad} is collapsed (triangle K = L)")
+    faces = fem.face_index(pair_keys(a, b))
+    if np.any(faces < 0):
+        bad = int(db.elements.ids[elems[np.nonzero(faces < 0)[0][0]]])
+        raise ApdlError(f"face {lkey} of element {bad} is not on the outer boundary")
+    return faces
+
+
+@command("SFE", LOADS, 8)
+def sfe(s: Session, c: Call) -> None:
+    lkey = c.int(2, 1, what="LKEY")
+    if lkey not in (1, 2, 3, 4):
+        raise ApdlError(f"field 2 (LKEY) must be 1..4, got {lkey}")
+    lab = c.label(3)
+    if lab not in ("CONV", "HFLUX"):
+        raise ApdlError(f"field 3: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
+    kval = c.int(4, 0, what="KVAL")
+    value = c.num(5, what="VAL1")
+    for i in (6, 7, 8):
+        if c.given(i) and c.num(i) != value:
+            raise ApdlError("values varying along a face (VAL2..VAL4) are not supported")
+    faces = _element_faces(s, element_targets(s, c, 1), lkey)
+    if lab == "CONV":
+        if kval not in (0, 1, 2):
+            raise ApdlError(f"field 4 (KVAL) must be 0/1 (film coefficient) or 2 (bulk "
+                            f"temperature), got {kval}")
+        _set_face_load(s, faces, lab, value if kval < 2 else None, value if kval == 2 else None)
+    else:
+        _set_face_load(s, faces, lab, value, None)
+    s.note_load(c)
+
+
+def _set_hgen(s: Session, elems: np.ndarray, value: float | None) -> None:
+    arrays = s.db.elements.arrays
+    arrays["hgen"][elems] = np.nan if value is None else value
+    arrays["hgen_record"][elems] = -1 if value is None else s.db.next_record()
+
+
+@command("BF", LOADS, 6)
+def bf(s: Session, c: Call) -> None:
+    lab = c.label(2)
+    if lab == "TEMP":
+        value = c.num(3, what="VAL1")
+        idx = node_targets(s, c, 1)
+        s.db.nodes.arrays["bf_temp"][idx] = value
+    elif lab == "HGEN":
+        name = c.label(1)
+        comp = s.db.components.get(name)
+        if comp is None or comp.entity != "ELEM":
+            raise ApdlError("HGEN by BF needs an element component; use BFE,ALL,HGEN,,value "
+                            "for selected elements")
+        _set_hgen(s, element_targets(s, c, 1), c.num(3, what="VAL1"))
+    else:
+        raise ApdlError(f"field 2: body load must be TEMP or HGEN, got {lab or '(empty)'!r}")
+    s.note_load(c)
+
+
+@command("BFE", LOADS, 7)
+def bfe(s: Session, c: Call) -> None:
+    lab = c.label(2)
+    if lab != "HGEN":
+        raise ApdlError(f"field 2: element body load must be HGEN, got {lab or '(empty)'!r}")
+    stloc = c.int(3, 1, what="STLOC")
+    if stloc != 1:
+        raise ApdlError("field 3 (STLOC): only a uniform value from location 1 is supported")
+    value = c.num(4, what="VAL1")
+    for i in (5, 6, 7):
+        if c.given(i) and c.num(i) != value:
+            raise ApdlError("HGEN varying inside an element (VAL2..VAL4) is not supported")
+    _set_hgen(s, element_targets(s, c, 1), value)
+    s.note_load(c)
+
+
+@command("BFEDELE", LOADS, 2)
+def bfedele(s: Session, c: Call) -> None:
+    lab = c.label(2, "ALL")
+    if lab not in ("HGEN", "ALL"):
+        raise ApdlError(f"field 2 must be HGEN or ALL, got {lab!r}")
+    _set_hgen(s, element_targets(s, c, 1), None)
+
+
+@command("IC", LOADS, 5)
+def ic(s: Session, c: Call) -> None:
+    lab = c.label(2, "TEMP")
+    if lab != "TEMP":
+        raise ApdlError(f"field 2: initial condition must be TEMP, got {lab!r}")
+    value = c.num(3, 0.0, what="VALUE")
+    s.db.nodes.arrays["ic_temp"][node_targets(s, c, 1)] = value
+
+
+@command("TUNIF", LOADS, 1)
+def tunif(s: Session, c: Call) -> None:
+    s.db.settings.tunif = c.num(1, 0.0, what="TEMP")
+
+
+@command("BFUNIF", LOADS, 2)
+def bfunif(s: Session, c: Call) -> None:
+    if c.label(1) != "TEMP":
+        raise ApdlError(f"field 1: BFUNIF supports TEMP only, got {c.label(1) or '(empty)'!r}")
+    s.db.settings.tunif = c.num(2, 0.0, what="VALUE")
+
+
+@command("TREF", LOADS, 1)
+def tref(s: Session, c: Call) -> None:
+    s.db.settings.tref = c.num(1, 0.0, what="TREF")

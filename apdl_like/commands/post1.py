@@ -1,0 +1,70 @@
+"""/POST1: result sets and nodal listings."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.commands import POST, Call, command
+from apdl_like.errors import ApdlError
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+
+@command("SET", POST, 5)
+def set_(s: Session, c: Call) -> None:
+    if not s.results:
+        raise ApdlError("there are no results (SOLVE first)")
+    what = c.label(1, "LAST")
+    if what in ("LAST", ""):
+        s.post_index = len(s.results) - 1
+    elif what == "FIRST":
+        s.post_index = 0
+    else:
+        step = c.int(1, what="LSTEP")
+        if not 1 <= step <= len(s.results):
+            raise ApdlError(f"load step {step} does not exist (1..{len(s.results)})")
+        s.post_index = step - 1
+
+
+_ITEMS = {
+    ("TEMP", ""): ["TEMP"],
+    ("U", "X"): ["UX"], ("U", "Y"): ["UY"], ("U", "COMP"): ["UX", "UY"], ("U", ""): ["UX", "UY"],
+    ("S", "COMP"): ["SX", "SY", "SZ", "SXY"], ("S", ""): ["SX", "SY", "SZ", "SXY"],
+    ("S", "X"): ["SX"], ("S", "Y"): ["SY"], ("S", "Z"): ["SZ"], ("S", "XY"): ["SXY"],
+    ("S", "EQV"): ["SEQV"], ("S", "PRIN"): ["SEQV"],
+}
+
+
+@command("PRNSOL", POST, 2)
+def prnsol(s: Session, c: Call) -> None:
+    key = (c.label(1, "TEMP"), c.label(2))
+    items = _ITEMS.get(key)
+    if items is None:
+        raise ApdlError(f"PRNSOL supports TEMP, U,X|Y|COMP and S,X|Y|Z|XY|COMP|EQV, got "
+                        f"{','.join(k for k in key if k)!r}")
+    res = s.result()
+    fem = s.fem
+    assert fem is not None
+    nodes = s.db.nodes
+    sel = np.nonzero(nodes.selected)[0]
+    columns = []
+    for item in items:
+        if item == "TEMP":
+            columns.append(fem.thermal_nodal(res.temperature)[sel])
+        elif res.displacement is None:
+            raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
+        elif item in ("UX", "UY"):
+            columns.append(fem.glued_nodal(res.displacement[0 if item == "UX" else 1])[sel])
+        else:
+            k = {"SX": "rr", "SY": "zz", "SZ": "tt", "SXY": "rz", "SEQV": "von_mises"}[item]
+            columns.append(fem.glued_nodal(res.stress[k])[sel])
+    s.say(f"PRNSOL load step {res.load_step}, time {res.time:g}")
+    s.say("    NODE " + "".join(f"{item:>16}" for item in items))
+    for j, i in enumerate(sel):
+        values = [col[j] for col in columns]
+        if all(np.isnan(v) for v in values):
+            continue
+        s.say(f"{int(nodes.ids[i]):8d} " + "".join(f"{v:16.6E}" for v in values))

@@ -1,0 +1,258 @@
+"""/PREP7: element types, materials, real constants, nodes, elements, areas and meshing."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.commands import PREP7, Call, command
+from apdl_like.errors import ApdlError
+from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+MAX_ENTITY_NUMBER = 2**31 - 1
+MP_LABELS = ("KXX", "DENS", "C", "EX", "PRXY", "NUXY", "ALPX")
+MP_POSITIVE = ("KXX", "DENS", "C", "EX")
+CONTACT_TYPES = ("CONTA172", "TARGE169")
+
+
+def _entity_number(c: Call, i: int, what: str) -> int:
+    n = c.int(i, what=what)
+    if not 1 <= n <= MAX_ENTITY_NUMBER:
+        raise ApdlError(f"field {i} ({what}) must lie in 1..{MAX_ENTITY_NUMBER}, got {n}")
+    return n
+
+
+def _element_name(c: Call) -> str:
+    text = c.label(2)
+    if not text:
+        raise ApdlError("field 2 (element name) is required")
+    name = text if not text.isdigit() else f"PLANE{int(text)}"
+    if name in CONTACT_TYPES:
+        return name
+    if name not in ELEMENT_TYPES:
+        raise ApdlError(f"element {text} is not supported (PLANE55, PLANE77, PLANE182, PLANE183)")
+    return name
+
+
+@command("ET", PREP7, 8)
+def et(s: Session, c: Call) -> None:
+    itype = _entity_number(c, 1, "ITYPE")
+    name = _element_name(c)
+    if name in CONTACT_TYPES:
+        # contact pairs come with an AxiMesh session (interfaces); accepted for archives
+        s.say(f"ET,{itype},{name}: contact pairs act through the session's interfaces")
+        return
+    keyopt = {}
+    for k in range(1, 7):
+        if c.given(2 + k):
+            keyopt[k] = c.int(2 + k, what=f"KOP{k}")
+    s.db.element_types[itype] = ElementType(name, keyopt)
+
+
+@command("KEYOPT", PREP7, 3)
+def keyopt(s: Session, c: Call) -> None:
+    itype = _entity_number(c, 1, "ITYPE")
+    knum = c.int(2, what="KNUM")
+    if not 1 <= knum <= 18:
+        raise ApdlError(f"field 2 (KNUM) must lie in 1..18, got {knum}")
+    value = c.int(3, 0, what="VALUE")
+    et_ = s.db.element_types.get(itype)
+    if et_ is None:
+        raise ApdlError(f"element type {itype} is not defined (ET first)")
+    et_.keyopt[knum] = value
+
+
+@command("ETCHG", PREP7, 1)
+def etchg(s: Session, c: Call) -> None:
+    how = c.label(1)
+    if how not in ("TTS", "STT"):
+        raise ApdlError(f"field 1 must be TTS (thermal to structural) or STT, got {how!r}")
+    table = THERMAL_TO_STRUCTURAL if how == "TTS" else \
+        {v: k for k, v in THERMAL_TO_STRUCTURAL.items()}
+    for et_ in s.db.element_types.values():
+        if et_.name in table:
+            et_.name = table[et_.name]
+
+
+def _attribute(name: str):  # noqa: ANN202
+    def set_attribute(s: Session, c: Call) -> None:
+        setattr(s.db, f"active_{name}", _entity_number(c, 1, name.upper()))
+
+    return set_attribute
+
+
+command("TYPE", PREP7, 1)(_attribute("type"))
+command("MAT", PREP7, 1)(_attribute("mat"))
+command("REAL", PREP7, 1)(_attribute("real"))
+
+
+@command("MP", PREP7, 7)
+def mp(s: Session, c: Call) -> None:
+    label = c.label(1)
+    if label not in MP_LABELS:
+        raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
+    mat = _entity_number(c, 2, "MAT")
+    value = c.num(3, what="C0")
+    for i in range(4, 8):
+        if c.given(i) and c.num(i) != 0.0:
+            raise ApdlError("temperature-dependent properties (C1..C4) are not supported")
+    if label in MP_POSITIVE and not value > 0.0:
+        raise ApdlError(f"{label} must be positive, got {value!r}")
+    if label in ("PRXY", "NUXY") and not -1.0 < value < 0.5:
+        raise ApdlError(f"{label} must lie in (-1, 0.5), got {value!r}")
+    s.db.materials.setdefault(mat, Material()).props[label] = value
+
+
+def _real_values(s: Session, nset: int, start: int, c: Call, first_field: int, count: int) -> None:
+    values = s.db.real_sets.setdefault(nset, {})
+    for k in range(count):
+        if c.given(first_field + k):
+            values[start + k] = c.num(first_field + k, what=f"R{start + k}")
+
+
+@command("R", PREP7, 7)
+def r(s: Session, c: Call) -> None:
+    nset = _entity_number(c, 1, "NSET")
+    s.db.real_sets[nset] = {}
+    _real_values(s, nset, 1, c, 2, 6)
+    s.last_real = (nset, 7)
+
+
+@command("RMORE", PREP7, 6)
+def rmore(s: Session, c: Call) -> None:
+    if s.last_real is None:
+        raise ApdlError("RMORE needs a preceding R command")
+    nset, start = s.last_real
+    _real_values(s, nset, start, c, 1, 6)
+    s.last_real = (nset, start + 6)
+
+
+@command("RMODIF", PREP7, 8)
+def rmodif(s: Session, c: Call) -> None:
+    nset = _entity_number(c, 1, "NSET")
+    stloc = c.int(2, what="STLOC")
+    if not 1 <= stloc <= 100:
+        raise ApdlError(f"field 2 (STLOC) must lie in 1..100, got {stloc}")
+    if nset not in s.db.real_sets:
+        raise ApdlError(f"real constant set {nset} does not exist")
+    _real_values(s, nset, stloc, c, 3, 6)
+    s.note_load(c)
+
+
+@command("N", PREP7, 7)
+def n(s: Session, c: Call) -> None:
+    nodes = s.db.nodes
+    if c.given(1):
+        num = _entity_number(c, 1, "NODE")
+    else:
+        nodes.flush()
+        num = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
+        num = max([num, *nodes.pending]) if nodes.pending else num
+    x, y = c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y")
+    if c.given(4) and c.num(4) != 0.0:
+        raise ApdlError("field 4 (Z) must be 0 in a 2-D axisymmetric model")
+    nodes.add(num, x, y)
+
+
+_NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (8,), "PLANE183": (8,)}
+
+
+@command("E", PREP7, 8)
+def e(s: Session, c: Call) -> None:
+    db = s.db
+    et_ = db.element_types.get(db.active_type)
+    if et_ is None:
+        raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
+    given = [i for i in range(1, 9) if c.given(i)]
+    if given != list(range(1, len(given) + 1)):
+        raise ApdlError("node fields must be given without gaps")
+    nums = [_entity_number(c, i, "node") for i in given]
+    allowed = (6,) if et_.triangle6 else _NODE_COUNTS[et_.name]
+    if len(nums) not in allowed:
+        shape = "6-node triangle" if et_.triangle6 else et_.name
+        raise ApdlError(f"{shape} takes {' or '.join(map(str, allowed))} nodes, got {len(nums)}")
+    idx = db.nodes.index(np.array(nums))
+    if np.any(idx < 0):
+        raise ApdlError(f"node {nums[int(np.nonzero(idx < 0)[0][0])]} does not exist")
+    if len(set(nums[:3])) < 3:
+        raise ApdlError("the first three nodes (I, J, K) must be distinct")
+    if len(nums) == 3:
+        nums.append(nums[2])  # the triangle is the quad with K = L
+    el = db.elements
+    el.flush()
+    number = int(el.ids.max()) + 1 if len(el.ids) else 1
+    el.add(number, db.active_type, db.active_mat, db.active_real, tuple(nums))
+
+
+@command("K", PREP7, 4)
+def k(s: Session, c: Call) -> None:
+    kps = s.db.keypoints
+    num = _entity_number(c, 1, "NPT") if c.given(1) else max(kps, default=0) + 1
+    if c.given(4) and c.num(4) != 0.0:
+        raise ApdlError("field 4 (Z) must be 0 in a 2-D axisymmetric model")
+    kps[num] = (c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
+
+
+@command("A", PREP7, 18)
+def a(s: Session, c: Call) -> None:
+    pts = [_entity_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
+    if len(pts) < 3:
+        raise ApdlError("an area needs at least 3 keypoints")
+    for p in pts:
+        if p not in s.db.keypoints:
+            raise ApdlError(f"keypoint {p} does not exist")
+    s.db.areas[max(s.db.areas, default=0) + 1] = pts
+
+
+@command("RECTNG", PREP7, 4)
+def rectng(s: Session, c: Call) -> None:
+    x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
+    y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
+    if x1 == x2 or y1 == y2:
+        raise ApdlError("the rectangle has zero width or height")
+    kps = s.db.keypoints
+    first = max(kps, default=0) + 1
+    corners = [(x1, y1), (x2, y1), (x2, y2), (x1, y2)]
+    for i, xy in enumerate(corners):
+        kps[first + i] = xy
+    s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
+
+
+@command("ESIZE", PREP7, 2)
+def esize(s: Session, c: Call) -> None:
+    size = c.num(1, what="SIZE")
+    if not size > 0.0:
+        raise ApdlError(f"field 1 (SIZE) must be positive, got {size!r}")
+    s.db.esize = size
+
+
+command("MSHAPE", PREP7, 2)(lambda s, c: None)  # AMESH makes triangles whatever is asked
+command("MSHKEY", PREP7, 1)(lambda s, c: None)
+
+
+@command("AMESH", PREP7, 3)
+def amesh(s: Session, c: Call) -> None:
+    from apdl_like.meshing import mesh_areas
+
+    areas = s.db.areas
+    if c.label(1, "ALL") == "ALL":
+        chosen = sorted(areas)
+    else:
+        first = _entity_number(c, 1, "NA1")
+        last = _entity_number(c, 2, "NA2") if c.given(2) else first
+        step = c.int(3, 1, what="NINC")
+        if step < 1:
+            raise ApdlError("field 3 (NINC) must be ≥ 1")
+        chosen = list(range(first, last + 1, step))
+        for num in chosen:
+            if num not in areas:
+                raise ApdlError(f"area {num} does not exist")
+    chosen = [num for num in chosen if num not in s.db.meshed_areas]
+    if not chosen:
+        raise ApdlError("no unmeshed areas to mesh")
+    mesh_areas(s, chosen)
+    s.db.meshed_areas.update(chosen)

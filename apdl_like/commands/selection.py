@@ -1,0 +1,193 @@
+"""NSEL, ESEL, NSLE, ESLN, ALLSEL, CM, CMSEL, CMDELE (valid in every processor)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.commands import MODEL, Call, command
+from apdl_like.errors import ApdlError
+from apdl_like.model import Component
+from apdl_like.selection import combine, in_range, number_range
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+_ANY_OR_BEGIN = MODEL | {"BEGIN"}
+
+
+def _mode(c: Call) -> str:
+    mode = c.label(1, "S")
+    if mode not in ("S", "R", "A", "U", "ALL", "NONE", "INVE"):
+        raise ApdlError(f"field 1: selection type must be S, R, A, U, ALL, NONE or INVE, "
+                        f"got {mode!r}")
+    return mode
+
+
+def _range(c: Call) -> tuple[float, float, float]:
+    vmin = c.num(4, what="VMIN")
+    vmax = c.num(5, vmin, what="VMAX")
+    vinc = c.num(6, 1.0, what="VINC")
+    return vmin, vmax, vinc
+
+
+@command("NSEL", _ANY_OR_BEGIN, 7)
+def nsel(s: Session, c: Call) -> None:
+    nodes = s.db.nodes
+    mode = _mode(c)
+    current = nodes.selected
+    if mode in ("ALL", "NONE", "INVE"):
+        nodes.selected = combine(mode, current, current)
+        return
+    item = c.label(2, "NODE")
+    if item == "NODE":
+        picked = number_range(nodes.ids, *_range(c))
+    elif item == "LOC":
+        comp = c.label(3)
+        if comp not in ("X", "Y", "Z"):
+            raise ApdlError(f"field 3: LOC takes X or Y (Z is 0 in a 2-D model), got {comp!r}")
+        vmin = c.num(4, what="VMIN")
+        vmax = c.num(5, vmin, what="VMAX")
+        values = np.zeros(len(nodes.ids)) if comp == "Z" else nodes.xy[:, "XY".index(comp)]
+        picked = in_range(values, vmin, vmax)
+    else:
+        raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
+    nodes.selected = combine(mode, current, picked)
+
+
+@command("ESEL", _ANY_OR_BEGIN, 7)
+def esel(s: Session, c: Call) -> None:
+    el = s.db.elements
+    mode = _mode(c)
+    current = el.selected
+    if mode in ("ALL", "NONE", "INVE"):
+        el.selected = combine(mode, current, current)
+        return
+    item = c.label(2, "ELEM")
+    if item == "ELEM":
+        picked = number_range(el.ids, *_range(c))
+    elif item in ("TYPE", "MAT", "REAL"):
+        values = {"TYPE": el.type, "MAT": el.mat, "REAL": el.real}[item]
+        picked = number_range(values, *_range(c))
+    elif item == "CENT" or item == "LOC":
+        comp = c.label(3)
+        if comp not in ("X", "Y"):
+            raise ApdlError(f"field 3: {item} takes X or Y, got {comp!r}")
+        vmin = c.num(4, what="VMIN")
+        vmax = c.num(5, vmin, what="VMAX")
+        picked = in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
+    else:
+        raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
+    el.selected = combine(mode, current, picked)
+
+
+def _centroids(s: Session) -> np.ndarray:
+    el = s.db.elements
+    corner = el.nodes[:, :4]
+    idx = s.db.nodes.index(corner.ravel()).reshape(corner.shape)
+    present = (corner > 0) & (idx >= 0)
+    xy = s.db.nodes.xy[np.where(present, idx, 0)]
+    # unique corners only (K = L counts once)
+    dup = np.zeros_like(present)
+    dup[:, 3] = corner[:, 3] == corner[:, 2]
+    w = (present & ~dup).astype(float)
+    return (xy * w[..., None]).sum(axis=1) / np.maximum(w.sum(axis=1), 1.0)[:, None]
+
+
+def _element_node_indices(s: Session, element_mask: np.ndarray) -> np.ndarray:
+    nums = s.db.elements.nodes[element_mask]
+    nums = nums[nums > 0]
+    idx = s.db.nodes.index(np.unique(nums))
+    return idx[idx >= 0]
+
+
+@command("NSLE", _ANY_OR_BEGIN, 3)
+def nsle(s: Session, c: Call) -> None:
+    mode = _mode(c)
+    nodes = s.db.nodes
+    picked = np.zeros(len(nodes.ids), bool)
+    picked[_element_node_indices(s, s.db.elements.selected)] = True
+    nodes.selected = combine(mode, nodes.selected, picked)
+
+
+@command("ESLN", _ANY_OR_BEGIN, 3)
+def esln(s: Session, c: Call) -> None:
+    mode = _mode(c)
+    key = c.int(2, 0, what="EKEY")
+    el, nodes = s.db.elements, s.db.nodes
+    num = el.nodes
+    idx = nodes.index(num.ravel()).reshape(num.shape)
+    sel = np.zeros(num.shape, bool)
+    ok = (num > 0) & (idx >= 0)
+    sel[ok] = nodes.selected[idx[ok]]
+    picked = np.all(sel | ~ok, axis=1) if key == 1 else np.any(sel, axis=1)
+    el.selected = combine(mode, el.selected, picked)
+
+
+@command("ALLSEL", _ANY_OR_BEGIN, 2)
+def allsel(s: Session, c: Call) -> None:
+    s.db.nodes.selected = np.ones(len(s.db.nodes), bool)
+    s.db.elements.selected = np.ones(len(s.db.elements), bool)
+
+
+def _component_name(c: Call, i: int) -> str:
+    name = c.raw(i).upper()
+    if not name or len(name) > 32 or not name[0].isalpha() or \
+            not all(ch.isalnum() or ch == "_" for ch in name):
+        raise ApdlError(f"field {i}: {c.raw(i)!r} is not a valid component name")
+    return name
+
+
+@command("CM", _ANY_OR_BEGIN, 3)
+def cm(s: Session, c: Call) -> None:
+    name = _component_name(c, 1)
+    entity = c.label(2)
+    if entity == "NODE":
+        s.db.components[name] = Component("NODE", s.db.nodes.ids[s.db.nodes.selected].copy())
+    elif entity == "ELEM":
+        s.db.components[name] = Component("ELEM",
+                                          s.db.elements.ids[s.db.elements.selected].copy())
+    else:
+        raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
+
+
+@command("CMDELE", _ANY_OR_BEGIN, 1)
+def cmdele(s: Session, c: Call) -> None:
+    name = _component_name(c, 1)
+    if s.db.components.pop(name, None) is None:
+        raise ApdlError(f"component {name} does not exist")
+
+
+def component(s: Session, name: str) -> Component:
+    comp = s.db.components.get(name.upper())
+    if comp is None:
+        known = ", ".join(sorted(s.db.components)) or "none"
+        raise ApdlError(f"component {name.upper()} does not exist (known: {known})")
+    return comp
+
+
+def component_mask(s: Session, comp: Component) -> np.ndarray:
+    table = s.db.nodes if comp.entity == "NODE" else s.db.elements
+    table.flush()
+    mask = np.zeros(len(table.ids), bool)
+    idx = table.index(comp.numbers)
+    mask[idx[idx >= 0]] = True
+    return mask
+
+
+@command("CMSEL", _ANY_OR_BEGIN, 3)
+def cmsel(s: Session, c: Call) -> None:
+    mode = c.label(1, "S")
+    if mode in ("ALL", "NONE"):
+        for comp in s.db.components.values():
+            table = s.db.nodes if comp.entity == "NODE" else s.db.elements
+            picked = component_mask(s, comp)
+            table.selected = table.selected | picked if mode == "ALL" else \
+                table.selected & ~picked
+        return
+    if mode not in ("S", "R", "A", "U"):
+        raise ApdlError(f"field 1: selection type must be S, R, A, U, ALL or NONE, got {mode!r}")
+    comp = component(s, _component_name(c, 2))
+    table = s.db.nodes if comp.entity == "NODE" else s.db.elements
+    table.selected = combine(mode, table.selected, component_mask(s, comp))

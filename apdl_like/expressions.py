@@ -1,0 +1,358 @@
+"""A small, hand-written evaluator for APDL numeric expressions (no `eval`).
+
+Grammar (APDL/Fortran precedence; `**` binds tighter than unary minus, so -2**2 = -4)::
+
+    expr  := term (("+" | "-") term)*
+    term  := unary (("*" | "/") unary)*
+    unary := ("+" | "-") unary | power
+    power := atom ("**" unary)?              right-associative
+    atom  := NUMBER | NAME | NAME "(" expr ("," expr)* ")" | "(" expr ")"
+
+Numbers take any float notation, including Fortran's `1.5D3`.  Names are parameters
+(case-insensitive).  Functions: ABS SQRT EXP LOG LOG10 SIN COS TAN ASIN ACOS ATAN ATAN2 MIN
+MAX SIGN NINT MOD (radians), plus model functions such as NX(n), NY(n), NODE(x,y,z) that the
+caller supplies at evaluation time.  Text is compiled once into closures (cached), so a deck
+that runs every 60 s pays the parse only once.
+
+Limits stop runaway input: expression length and nesting depth.  Every failure is an
+`ApdlError` with a plain message; the caller adds file:line and the command.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Mapping
+from functools import lru_cache
+
+from apdl_like.errors import ApdlError
+
+MAX_EXPRESSION_CHARS = 640  # the APDL command-line length
+MAX_DEPTH = 32  # nesting of parentheses, unary signs and function calls
+MAX_NAME_CHARS = 32  # APDL parameter-name length
+
+ModelFunction = Callable[..., float]
+Evaluator = Callable[[Mapping[str, float], Mapping[str, ModelFunction]], float]
+
+_TOKEN = re.compile(
+    r"\s*(?:"
+    r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eEdD][+-]?\d+)?)"
+    r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
+    r"|(?P<op>\*\*|[-+*/(),])"
+    r")"
+)
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+def _sign(a: float, b: float) -> float:
+    return math.copysign(abs(a), b)
+
+
+def _nint(a: float) -> float:
+    # Fortran NINT: halves away from zero (Python's round() would go to even).
+    return float(math.floor(abs(a) + 0.5)) * (1.0 if a >= 0 else -1.0)
+
+
+# name -> (function, minimum arguments, maximum arguments)
+BUILTINS: dict[str, tuple[Callable[..., float], int, int]] = {
+    "ABS": (abs, 1, 1),
+    "SQRT": (math.sqrt, 1, 1),
+    "EXP": (math.exp, 1, 1),
+    "LOG": (math.log, 1, 1),
+    "LOG10": (math.log10, 1, 1),
+    "SIN": (math.sin, 1, 1),
+    "COS": (math.cos, 1, 1),
+    "TAN": (math.tan, 1, 1),
+    "ASIN": (math.asin, 1, 1),
+    "ACOS": (math.acos, 1, 1),
+    "ATAN": (math.atan, 1, 1),
+    "ATAN2": (math.atan2, 2, 2),
+    "MIN": (min, 1, 20),
+    "MAX": (max, 1, 20),
+    "SIGN": (_sign, 2, 2),
+    "NINT": (_nint, 1, 1),
+    "MOD": (math.fmod, 2, 2),
+}
+
+# Functions answered by the model (nodes, results); arity is checked at compile time.
+MODEL_FUNCTIONS: dict[str, tuple[int, int]] = {
+    "NX": (1, 1),
+    "NY": (1, 1),
+    "NZ": (1, 1),
+    "NODE": (2, 3),
+    "TEMP": (1, 1),
+    "UX": (1, 1),
+    "UY": (1, 1),
+}
+
+RESERVED = frozenset(BUILTINS) | frozenset(MODEL_FUNCTIONS)
+
+
+def _tokenize(text: str) -> list[tuple[str, str]]:
+    tokens: list[tuple[str, str]] = []
+    pos = 0
+    end = len(text.rstrip())
+    while pos < end:
+        m = _TOKEN.match(text, pos)
+        if m is None or m.end() == pos:
+            bad = text[pos:].strip()[:1]
+            raise ApdlError(f"unexpected character {bad!r} in expression {text.strip()!r}")
+        kind = m.lastgroup
+        assert kind is not None
+        tokens.append((kind, m.group(kind)))
+        pos = m.end()
+    return tokens
+
+
+def is_parameter_name(name: str) -> bool:
+    """A valid user parameter name: letter first, letters/digits/_, ≤ 32 chars, not a function."""
+    return (
+        bool(_NAME.match(name))
+        and len(name) <= MAX_NAME_CHARS
+        and name.upper() not in RESERVED
+    )
+
+
+class _Parser:
+    def __init__(self, text: str) -> None:
+        self.text = text.strip()
+        self.tokens = _tokenize(text)
+        self.i = 0
+        self.depth = 0
+
+    def fail(self, what: str) -> ApdlError:
+        return ApdlError(f"{what} in expression {self.text!r}")
+
+    def peek(self) -> tuple[str, str] | None:
+        return self.tokens[self.i] if self.i < len(self.tokens) else None
+
+    def take(self) -> tuple[str, str]:
+        tok = self.peek()
+        if tok is None:
+            raise self.fail("unexpected end")
+        self.i += 1
+        return tok
+
+    def expect(self, op: str) -> None:
+        tok = self.peek()
+        if tok != ("op", op):
+            raise self.fail(f"expected {op!r}")
+        self.i += 1
+
+    def enter(self) -> None:
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise self.fail(f"nesting deeper than {MAX_DEPTH}")
+
+    def parse(self) -> Evaluator:
+        if not self.tokens:
+            raise ApdlError("empty expression")
+        node = self.expr()
+        if self.peek() is not None:
+            raise self.fail(f"unexpected {self.peek()[1]!r}")  # type: ignore[index]
+        return node
+
+    def expr(self) -> Evaluator:
+        node = self.term()
+        while (tok := self.peek()) in (("op", "+"), ("op", "-")):
+            self.i += 1
+            node = _binary(tok[1], node, self.term())  # type: ignore[index]
+        return node
+
+    def term(self) -> Evaluator:
+        node = self.unary()
+        while (tok := self.peek()) in (("op", "*"), ("op", "/")):
+            self.i += 1
+            node = _binary(tok[1], node, self.unary())  # type: ignore[index]
+        return node
+
+    def unary(self) -> Evaluator:
+        tok = self.peek()
+        if tok in (("op", "-"), ("op", "+")):
+            self.i += 1
+            self.enter()
+            inner = self.unary()
+            self.depth -= 1
+            if tok[1] == "+":  # type: ignore[index]
+                return inner
+            return _negate(inner)
+        return self.power()
+
+    def power(self) -> Evaluator:
+        base = self.atom()
+        if self.peek() == ("op", "**"):
+            self.i += 1
+            self.enter()
+            exponent = self.unary()
+            self.depth -= 1
+            return _binary("**", base, exponent)
+        return base
+
+    def atom(self) -> Evaluator:
+        kind, value = self.take()
+        if kind == "num":
+            number = float(value.replace("d", "e").replace("D", "e"))
+            if not math.isfinite(number):
+                raise self.fail(f"number {value} out of range")
+            return _constant(number)
+        if kind == "name":
+            name = value.upper()
+            if self.peek() == ("op", "("):
+                self.i += 1
+                self.enter()
+                args = [self.expr()]
+                while self.peek() == ("op", ","):
+                    self.i += 1
+                    args.append(self.expr())
+                self.expect(")")
+                self.depth -= 1
+                return self.call(name, args)
+            if name in RESERVED:
+                raise self.fail(f"function {name} needs arguments")
+            if len(name) > MAX_NAME_CHARS:
+                raise self.fail(f"parameter name {value!r} longer than {MAX_NAME_CHARS}")
+            return _parameter(name)
+        if (kind, value) == ("op", "("):
+            self.enter()
+            node = self.expr()
+            self.expect(")")
+            self.depth -= 1
+            return node
+        raise self.fail(f"unexpected {value!r}")
+
+    def call(self, name: str, args: list[Evaluator]) -> Evaluator:
+        if name in BUILTINS:
+            func, lo, hi = BUILTINS[name]
+            if not lo <= len(args) <= hi:
+                raise self.fail(f"{name} takes {_arity(lo, hi)}, got {len(args)}")
+            return _builtin_call(name, func, args)
+        if name in MODEL_FUNCTIONS:
+            lo, hi = MODEL_FUNCTIONS[name]
+            if not lo <= len(args) <= hi:
+                raise self.fail(f"{name} takes {_arity(lo, hi)}, got {len(args)}")
+            return _model_call(name, args)
+        raise self.fail(f"unknown function {name}")
+
+
+def _arity(lo: int, hi: int) -> str:
+    return f"{lo} argument{'s' if lo > 1 else ''}" if lo == hi else f"{lo} to {hi} arguments"
+
+
+def _constant(value: float) -> Evaluator:
+    def const(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        return value
+
+    const.constant = value  # type: ignore[attr-defined]
+    return const
+
+
+def _parameter(name: str) -> Evaluator:
+    def param(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        try:
+            return params[name]
+        except KeyError:
+            raise ApdlError(f"undefined parameter {name}") from None
+
+    return param
+
+
+def _negate(inner: Evaluator) -> Evaluator:
+    c = getattr(inner, "constant", None)
+    if c is not None:
+        return _constant(-c)
+
+    def neg(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        return -inner(params, funcs)
+
+    return neg
+
+
+def _power(a: float, b: float) -> float:
+    try:
+        return math.pow(a, b)
+    except ValueError:
+        raise ApdlError(f"{a!r}**{b!r} is not a real number") from None
+    except OverflowError:
+        raise ApdlError(f"{a!r}**{b!r} overflows") from None
+
+
+def _divide(a: float, b: float) -> float:
+    if b == 0.0:
+        raise ApdlError("division by zero")
+    return a / b
+
+
+_OPS: dict[str, Callable[[float, float], float]] = {
+    "+": lambda a, b: a + b,
+    "-": lambda a, b: a - b,
+    "*": lambda a, b: a * b,
+    "/": _divide,
+    "**": _power,
+}
+
+
+def _binary(op: str, left: Evaluator, right: Evaluator) -> Evaluator:
+    f = _OPS[op]
+    a, b = getattr(left, "constant", None), getattr(right, "constant", None)
+    if a is not None and b is not None:
+        return _constant(_finite(f(a, b)))
+
+    def binop(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        return f(left(params, funcs), right(params, funcs))
+
+    return binop
+
+
+def _builtin_call(name: str, func: Callable[..., float], args: list[Evaluator]) -> Evaluator:
+    def call(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        values = [a(params, funcs) for a in args]
+        try:
+            return float(func(*values))
+        except (ValueError, ZeroDivisionError):
+            shown = ", ".join(repr(v) for v in values)
+            raise ApdlError(f"{name}({shown}) is undefined") from None
+        except OverflowError:
+            raise ApdlError(f"{name} overflows") from None
+
+    return call
+
+
+def _model_call(name: str, args: list[Evaluator]) -> Evaluator:
+    def call(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        values = [a(params, funcs) for a in args]
+        func = funcs.get(name)
+        if func is None:
+            raise ApdlError(f"{name}() needs a model, none is defined here")
+        return float(func(*values))
+
+    return call
+
+
+def _finite(value: float) -> float:
+    if not math.isfinite(value):
+        raise ApdlError("result is not a finite number")
+    return value
+
+
+@lru_cache(maxsize=8192)
+def compile_expression(text: str) -> Evaluator:
+    """Compile expression text to a function `f(params, model_functions) -> float`."""
+    if len(text) > MAX_EXPRESSION_CHARS:
+        raise ApdlError(f"expression longer than {MAX_EXPRESSION_CHARS} characters")
+    compiled = _Parser(text).parse()
+    if getattr(compiled, "constant", None) is not None:
+        return compiled
+
+    def checked(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        return _finite(compiled(params, funcs))
+
+    return checked
+
+
+def evaluate(
+    text: str,
+    params: Mapping[str, float] | None = None,
+    functions: Mapping[str, ModelFunction] | None = None,
+) -> float:
+    """Evaluate an APDL expression; names are looked up upper-case in `params`."""
+    return compile_expression(text)(params or {}, functions or {})

@@ -1,0 +1,262 @@
+"""Running a parsed deck: parameters, *DO/*IF control flow, /INPUT, command dispatch.
+
+Limits keep any deck finite: loop iterations per run, statements per run, /INPUT depth.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from apdl_like.commands import REGISTRY, Call
+from apdl_like.errors import ApdlError
+from apdl_like.expressions import compile_expression, is_parameter_name
+from apdl_like.parser import Program, Statement, read_deck
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+MAX_LOOP_ITERATIONS = 100_000
+MAX_STATEMENTS = 2_000_000
+MAX_INPUT_DEPTH = 8
+IF_OPERATORS = ("EQ", "NE", "LT", "GT", "LE", "GE", "ABLT", "ABGT")
+EQ_TOLERANCE = 1e-10  # APDL compares *IF values with this absolute tolerance
+
+
+class _Exit(Exception):
+    """*EXIT / *CYCLE of the loop starting at statement `do_index`."""
+
+    def __init__(self, do_index: int, cycle: bool) -> None:
+        self.do_index, self.cycle = do_index, cycle
+
+
+def _value(session: Session, st: Statement, i: int, what: str) -> float:
+    text = st.fields[i - 1] if i <= len(st.fields) else ""
+    if not text:
+        raise st.error(f"field {i} ({what}) is required")
+    try:
+        return compile_expression(text)(session.params, session.model_functions)
+    except ApdlError as exc:
+        raise st.error(f"field {i} ({what}): {exc.reason}") from None
+
+
+def _compare(a: float, op: str, b: float) -> bool:
+    if op == "EQ":
+        return abs(a - b) <= EQ_TOLERANCE
+    if op == "NE":
+        return abs(a - b) > EQ_TOLERANCE
+    if op == "LT":
+        return a < b
+    if op == "GT":
+        return a > b
+    if op == "LE":
+        return a <= b
+    if op == "GE":
+        return a >= b
+    if op == "ABLT":
+        return abs(a) < abs(b)
+    return abs(a) > abs(b)  # ABGT
+
+
+def _condition(session: Session, st: Statement) -> tuple[bool, str]:
+    """Evaluate `*IF/*ELSEIF,V1,OP1,V2[,AND|OR|XOR,V3,OP2,V4]` -> (truth, action)."""
+    f = [x.upper() for x in st.fields]
+
+    def one(base: int) -> bool:
+        op = f[base] if base < len(f) else ""
+        if op not in IF_OPERATORS:
+            raise st.error(f"field {base + 1}: comparison must be one of {', '.join(IF_OPERATORS)}")
+        a = _value(session, st, base, "VAL1")
+        b = _value(session, st, base + 2, "VAL2")
+        return _compare(a, op, b)
+
+    truth = one(1)
+    action_field = 3 if st.name == "*IF" else None
+    conj = f[3] if len(f) > 3 else ""
+    if conj in ("AND", "OR", "XOR"):
+        second = one(5)
+        truth = {"AND": truth and second, "OR": truth or second, "XOR": truth != second}[conj]
+        action_field = 7 if st.name == "*IF" else None
+    elif st.name == "*ELSEIF" and conj:
+        raise st.error(f"field 4 must be AND, OR or XOR, got {conj!r}")
+    action = f[action_field] if action_field is not None and action_field < len(f) else ""
+    return truth, action
+
+
+def _assign(session: Session, st: Statement) -> None:
+    name, expr = st.fields
+    if not is_parameter_name(name):
+        raise st.error(f"{name!r} is not a valid parameter name (≤ 32 characters, letter first, "
+                       "not a function name)")
+    if not expr:
+        session.params.pop(name, None)  # `NAME =` deletes the parameter, as in APDL
+        return
+    if expr.startswith("'"):
+        raise st.error("character parameters are not supported (numeric parameters only)")
+    try:
+        session.params[name] = compile_expression(expr)(session.params, session.model_functions)
+    except ApdlError as exc:
+        raise st.error(exc.reason) from None
+
+
+def execute(session: Session, program: Program, depth: int = 0) -> None:
+    """Run `program`; nested `/INPUT` files run recursively with their own file:line."""
+    stmts = program.statements
+    n = len(stmts)
+    loops: dict[int, list[float]] = {}  # *DO index -> [value, increment, remaining]
+    i = 0
+    while i < n:
+        st = stmts[i]
+        session.statements_run += 1
+        if session.statements_run > MAX_STATEMENTS:
+            raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
+        name = st.name
+        try:
+            if name == "=":
+                _assign(session, st)
+            elif name == "*DO":
+                i = _start_loop(session, program, st, i, loops)
+                continue
+            elif name == "*ENDDO":
+                i = _next_iteration(session, program, i, loops)
+                continue
+            elif name == "*IF":
+                truth, action = _condition(session, st)
+                if action == "THEN":
+                    i = _take_branch(session, program, i, truth)
+                    continue
+                if truth:
+                    if action in ("EXIT", "CYCLE"):
+                        if i not in program.enclosing_do:
+                            raise st.error(f"*IF action {action} outside a *DO loop")
+                        raise _Exit(program.enclosing_do[i], action == "CYCLE")
+                    if action == "STOP":
+                        raise st.error("deck stopped by *IF,...,STOP")
+                    raise st.error(f"*IF action must be THEN, EXIT, CYCLE or STOP, got {action!r}"
+                                   " (*GO labels are not supported)")
+                elif action not in ("EXIT", "CYCLE", "STOP"):
+                    raise st.error(f"*IF action must be THEN, EXIT, CYCLE or STOP, got {action!r}")
+            elif name in ("*ELSEIF", "*ELSE"):
+                # reached the end of a branch that ran: skip to after *ENDIF
+                i = program.block_end[_owner_if(program, i)] + 1
+                continue
+            elif name == "*ENDIF":
+                pass
+            elif name in ("*EXIT", "*CYCLE"):
+                raise _Exit(program.enclosing_do[i], name == "*CYCLE")
+            elif name == "/INPUT":
+                _input(session, st, depth)
+            else:
+                _dispatch(session, st)
+        except _Exit as jump:
+            end = program.block_end[jump.do_index]
+            if jump.cycle:
+                i = end
+            else:
+                for j in [j for j in loops if jump.do_index <= j <= end]:
+                    del loops[j]
+                i = end + 1
+            continue
+        i += 1
+
+
+def _owner_if(program: Program, i: int) -> int:
+    for if_index, branches in program.if_branches.items():
+        if i in branches:
+            return if_index
+    raise program.statements[i].error("branch without its *IF")  # pragma: no cover
+
+
+def _take_branch(session: Session, program: Program, i: int, truth: bool) -> int:
+    if truth:
+        return i + 1
+    for j in program.if_branches[i]:
+        st = program.statements[j]
+        if st.name == "*ELSE":
+            return j + 1
+        ok, _ = _condition(session, st)
+        if ok:
+            return j + 1
+    return program.block_end[i] + 1
+
+
+def _start_loop(session: Session, program: Program, st: Statement, i: int,
+                loops: dict[int, list[float]]) -> int:
+    par = st.fields[0].upper() if st.fields else ""
+    if not is_parameter_name(par):
+        raise st.error(f"field 1 must be a parameter name, got {par!r}")
+    start = _value(session, st, 2, "IVAL")
+    final = _value(session, st, 3, "FVAL")
+    inc = _value(session, st, 4, "INC") if len(st.fields) >= 4 and st.fields[3] else 1.0
+    if inc == 0.0:
+        raise st.error("field 4 (INC) must not be zero")
+    count = math.floor((final - start) / inc + 1e-9) + 1
+    if count > MAX_LOOP_ITERATIONS:
+        raise st.error(f"loop of {count} iterations exceeds the limit of {MAX_LOOP_ITERATIONS}")
+    session.params[par] = start
+    if count <= 0:
+        return program.block_end[i] + 1
+    loops[i] = [start, inc, count - 1]
+    _count_iteration(session, st)
+    return i + 1
+
+
+def _next_iteration(session: Session, program: Program, end: int,
+                    loops: dict[int, list[float]]) -> int:
+    do_index = next(j for j, e in program.block_end.items() if e == end)
+    state = loops.get(do_index)
+    if state is None or state[2] <= 0:
+        loops.pop(do_index, None)
+        return end + 1
+    state[0] += state[1]
+    state[2] -= 1
+    do_st = program.statements[do_index]
+    session.params[do_st.fields[0].upper()] = state[0]
+    _count_iteration(session, do_st)
+    return do_index + 1
+
+
+def _count_iteration(session: Session, st: Statement) -> None:
+    session.loop_iterations += 1
+    if session.loop_iterations > MAX_LOOP_ITERATIONS:
+        raise st.error(f"more than {MAX_LOOP_ITERATIONS} loop iterations (runaway *DO?)")
+
+
+def _input(session: Session, st: Statement, depth: int) -> None:
+    if depth + 1 > MAX_INPUT_DEPTH:
+        raise st.error(f"/INPUT nested deeper than {MAX_INPUT_DEPTH} files")
+    fname = st.fields[0] if st.fields else ""
+    ext = st.fields[1] if len(st.fields) > 1 else ""
+    if not fname:
+        raise st.error("field 1 (file name) is required")
+    if session.base_dir is None:
+        raise st.error("/INPUT needs a deck folder (run the deck from a file)")
+    name = f"{fname}.{ext}" if ext else fname
+    base = session.base_dir.resolve()
+    target = (base / name).resolve()
+    if not target.is_relative_to(base):
+        raise st.error(f"/INPUT file {name!r} lies outside the deck's folder {str(base)!r}")
+    if not target.is_file():
+        raise st.error(f"/INPUT file {name!r} not found in {str(base)!r}")
+    shown = str(Path(st.file).parent / name) if st.file and not st.file.startswith("<") else name
+    execute(session, read_deck(target, shown), depth + 1)
+
+
+def _dispatch(session: Session, st: Statement) -> None:
+    spec = REGISTRY.get(st.name)
+    if spec is None:
+        raise st.error(f"unknown or unsupported command {st.name}")
+    if session.processor not in spec.processors:
+        where = {"BEGIN": "the begin level", "PREP7": "/PREP7", "SOLU": "/SOLU",
+                 "POST1": "/POST1"}
+        allowed = " or ".join(where[p] for p in sorted(spec.processors))
+        raise st.error(f"not valid in {where[session.processor]} (use it in {allowed})")
+    if len(st.fields) > spec.max_fields:
+        raise st.error(f"takes at most {spec.max_fields} fields, got {len(st.fields)}")
+    try:
+        spec.handler(session, Call(st, session))
+    except ApdlError as exc:
+        raise exc.located(st.file, st.line, st.shown) from None
+    except ValueError as exc:  # validation inside twin.fem (names the item)
+        raise st.error(str(exc)) from None

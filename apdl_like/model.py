@@ -1,0 +1,306 @@
+"""The APDL database: nodes, elements, attributes, components, selections and loads.
+
+Entities carry their APDL numbers; tables are numpy arrays sorted by number, so selecting
+and loading thousands of entities in a window deck is a handful of vectorized operations.
+Nodes and elements added one by one (`N`, `E`) wait in a small pending dict and are merged
+when a command next reads the tables; every per-node and per-element array (selection,
+loads) is carried over to the new numbering at that moment.
+
+Face loads (SF, SFE) live on the exterior faces of the mesh, which `apdl_like.fem_bridge`
+derives from the elements; they are stored per face and keyed by the sorted pair of corner
+node numbers, so they survive a rebuild of the face table.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# Element types this subset knows: name -> (physics, corner nodes, quadratic?)
+ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
+    "PLANE55": ("thermal", 4, False),
+    "PLANE77": ("thermal", 4, True),
+    "PLANE182": ("structural", 4, False),
+    "PLANE183": ("structural", 4, True),
+}
+# ETCHG,TTS / STT pairs (thermal <-> structural)
+THERMAL_TO_STRUCTURAL = {"PLANE55": "PLANE182", "PLANE77": "PLANE183"}
+MAX_ELEMENT_NODES = 8
+
+
+@dataclass
+class ElementType:
+    name: str
+    keyopt: dict[int, int] = field(default_factory=dict)
+
+    @property
+    def physics(self) -> str:
+        return ELEMENT_TYPES[self.name][0]
+
+    @property
+    def quadratic(self) -> bool:
+        return ELEMENT_TYPES[self.name][2]
+
+    @property
+    def axisymmetric(self) -> bool:
+        return self.keyopt.get(3, 0) == 1
+
+    @property
+    def triangle6(self) -> bool:
+        """PLANE183 with KEYOPT(1)=1: the 6-node triangle `E,I,J,K,L,M,N`."""
+        return self.name == "PLANE183" and self.keyopt.get(1, 0) == 1
+
+
+def _remap(old_ids: np.ndarray, new_ids: np.ndarray, arrays: dict[str, np.ndarray],
+           fills: dict[str, object]) -> dict[str, np.ndarray]:
+    """Carry per-entity arrays from `old_ids` to `new_ids` (both sorted)."""
+    pos = np.searchsorted(old_ids, new_ids)
+    pos_c = np.clip(pos, 0, max(len(old_ids) - 1, 0))
+    found = (pos < len(old_ids)) & (old_ids[pos_c] == new_ids) if len(old_ids) else \
+        np.zeros(len(new_ids), bool)
+    out = {}
+    for name, arr in arrays.items():
+        new = np.full((len(new_ids), *arr.shape[1:]), fills[name], dtype=arr.dtype)
+        if len(old_ids):
+            new[found] = arr[pos_c[found]]
+        out[name] = new
+    return out
+
+
+class NodeTable:
+    """Nodes by number: coordinates (x = r, y = z), selection and per-node loads (NaN: none)."""
+
+    ARRAYS = {"selected": True, "d_temp": np.nan, "d_ux": np.nan, "d_uy": np.nan,
+              "bf_temp": np.nan, "ic_temp": np.nan}
+
+    def __init__(self) -> None:
+        self.ids = np.zeros(0, dtype=np.int64)
+        self.xy = np.zeros((0, 2))
+        self.arrays: dict[str, np.ndarray] = {
+            "selected": np.zeros(0, bool),
+            **{k: np.zeros(0) for k in self.ARRAYS if k != "selected"},
+        }
+        self.pending: dict[int, tuple[float, float]] = {}
+        self.version = 0
+
+    def set_arrays(self, ids: np.ndarray, xy: np.ndarray) -> None:
+        """Replace every node at once (a mesh loaded from outside); all selected, no loads."""
+        order = np.argsort(ids)
+        self.ids = np.asarray(ids, np.int64)[order]
+        self.xy = np.asarray(xy, float)[order]
+        self.arrays = {k: np.full(len(self.ids), v, dtype=bool if k == "selected" else float)
+                       for k, v in self.ARRAYS.items()}
+        self.pending.clear()
+        self.version += 1
+
+    def add(self, number: int, x: float, y: float) -> None:
+        self.pending[number] = (x, y)
+
+    def flush(self) -> None:
+        if not self.pending:
+            return
+        nums = np.fromiter(self.pending, dtype=np.int64, count=len(self.pending))
+        coords = np.array(list(self.pending.values()), dtype=float).reshape(-1, 2)
+        new_ids = np.union1d(self.ids, nums)
+        carried = _remap(self.ids, new_ids, {"xy": self.xy, **self.arrays},
+                         {"xy": np.nan, **self.ARRAYS})
+        pos = np.searchsorted(new_ids, nums)
+        carried["xy"][pos] = coords
+        carried["selected"][pos] = True  # new entities join the selected set, as in APDL
+        self.ids, self.xy = new_ids, carried.pop("xy")
+        self.arrays = carried
+        self.pending.clear()
+        self.version += 1
+
+    def __len__(self) -> int:
+        self.flush()
+        return len(self.ids)
+
+    @property
+    def selected(self) -> np.ndarray:
+        self.flush()
+        return self.arrays["selected"]
+
+    @selected.setter
+    def selected(self, mask: np.ndarray) -> None:
+        self.flush()
+        self.arrays["selected"] = mask
+
+    def index(self, numbers: np.ndarray | int) -> np.ndarray:
+        """Positions of node numbers; -1 for numbers that do not exist."""
+        self.flush()
+        nums = np.atleast_1d(np.asarray(numbers, dtype=np.int64))
+        pos = np.searchsorted(self.ids, nums)
+        pos_c = np.clip(pos, 0, max(len(self.ids) - 1, 0))
+        ok = (pos < len(self.ids)) & (self.ids[pos_c] == nums) if len(self.ids) else \
+            np.zeros(nums.shape, bool)
+        return np.where(ok, pos_c, -1)
+
+
+class ElementTable:
+    """Elements by number: type, material, real set, node numbers (0 = none), selection, HGEN."""
+
+    ARRAYS = {"selected": True, "hgen": np.nan, "hgen_record": -1}
+
+    def __init__(self) -> None:
+        self.ids = np.zeros(0, dtype=np.int64)
+        self.type = np.zeros(0, dtype=np.int64)
+        self.mat = np.zeros(0, dtype=np.int64)
+        self.real = np.zeros(0, dtype=np.int64)
+        self.nodes = np.zeros((0, MAX_ELEMENT_NODES), dtype=np.int64)
+        self.arrays: dict[str, np.ndarray] = {
+            "selected": np.zeros(0, bool), "hgen": np.zeros(0),
+            "hgen_record": np.zeros(0, np.int64),
+        }
+        self.pending: dict[int, tuple[int, int, int, tuple[int, ...]]] = {}
+        self.version = 0
+
+    def set_arrays(self, ids: np.ndarray, etype: np.ndarray, mat: np.ndarray,
+                   real: np.ndarray, nodes: np.ndarray) -> None:
+        order = np.argsort(ids)
+        self.ids = np.asarray(ids, np.int64)[order]
+        self.type = np.asarray(etype, np.int64)[order]
+        self.mat = np.asarray(mat, np.int64)[order]
+        self.real = np.asarray(real, np.int64)[order]
+        padded = np.zeros((len(ids), MAX_ELEMENT_NODES), np.int64)
+        padded[:, : nodes.shape[1]] = nodes
+        self.nodes = padded[order]
+        dtypes = {"selected": bool, "hgen": float, "hgen_record": np.int64}
+        self.arrays = {k: np.full(len(self.ids), v, dtype=dtypes[k])
+                       for k, v in self.ARRAYS.items()}
+        self.pending.clear()
+        self.version += 1
+
+    def add(self, number: int, etype: int, mat: int, real: int, nodes: tuple[int, ...]) -> None:
+        self.pending[number] = (etype, mat, real, nodes)
+
+    def flush(self) -> None:
+        if not self.pending:
+            return
+        nums = np.fromiter(self.pending, dtype=np.int64, count=len(self.pending))
+        new_ids = np.union1d(self.ids, nums)
+        carried = _remap(
+            self.ids, new_ids,
+            {"type": self.type, "mat": self.mat, "real": self.real, "nodes": self.nodes,
+             **self.arrays},
+            {"type": 0, "mat": 0, "real": 0, "nodes": 0, **self.ARRAYS},
+        )
+        pos = np.searchsorted(new_ids, nums)
+        for p, (etype, mat, real, nodes) in zip(pos, self.pending.values(), strict=True):
+            carried["type"][p], carried["mat"][p], carried["real"][p] = etype, mat, real
+            carried["nodes"][p] = 0
+            carried["nodes"][p, : len(nodes)] = nodes
+        carried["selected"][pos] = True
+        self.ids, self.type, self.mat, self.real, self.nodes = (
+            new_ids, carried.pop("type"), carried.pop("mat"), carried.pop("real"),
+            carried.pop("nodes"))
+        self.arrays = carried
+        self.pending.clear()
+        self.version += 1
+
+    def __len__(self) -> int:
+        self.flush()
+        return len(self.ids)
+
+    @property
+    def selected(self) -> np.ndarray:
+        self.flush()
+        return self.arrays["selected"]
+
+    @selected.setter
+    def selected(self, mask: np.ndarray) -> None:
+        self.flush()
+        self.arrays["selected"] = mask
+
+    def index(self, numbers: np.ndarray | int) -> np.ndarray:
+        self.flush()
+        nums = np.atleast_1d(np.asarray(numbers, dtype=np.int64))
+        pos = np.searchsorted(self.ids, nums)
+        pos_c = np.clip(pos, 0, max(len(self.ids) - 1, 0))
+        ok = (pos < len(self.ids)) & (self.ids[pos_c] == nums) if len(self.ids) else \
+            np.zeros(nums.shape, bool)
+        return np.where(ok, pos_c, -1)
+
+
+@dataclass
+class Component:
+    entity: str  # "NODE" or "ELEM"
+    numbers: np.ndarray  # sorted APDL numbers
+
+
+@dataclass
+class FaceLoads:
+    """Loads on exterior faces, keyed by (low, high) corner node numbers packed in one int."""
+
+    keys: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    conv_h: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    conv_bulk: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    conv_record: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    hflux: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    hflux_record: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+
+    FILLS = {"conv_h": np.nan, "conv_bulk": np.nan, "conv_record": -1, "hflux": np.nan,
+             "hflux_record": -1}
+
+    def rekey(self, new_keys: np.ndarray) -> None:
+        """Carry the loads over to a new face table (faces that vanished lose their loads)."""
+        order = np.argsort(new_keys)
+        if np.array_equal(new_keys, self.keys):
+            return
+        names = list(self.FILLS)
+        sorted_old = np.argsort(self.keys)
+        carried = _remap(self.keys[sorted_old], new_keys[order],
+                         {n: getattr(self, n)[sorted_old] for n in names}, self.FILLS)
+        inverse = np.empty_like(order)
+        inverse[order] = np.arange(order.size)
+        for n in names:
+            setattr(self, n, carried[n][inverse])
+        self.keys = np.asarray(new_keys, np.int64)
+
+
+@dataclass
+class Material:
+    """MP properties of one material number (APDL labels)."""
+
+    props: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class SolutionSettings:
+    antype: str = "STATIC"
+    restart: bool = False
+    time: float | None = None
+    deltim: float | None = None
+    nsubst: int | None = None
+    kbc: int = 0
+    timint: bool | None = None  # None: the default of the analysis type
+    outres: str = "ALL"
+    tref: float = 0.0
+    tunif: float = 0.0
+
+
+@dataclass
+class Database:
+    nodes: NodeTable = field(default_factory=NodeTable)
+    elements: ElementTable = field(default_factory=ElementTable)
+    element_types: dict[int, ElementType] = field(default_factory=dict)
+    materials: dict[int, Material] = field(default_factory=dict)
+    real_sets: dict[int, dict[int, float]] = field(default_factory=dict)
+    components: dict[str, Component] = field(default_factory=dict)
+    faces: FaceLoads = field(default_factory=FaceLoads)
+    settings: SolutionSettings = field(default_factory=SolutionSettings)
+    # active attributes for new elements (TYPE, MAT, REAL)
+    active_type: int = 1
+    active_mat: int = 1
+    active_real: int = 1
+    # AMESH geometry: keypoints and areas (lists of keypoint numbers)
+    keypoints: dict[int, tuple[float, float]] = field(default_factory=dict)
+    areas: dict[int, list[int]] = field(default_factory=dict)
+    meshed_areas: set[int] = field(default_factory=set)
+    esize: float | None = None
+    load_records: int = 0  # a counter: every load command gets its own record id
+
+    def next_record(self) -> int:
+        self.load_records += 1
+        return self.load_records

@@ -1,0 +1,181 @@
+"""Lexing an APDL deck into statements (APDL conventions, case-insensitive).
+
+One line is one statement: a command with comma-separated fields (`D,ALL,TEMP,20`; empty
+fields allowed, `NSEL,S,LOC,X,,0.1`), or a parameter assignment `NAME = expr`.  `!` starts a
+comment; `/COM` and `/TITLE` keep the rest of the line as text.  Fields stay text here; the
+command that uses a field decides whether it is a label or an expression.
+
+`parse_deck` also matches the blocks (`*DO/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) so that a
+deck with an unclosed block fails before anything runs.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from apdl_like.errors import ApdlError
+
+MAX_DECK_BYTES = 20_000_000  # far above any real deck; stops accidental binary/huge input
+MAX_LINE_CHARS = 640  # the APDL command-line limit
+MAX_FIELDS = 40
+
+_ASSIGNMENT = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*)\s*=(?!=)(.*)\Z", re.S)
+_COMMAND_NAME = re.compile(r"[/*]?[A-Za-z][A-Za-z0-9_\-]*\Z")
+_TEXT_COMMANDS = ("/COM", "/TITLE", "/STITLE", "/EOF")
+
+
+@dataclass(frozen=True, slots=True)
+class Statement:
+    """A command or an assignment, where it came from and its text fields."""
+
+    file: str
+    line: int
+    name: str  # upper-case command name, or "=" for an assignment
+    fields: tuple[str, ...]  # text after the name, split at commas (assignment: (name, expr))
+    text: str = ""  # the raw line (for /COM, /TITLE and messages)
+
+    def error(self, message: str) -> ApdlError:
+        return ApdlError(message, file=self.file, line=self.line, command=self.shown)
+
+    @property
+    def shown(self) -> str:
+        return f"{self.fields[0]}=" if self.name == "=" else self.name
+
+
+@dataclass(slots=True)
+class Program:
+    """The statements of one file and its matched blocks (indices into `statements`)."""
+
+    file: str
+    statements: list[Statement]
+    block_end: dict[int, int] = field(default_factory=dict)  # *DO / *IF index -> *ENDDO/*ENDIF
+    if_branches: dict[int, list[int]] = field(default_factory=dict)  # *IF -> [*ELSEIF.., *ELSE]
+    enclosing_do: dict[int, int] = field(default_factory=dict)  # *EXIT/*CYCLE -> its *DO
+
+
+def _strip_comment(line: str) -> str:
+    # A `!` inside single quotes (a character value) is text, not a comment.
+    if "!" not in line:
+        return line
+    quoted = False
+    for i, ch in enumerate(line):
+        if ch == "'":
+            quoted = not quoted
+        elif ch == "!" and not quoted:
+            return line[:i]
+    return line
+
+
+def lex_line(raw: str, file: str, number: int) -> Statement | None:
+    """One deck line -> a statement, or None for blank and comment lines."""
+    if len(raw) > MAX_LINE_CHARS:
+        raise ApdlError(
+            f"line longer than {MAX_LINE_CHARS} characters", file=file, line=number
+        )
+    head = raw.lstrip()
+    upper = head[:7].upper()
+    for text_cmd in _TEXT_COMMANDS:
+        n = len(text_cmd)
+        if upper.startswith(text_cmd) and (len(head) == n or head[n] in ", \t"):
+            rest = head[len(text_cmd) :].lstrip(" \t")
+            rest = rest[1:] if rest.startswith(",") else rest
+            return Statement(file, number, text_cmd, (rest.strip(),), raw)
+    body = _strip_comment(raw).strip()
+    if not body:
+        return None
+    if "\x00" in body:
+        raise ApdlError("binary data in deck", file=file, line=number)
+    m = _ASSIGNMENT.match(body)
+    if m is not None and "," not in body[: m.start(2)]:
+        return Statement(file, number, "=", (m.group(1).upper(), m.group(2).strip()), raw)
+    parts = body.split(",")
+    name = parts[0].strip().upper()
+    if not _COMMAND_NAME.match(name):
+        shown = parts[0].strip() or "(empty)"
+        raise ApdlError(f"not a command or assignment: {shown!r}", file=file, line=number)
+    if len(parts) - 1 > MAX_FIELDS:
+        raise ApdlError(f"more than {MAX_FIELDS} fields", file=file, line=number, command=name)
+    return Statement(file, number, name, tuple(p.strip() for p in parts[1:]), raw)
+
+
+def _match_blocks(program: Program) -> None:
+    stack: list[tuple[str, int]] = []  # ("DO"|"IF", index)
+    for i, st in enumerate(program.statements):
+        name = st.name
+        if name == "*DO":
+            stack.append(("DO", i))
+        elif name == "*IF" and _if_is_block(st):
+            stack.append(("IF", i))
+            program.if_branches[i] = []
+        elif name in ("*ELSEIF", "*ELSE"):
+            if not stack or stack[-1][0] != "IF":
+                raise st.error(f"{name} without an open *IF")
+            branches = program.if_branches[stack[-1][1]]
+            if branches and program.statements[branches[-1]].name == "*ELSE":
+                raise st.error(f"{name} after *ELSE")
+            branches.append(i)
+        elif name in ("*ENDDO", "*ENDIF"):
+            kind = name[4:]
+            if not stack or stack[-1][0] != kind:
+                open_block = (f"*{stack[-1][0]} of line {program.statements[stack[-1][1]].line}"
+                              if stack else "no block")
+                raise st.error(f"{name} does not close an open *{kind} ({open_block} is open)")
+            program.block_end[stack.pop()[1]] = i
+        elif name in ("*EXIT", "*CYCLE") or (name == "*IF" and not _if_is_block(st)):
+            dos = [j for kind, j in stack if kind == "DO"]
+            if name != "*IF" and not dos:
+                raise st.error(f"{name} outside a *DO loop")
+            if dos:
+                program.enclosing_do[i] = dos[-1]
+    if stack:
+        kind, j = stack[-1]
+        raise program.statements[j].error(f"*{kind} block is never closed (no *END{kind})")
+
+
+def _if_is_block(st: Statement) -> bool:
+    """`*IF,V1,OP,V2,THEN` or `*IF,V1,OP,V2,AND|OR|XOR,V3,OP,V4,THEN`."""
+    f = [x.upper() for x in st.fields]
+    action = f[7] if len(f) > 3 and f[3] in ("AND", "OR", "XOR") and len(f) > 7 else \
+        (f[3] if len(f) > 3 else "")
+    return action == "THEN"
+
+
+def parse_deck(text: str, file: str = "<deck>") -> Program:
+    """Lex a whole deck and match its blocks; raises ApdlError with file:line."""
+    if len(text) > MAX_DECK_BYTES:
+        raise ApdlError(f"deck larger than {MAX_DECK_BYTES // 1_000_000} MB", file=file)
+    statements = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        st = lex_line(raw, file, number)
+        if st is not None:
+            if st.name == "/EOF":
+                break
+            statements.append(st)
+    program = Program(file, statements)
+    _match_blocks(program)
+    return program
+
+
+def read_deck(path: Path, shown: str | None = None) -> Program:
+    """Read and parse a deck file, with the size limit checked before reading."""
+    name = shown or str(path)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise ApdlError(f"cannot read deck: {exc.strerror}", file=name) from None
+    if size > MAX_DECK_BYTES:
+        raise ApdlError(
+            f"deck is {size / 1e6:.1f} MB, over the {MAX_DECK_BYTES // 1_000_000} MB limit",
+            file=name,
+        )
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ApdlError(f"cannot read deck: {exc.strerror}", file=name) from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")  # decks from old tools; every byte decodes
+    return parse_deck(text, name)

@@ -1,0 +1,315 @@
+"""SOLVE: thermal (steady or transient) and structural load steps on twin.fem.
+
+The problems are cached in the session: a `ThermalProblem` per mesh topology and material
+table, an `ElasticProblem` per mesh, materials, constraints and TREF.  A window deck that
+only changes loads and time therefore costs one factorization (the stepper) plus the
+back-substitutions.
+
+Load ramping (KBC,0, APDL's default) interpolates HGEN, CONV (h, T_bulk), HFLUX and D,TEMP
+linearly over the substeps of a load step from their values at the end of the previous load
+step (first load step: zero, and TUNIF for temperatures); each substep then needs its own
+factorization.  KBC,1 (stepped) applies the new loads at once.  Contact conductance is
+always stepped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.errors import ApdlError
+from apdl_like.fem_bridge import FemModel, build_model
+from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+TCC_LOCATION = 14  # real-constant position of TCC (thermal contact conductance) on CONTA17x
+_PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants positive values
+
+
+@dataclass
+class StepResult:
+    """One solved load step (its last substep)."""
+
+    load_step: int
+    time: float
+    analysis: str  # "thermal" | "structural"
+    temperature: np.ndarray  # thermal dofs, °C (structural: the body temperature used)
+    displacement: np.ndarray | None = None  # (2, n glued scalar dofs), m
+    stress: dict[str, np.ndarray] = field(default_factory=dict)  # glued scalar dofs, Pa
+
+
+def fem_model(session: Session) -> FemModel:
+    """The FEM view of the current mesh, rebuilt only when nodes or elements changed."""
+    db = session.db
+    db.nodes.flush()
+    db.elements.flush()
+    key = (db.nodes.version, db.elements.version)
+    if session.fem is not None and session.fem_key == key:
+        return session.fem
+    if session.fem is not None and session.external_mesh:
+        raise ApdlError("the mesh of this session came from an AxiMesh with contact interfaces "
+                        "and cannot be changed by N/E commands")
+    session.fem = build_model(db)
+    session.fem_key = key
+    db.faces.rekey(session.fem.face_keys)
+    return session.fem
+
+
+def _require(props: dict[str, float], label: str, mat: int, why: str) -> float:
+    if label not in props:
+        raise ApdlError(f"material {mat} has no {label} (MP,{label},{mat},...), needed {why}")
+    return props[label]
+
+
+def _materials(session: Session, fem: FemModel, kind: str) -> dict[str, Material]:
+    db = session.db
+    mats = {}
+    used = np.unique(db.elements.mat[fem.cell_element])
+    transient = session.db.settings.antype == "TRANS"
+    for m in used:
+        m = int(m)
+        props = db.materials.get(m)
+        if props is None:
+            raise ApdlError(f"material {m} is used by elements but has no MP properties")
+        p = props.props
+        try:
+            if kind == "thermal":
+                k = _require(p, "KXX", m, "for heat conduction")
+                rho = _require(p, "DENS", m, "for a transient") if transient else \
+                    p.get("DENS", _PLACEHOLDER)
+                c = _require(p, "C", m, "for a transient") if transient else \
+                    p.get("C", _PLACEHOLDER)
+                mats[f"MAT{m}"] = Material(k=k, rho=rho, c=c, name=f"MAT{m}")
+            else:
+                E = _require(p, "EX", m, "for a structural analysis")
+                nu = p.get("PRXY", p.get("NUXY", 0.3))
+                mats[f"MAT{m}"] = Material(k=p.get("KXX", _PLACEHOLDER), rho=_PLACEHOLDER,
+                                           c=_PLACEHOLDER, E=E, nu=nu, alpha=p.get("ALPX", 0.0),
+                                           name=f"MAT{m}")
+        except ValueError as exc:
+            raise ApdlError(str(exc)) from None
+        if f"MAT{m}" not in fem.mesh.regions:
+            fem.mesh.add_region(f"MAT{m}", np.nonzero(db.elements.mat[fem.cell_element] == m)[0])
+    return mats
+
+
+def _material_key(mats: dict[str, Material]) -> tuple:
+    return tuple(sorted((n, m.k, m.rho, m.c, m.E, m.nu, m.alpha) for n, m in mats.items()))
+
+
+def thermal_problem(session: Session, fem: FemModel) -> ThermalProblem:
+    mats = _materials(session, fem, "thermal")
+    key = (id(fem), _material_key(mats), fem.order)
+    if session.thermal_key != key:
+        session.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
+        session.thermal_key = key
+    return session.thermal  # type: ignore[return-value]
+
+
+def _check_axisymmetric(session: Session, physics: str) -> None:
+    db = session.db
+    types = {int(t) for t in np.unique(db.elements.type)}
+    for t in types:
+        et = db.element_types[t]
+        if et.physics != physics:
+            raise ApdlError(f"element type {t} ({et.name}) is not a {physics} element; a load "
+                            f"step solves one physics (use ETCHG to switch)")
+        if not et.axisymmetric:
+            raise ApdlError(f"element type {t} ({et.name}) is a plane element: only axisymmetric "
+                            f"analyses are supported (KEYOPT,{t},3,1)")
+
+
+def _groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[np.ndarray]:
+    """Index sets sharing a record id (and `extra` value), for entities with a record."""
+    has = np.nonzero(record >= 0)[0]
+    if has.size == 0:
+        return []
+    keys = record[has].astype(float) if extra is None else \
+        np.column_stack([record[has].astype(float), np.nan_to_num(extra[has], nan=-1e300)])
+    _, inverse = np.unique(keys, axis=0 if extra is not None else None, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    splits = np.nonzero(np.diff(inverse[order]))[0] + 1
+    return [has[s] for s in np.split(order, splits)]
+
+
+def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> ThermalLoads:
+    """The database's thermal loads as twin.fem ThermalLoads (ramped to `fraction`)."""
+    db = session.db
+    prev = session.previous_loads if fraction < 1.0 else None
+    tunif = db.settings.tunif
+    el = db.elements.arrays
+    cell_hgen = el["hgen"][fem.cell_element]
+    cell_rec = el["hgen_record"][fem.cell_element]
+    cell_prev = prev["hgen"][fem.cell_element] if prev is not None else None
+    sources = {}
+    for cells in _groups(cell_rec, cell_prev):
+        q = float(cell_hgen[cells[0]])
+        if prev is not None:
+            q0 = float(np.nan_to_num(cell_prev[cells[0]]))
+            q = q0 + fraction * (q - q0)
+        if q != 0.0:
+            sources[fem.region_for(cells)] = q
+    faces = db.faces
+    convection, flux = {}, {}
+    fprev = prev["faces"] if prev is not None else None
+    for idx in _groups(faces.conv_record, None if fprev is None else fprev["conv_h"]):
+        h, tb = float(faces.conv_h[idx[0]]), float(faces.conv_bulk[idx[0]])
+        if np.isnan(h) or np.isnan(tb):
+            raise ApdlError("a face has CONV with only one of film coefficient and bulk "
+                            "temperature (SFE KVAL 1 and 2)")
+        if fprev is not None:
+            h0 = float(np.nan_to_num(fprev["conv_h"][idx[0]]))
+            tb0 = fprev["conv_bulk"][idx[0]]
+            tb0 = tunif if np.isnan(tb0) else float(tb0)
+            h, tb = h0 + fraction * (h - h0), tb0 + fraction * (tb - tb0)
+        if h != 0.0:
+            convection[fem.boundary_for(fem.face_facets[idx])] = (h, tb)
+    for idx in _groups(faces.hflux_record, None if fprev is None else fprev["hflux"]):
+        q = float(faces.hflux[idx[0]])
+        if fprev is not None:
+            q0 = float(np.nan_to_num(fprev["hflux"][idx[0]]))
+            q = q0 + fraction * (q - q0)
+        if q != 0.0:
+            flux[fem.boundary_for(fem.face_facets[idx])] = q
+    d = db.nodes.arrays["d_temp"]
+    fixed = np.nonzero(~np.isnan(d) & (fem.thermal_dof >= 0))[0]
+    values = d[fixed]
+    if prev is not None:
+        d0 = prev["d_temp"][fixed]
+        d0 = np.where(np.isnan(d0), tunif, d0)
+        values = d0 + fraction * (values - d0)
+    contact = {}
+    for name in fem.mesh.interfaces:
+        real = session.contact_real_sets.get(name)
+        tcc = db.real_sets.get(real, {}).get(TCC_LOCATION) if real is not None else None
+        if tcc is not None:
+            if not tcc > 0.0:
+                raise ApdlError(f"TCC of real set {real} (contact {name}) must be > 0, got {tcc!r}")
+            contact[name] = 1.0 / tcc
+    return ThermalLoads(sources=sources, convection=convection, flux=flux,
+                        contact_resistance=contact,
+                        fixed_dofs=(fem.thermal_dof[fixed], values) if fixed.size else None)
+
+
+def _snapshot(session: Session) -> dict:
+    db = session.db
+    f = db.faces
+    return {"hgen": db.elements.arrays["hgen"].copy(),
+            "d_temp": db.nodes.arrays["d_temp"].copy(),
+            "faces": {"conv_h": f.conv_h.copy(), "conv_bulk": f.conv_bulk.copy(),
+                      "hflux": f.hflux.copy()},
+            "key": session.fem_key}
+
+
+def initial_temperature(session: Session, fem: FemModel, n_dofs: int) -> np.ndarray:
+    base = np.full(n_dofs, session.db.settings.tunif)
+    return fem.nodal_to_thermal(session.db.nodes.arrays["ic_temp"], base)
+
+
+def solve_thermal(session: Session) -> StepResult:
+    fem = fem_model(session)
+    _check_axisymmetric(session, "thermal")
+    problem = thermal_problem(session, fem)
+    s = session.db.settings
+    if session.previous_loads is not None and session.previous_loads["key"] != session.fem_key:
+        session.previous_loads = None
+    if session.fresh_start or session.state is None or session.state.size != problem.n_dofs:
+        session.state = initial_temperature(session, fem, problem.n_dofs)
+        session.time = 0.0
+        session.fresh_start = False
+    ramped = s.kbc == 0 and s.antype == "TRANS"
+    steps_T, steps_t = [], []
+    if s.antype == "STATIC" or s.timint is False:
+        end = s.time if s.time is not None else session.time + 1.0
+        loads = thermal_loads(session, fem)
+        try:
+            T = problem.steady(loads)
+        except ValueError as exc:
+            raise ApdlError(str(exc)) from None
+        steps_T, steps_t = [T], [end]
+    else:
+        if s.time is None:
+            raise ApdlError("a transient load step needs its end time (TIME)")
+        span = s.time - session.time
+        if not span > 0.0:
+            raise ApdlError(f"TIME {s.time!r} is not after the current time {session.time!r}")
+        if s.deltim is not None:
+            n = max(1, int(np.ceil(span / s.deltim - 1e-9)))
+        else:
+            n = s.nsubst or 1
+        dt = span / n
+        T = session.state
+        stepper = None
+        for k in range(1, n + 1):
+            if stepper is None or ramped:
+                loads = thermal_loads(session, fem, k / n if ramped else 1.0)
+                stepper = problem.transient(loads, dt)
+            T = stepper.step(T)
+            steps_T.append(T)
+            steps_t.append(session.time + k * dt if k < n else s.time)
+    session.state = steps_T[-1]
+    session.time = steps_t[-1]
+    session.substep_times = steps_t
+    session.substep_temperatures = steps_T
+    session.previous_loads = _snapshot(session)
+    return StepResult(len(session.results) + 1, session.time, "thermal", session.state)
+
+
+def _constraints(session: Session, fem: FemModel) -> dict[str, str]:
+    nodes = session.db.nodes.arrays
+    for label in ("d_ux", "d_uy"):
+        v = nodes[label]
+        if np.any(v[~np.isnan(v)] != 0.0):
+            raise ApdlError(f"only zero displacements are supported ({label[2:].upper()} ≠ 0)")
+    ux, uy = ~np.isnan(nodes["d_ux"]), ~np.isnan(nodes["d_uy"])
+    fn = fem.face_nodes
+    face_ux = ux[fn[0]] & ux[fn[1]]
+    face_uy = uy[fn[0]] & uy[fn[1]]
+    out = {}
+    for mask, comps in ((face_ux & face_uy, "rz"), (face_ux & ~face_uy, "r"),
+                        (face_uy & ~face_ux, "z")):
+        if mask.any():
+            out[fem.boundary_for(fem.face_facets[mask])] = comps
+    for label, nodal, face in (("UX", ux, face_ux), ("UY", uy, face_uy)):
+        covered = np.zeros(nodal.size, bool)
+        covered[fn[0, face]] = covered[fn[1, face]] = True
+        lone = nodal & ~covered & (fem.glued_dof >= 0)
+        if lone.any():
+            n = int(session.db.nodes.ids[np.nonzero(lone)[0][0]])
+            raise ApdlError(f"D,{label} on node {n} is not on a constrained boundary edge: "
+                            "constraints act on element faces whose nodes are all constrained")
+    if not any("z" in c for c in out.values()):
+        raise ApdlError("the structure needs an axial constraint (D,...,UY,0 on an edge)")
+    return out
+
+
+def solve_structural(session: Session) -> StepResult:
+    fem = fem_model(session)
+    _check_axisymmetric(session, "structural")
+    s = session.db.settings
+    if s.antype != "STATIC":
+        raise ApdlError("structural analyses are static only (ANTYPE,STATIC)")
+    mats = _materials(session, fem, "structural")
+    constraints = _constraints(session, fem)
+    key = (id(fem), _material_key(mats), tuple(sorted(constraints.items())), s.tref, fem.order)
+    if session.elastic_key != key:
+        try:
+            session.elastic = ElasticProblem(fem.mesh, mats, constraints, T_ref=s.tref,
+                                             order=fem.order)
+        except RuntimeError as exc:  # singular stiffness (a mechanism)
+            raise ApdlError(f"the structure is not held (singular stiffness: {exc})") from None
+        session.elastic_key = key
+    elastic = session.elastic
+    n_t = elastic.temperature_basis.N
+    base = session.body_temperature if session.body_temperature is not None and \
+        session.body_temperature.size == n_t else np.full(n_t, s.tunif)
+    T = fem.nodal_to_thermal(session.db.nodes.arrays["bf_temp"], base)
+    u = elastic.solve(T)
+    stress = elastic.stresses(u, T)
+    session.time = s.time if s.time is not None else session.time + 1.0
+    return StepResult(len(session.results) + 1, session.time, "structural", T, u, stress)

@@ -1,0 +1,136 @@
+"""Writing the twin's per-window deck from a `LoadSet`.
+
+The deck only changes loads and time; it runs in a session that already holds the spindle
+model (`Session.from_mesh`), so mesh, materials and assembled operators stay loaded.  Every
+number is written with `repr`, which reads back to the identical binary64 value.
+
+    /PREP7                        contact pairs: TCC (real constant 14) = 1/R
+    RMODIF,101,14,<1/R>
+    FINISH
+    /SOLU
+    WINDOW = k, T_START = t0      the window, kept in params.json
+    ANTYPE,TRANS[,REST]           REST continues from the carried-over temperature state
+    TIMINT,ON / KBC,1 / DELTIM,dt / TIME,t0+n·dt / OUTRES,ALL,ALL
+    CMSEL,S,<REGION>   BFE,ALL,HGEN,,q          per heated region (element component)
+    CMSEL,S,<BOUNDARY> SF,ALL,CONV,h,T_bulk     per convective boundary (node component)
+    ALLSEL
+    SOLVE
+    FINISH
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from apdl_like.loadset import LoadSet
+
+
+def component_name(name: str) -> str:
+    """The APDL component name of a mesh set: upper-case, letters/digits/_, ≤ 32 chars."""
+    out = "".join(ch if ch.isascii() and (ch.isalnum() or ch == "_") else "_" for ch in name)
+    out = out.upper()
+    if not out or not out[0].isalpha():
+        out = "C" + out
+    return out[:32]
+
+
+CONTACT_REAL_BASE = 101
+
+
+@dataclass(frozen=True)
+class DeckLayout:
+    """Names the deck uses for the model's sets (fixed by the mesh's own names).
+
+    regions     region -> element component
+    boundaries  boundary -> node component (suffix _N if a region already has the name)
+    interfaces  interface -> real-constant set of its contact pair (101, 102, ... by name)
+    """
+
+    regions: dict[str, str]
+    boundaries: dict[str, str]
+    interfaces: dict[str, int]
+
+    @classmethod
+    def from_names(cls, regions: Iterable[str], boundaries: Iterable[str],
+                   interfaces: Iterable[str]) -> DeckLayout:
+        reg = {name: component_name(name) for name in sorted(regions)}
+        taken = set(reg.values())
+        bnd = {}
+        for name in sorted(boundaries):
+            c = component_name(name)
+            if c in taken:
+                c = component_name(name[:30] + "_N")
+            taken.add(c)
+            bnd[name] = c
+        ifc = {name: CONTACT_REAL_BASE + i for i, name in enumerate(sorted(interfaces))}
+        return cls(reg, bnd, ifc)
+
+    @classmethod
+    def for_mesh(cls, mesh) -> DeckLayout:  # noqa: ANN001 - twin.fem.AxiMesh
+        return cls.from_names(mesh.regions, mesh.boundaries, mesh.interfaces)
+
+
+def _num(x: float) -> str:
+    return repr(float(x))
+
+
+def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
+    """The APDL text of one window."""
+    for name in loads.heat_generation:
+        if name not in layout.regions:
+            raise ValueError(f"heat generation on unknown region {name!r}")
+    for name in loads.convection:
+        if name not in layout.boundaries:
+            raise ValueError(f"convection on unknown boundary {name!r}")
+    for name in loads.contact_resistance:
+        if name not in layout.interfaces:
+            raise ValueError(f"contact resistance on unknown interface {name!r}")
+    end = loads.start_s + loads.n_steps * loads.dt_s
+    out = [
+        f"! spindle twin, window {loads.window}: t = {loads.start_s:g} .. {end:g} s, "
+        f"{loads.n_steps} steps of {loads.dt_s:g} s",
+        "! loads only: runs in a session that holds the spindle model (apdl_like.Session)",
+    ]
+    if loads.contact_resistance:
+        out.append("/PREP7")
+        for name, r in sorted(loads.contact_resistance.items()):
+            out.append(f"RMODIF,{layout.interfaces[name]},14,{_num(1.0 / r)}"
+                       f"   ! {name}: TCC = 1/R, R = {r:.6g} m2K/W")
+        out.append("FINISH")
+    out += [
+        "/SOLU",
+        f"WINDOW = {loads.window}",
+        f"T_START = {_num(loads.start_s)}",
+        "ANTYPE,TRANS,REST" if loads.start_s > 0.0 else "ANTYPE,TRANS",
+        "TIMINT,ON",
+        "KBC,1                 ! loads held over the window (stepped)",
+        f"DELTIM,{_num(loads.dt_s)}",
+        f"TIME,{_num(end)}",
+        "OUTRES,ALL,ALL",
+    ]
+    for name, q in sorted(loads.heat_generation.items()):
+        out += [f"CMSEL,S,{layout.regions[name]}", f"BFE,ALL,HGEN,,{_num(q)}   ! W/m3"]
+    for name, (h, tb) in sorted(loads.convection.items()):
+        out += [f"CMSEL,S,{layout.boundaries[name]}",
+                f"SF,ALL,CONV,{_num(h)},{_num(tb)}   ! W/m2K, C"]
+    out += ["ALLSEL", "SOLVE", "FINISH", ""]
+    return "\n".join(out)
+
+
+def write_window_deck(loads: LoadSet, layout: DeckLayout, path: str | Path) -> Path:
+    """Write the window deck atomically (temp file in the same folder, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(window_deck(loads, layout))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
