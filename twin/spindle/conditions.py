@@ -1,0 +1,240 @@
+"""Nominal boundary conditions of the spindle at an operating point.
+
+    bc = nominal_conditions(model, speed_rpm=9000, ambient_C=25.3, coolant_C=None,
+                            T_bearings_C=None, T_sleeves_C=None)
+    loads = bc.to_thermal_loads()                      # twin.fem.ThermalLoads
+    loads = bc.to_thermal_loads(H_front=1.7e6, R_rear=2e-4)   # a correction's values
+
+`BoundaryConditions` holds the four quantities the twin corrects every 60 s — H_front,
+H_rear (bearing heat, W/m³, applied uniformly to the bearing's inner ring, rolling band and
+outer ring: the "bearing volume" of Eq. 1) and R_front, R_rear (outer ring / sleeve contact
+resistance, m²K/W) — plus the motor heat per region (W/m³) and a film coefficient and
+bulk temperature per boundary.  Physics in `twin.physics`; the spec supplies the data.
+
+Temperatures: `T_bearings_C` is the bearing (outer ring) temperature used for the oil
+viscosity and for the thermal expansion of the fit (Eq. 5); None means the spindle is at
+ambient (a cold start).  It may be one value or (front, rear).  `T_sleeves_C` likewise for
+the sleeves, defaulting to the bearing temperatures.  The coolant defaults to the ambient
+temperature (a chiller tracking the room).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+from twin.errors import InputError
+from twin.fem import ThermalLoads
+from twin.physics import (
+    air_gap_h,
+    bearing_heat_W,
+    contact_resistance_initial,
+    contact_resistance_thermal,
+    coolant_h,
+    fit_pressure_MPa,
+    motor_heat_split_W,
+    motor_loss_W,
+    natural_convection_h,
+    radiation_h,
+    rotating_cylinder_h,
+    rotating_disk_h,
+)
+from twin.physics.contact import harmonic_mean, thermal_interference_um
+from twin.spindle.spec import ConvectionSpec, SpindleSpec
+
+SIDES = ("front", "rear")
+
+
+@dataclass(frozen=True)
+class BoundaryConditions:
+    """Thermal boundary conditions of one operating point (see the module doc)."""
+
+    speed_rpm: float
+    ambient_C: float
+    coolant_C: float
+    H_front: float  # W/m³
+    H_rear: float  # W/m³
+    R_front: float  # m²K/W
+    R_rear: float  # m²K/W
+    motor_heat: dict[str, float]  # region → W/m³
+    convection: dict[str, tuple[float, float]]  # boundary → (h W/m²K, T∞ °C)
+    bearing_regions: dict[str, tuple[str, ...]]  # side → regions carrying H
+    interfaces: dict[str, str]  # side → interface name
+    bearing_volume_m3: dict[str, float] = field(default_factory=dict)
+    motor_volume_m3: dict[str, float] = field(default_factory=dict)
+
+    def heat_W(self) -> dict[str, float]:
+        """Heat generated per source, W (front/rear bearing, rotor, stator)."""
+        out = {"front_bearing": self.H_front * self.bearing_volume_m3.get("front", math.nan),
+               "rear_bearing": self.H_rear * self.bearing_volume_m3.get("rear", math.nan)}
+        for region, q in self.motor_heat.items():
+            out[region] = q * self.motor_volume_m3.get(region, math.nan)
+        return out
+
+    def with_values(self, **values: float) -> BoundaryConditions:
+        """A copy with some of H_front, H_rear, R_front, R_rear replaced."""
+        return replace(self, **_checked(values))
+
+    def to_thermal_loads(self, H_front: float | None = None, H_rear: float | None = None,
+                         R_front: float | None = None,
+                         R_rear: float | None = None) -> ThermalLoads:
+        """twin.fem.ThermalLoads of these conditions, with optional overrides."""
+        given = {"H_front": H_front, "H_rear": H_rear, "R_front": R_front, "R_rear": R_rear}
+        over = _checked({k: v for k, v in given.items() if v is not None})
+        H = {"front": over.get("H_front", self.H_front), "rear": over.get("H_rear", self.H_rear)}
+        R = {"front": over.get("R_front", self.R_front), "rear": over.get("R_rear", self.R_rear)}
+        sources = dict(self.motor_heat)
+        for side in SIDES:
+            for region in self.bearing_regions[side]:
+                sources[region] = sources.get(region, 0.0) + H[side]
+        return ThermalLoads(
+            sources=sources,
+            convection=dict(self.convection),
+            contact_resistance={self.interfaces[s]: R[s] for s in SIDES},
+        )
+
+
+def _checked(values: dict[str, float]) -> dict[str, float]:
+    out = {}
+    for name, value in values.items():
+        if name not in ("H_front", "H_rear", "R_front", "R_rear"):
+            raise ValueError(f"unknown boundary-condition value {name!r}")
+        value = float(value)
+        if not math.isfinite(value) or value < 0 or (name.startswith("R") and value == 0):
+            kind = "positive" if name[0] == "R" else "non-negative"
+            raise ValueError(f"{name} must be a finite {kind} number, got {value!r}")
+        out[name] = value
+    return out
+
+
+def check_operating_point(spec: SpindleSpec, speed_rpm: float, ambient_C: float,
+                          coolant_C: float | None = None) -> None:
+    """InputError naming the field if the operating point is impossible for the spec."""
+    if not math.isfinite(speed_rpm) or speed_rpm < 0:
+        raise InputError(f"speed_rpm must be a non-negative number, got {speed_rpm}",
+                         column="speed_rpm")
+    if speed_rpm > spec.spindle.max_speed_rpm:
+        raise InputError(f"speed_rpm {speed_rpm:g} exceeds the spindle's limit "
+                         f"{spec.spindle.max_speed_rpm:g} rpm (spindle.max_speed_rpm)",
+                         column="speed_rpm")
+    for name, value in (("ambient_C", ambient_C), ("coolant_C", coolant_C)):
+        if value is None:
+            continue
+        if not math.isfinite(value) or not -40.0 <= value <= 80.0:
+            raise InputError(f"{name} must be a temperature between -40 and 80 °C, got {value}",
+                             column=name)
+
+
+def _pair(value: float | tuple[float, float] | None, default: float) -> dict[str, float]:
+    if value is None:
+        return {"front": default, "rear": default}
+    if isinstance(value, (int, float)):
+        return {"front": float(value), "rear": float(value)}
+    front, rear = value
+    return {"front": float(front), "rear": float(rear)}
+
+
+def film_coefficient(conv: ConvectionSpec, spec: SpindleSpec, speed_rpm: float,
+                     ambient_C: float) -> float:
+    """h [W/m²K] of one boundary from its spec entry (twin.physics.convection)."""
+    mm = 1e-3
+    if conv.model == "coolant":
+        ch = spec.coolant_channels[0]
+        c = spec.coolant
+        h = coolant_h(c.flow_L_min, ch.z_end_mm - ch.z_start_mm, ch.r_outer_mm - ch.r_inner_mm,
+                      parallel_channels=c.parallel_channels,
+                      conductivity_W_per_mK=c.conductivity_W_per_mK,
+                      viscosity_m2_s=c.viscosity_m2_s, prandtl=c.prandtl)
+    elif conv.model == "natural":
+        surface = ambient_C + conv.delta_T_K
+        h = natural_convection_h(conv.delta_T_K, conv.length_mm * mm,
+                                 orientation=conv.orientation, surface_C=surface)
+        h += radiation_h(surface, ambient_C, conv.emissivity) if conv.emissivity > 0 else 0.0
+    elif conv.model == "air_gap":
+        h = air_gap_h(speed_rpm, conv.diameter_mm * mm, conv.gap_mm * mm)
+    elif conv.model == "rotating_cylinder":
+        h = rotating_cylinder_h(speed_rpm, conv.diameter_mm * mm)
+    elif conv.model == "rotating_disk":
+        h = rotating_disk_h(speed_rpm, conv.radius_mm * mm)
+    else:  # fixed
+        h = float(conv.h_W_per_m2K)
+    return max(h, conv.min_h_W_per_m2K)
+
+
+def contact_resistance(spec: SpindleSpec, side: str, ring_C: float, sleeve_C: float) -> float:
+    """R [m²K/W] of a bearing's outer ring / sleeve fit: Eq. 4 at the assembly pressure,
+    corrected by Eq. 5 for the thermal expansion of ring and sleeve (twin.physics.contact)."""
+    b = spec.bearings[side]
+    ring, sleeve = spec.material_of(b.outer_ring), spec.material_of(b.sleeve)
+    ring_box, sleeve_box = spec.region_box(b.outer_ring), spec.region_box(b.sleeve)
+    modulus = harmonic_mean(ring.youngs_modulus_GPa, sleeve.youngs_modulus_GPa)
+    conductivity = harmonic_mean(ring.conductivity_W_per_mK, sleeve.conductivity_W_per_mK)
+    radii = (ring_box.r_inner_mm, ring_box.r_outer_mm, sleeve_box.r_outer_mm)
+    p0 = fit_pressure_MPa(b.fit_interference_um, *radii, modulus)
+    r0 = contact_resistance_initial(b.roughness_um, conductivity, p0, modulus)
+    assembly = spec.spindle.assembly_temperature_C
+    delta_um = thermal_interference_um(ring_box.r_outer_mm, ring_C - assembly,
+                                       sleeve_C - assembly, ring.expansion_per_K,
+                                       sleeve.expansion_per_K)
+    stiffness = fit_pressure_MPa(1.0, *radii, modulus)  # MPa per µm of radial interference
+    return contact_resistance_thermal(r0, p0, stiffness * delta_um,
+                                      min_pressure_fraction=b.min_pressure_fraction)
+
+
+def bearing_heat_density(spec: SpindleSpec, side: str, speed_rpm: float,
+                         temperature_C: float) -> float:
+    """H [W/m³] of a bearing: Palmgren power over the bearing volume (Eq. 1)."""
+    b = spec.bearings[side]
+    power = bearing_heat_W(
+        speed_rpm, temperature_C, pitch_diameter_mm=spec.pitch_diameter_mm(side), f0=b.f0,
+        nu40_mm2_s=b.lubricant_nu40_mm2_s, nu100_mm2_s=b.lubricant_nu100_mm2_s,
+        preload_N=b.preload_N, radial_load_N=b.radial_load_N,
+        contact_angle_deg=b.contact_angle_deg, static_load_rating_N=b.static_load_rating_N,
+        static_axial_factor_Y0=b.static_axial_factor_Y0,
+    )
+    return power / spec.bearing_volume_m3(side)
+
+
+def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN001
+                       coolant_C: float | None = None,
+                       T_bearings_C: float | tuple[float, float] | None = None,
+                       T_sleeves_C: float | tuple[float, float] | None = None,
+                       ) -> BoundaryConditions:
+    """Nominal boundary conditions at an operating point.
+
+    `model`: a SpindleModel or a SpindleSpec (only the spec is used; volumes come from
+    the spec's rectangles, which the linear mesh reproduces exactly).
+    """
+    spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
+    check_operating_point(spec, speed_rpm, ambient_C, coolant_C)
+    coolant = ambient_C if coolant_C is None else float(coolant_C)
+    T_b = _pair(T_bearings_C, ambient_C)
+    T_s = _pair(T_sleeves_C, math.nan)
+    T_s = {k: (T_b[k] if math.isnan(v) else v) for k, v in T_s.items()}
+
+    H = {s: bearing_heat_density(spec, s, speed_rpm, T_b[s]) for s in SIDES}
+    R = {s: contact_resistance(spec, s, T_b[s], T_s[s]) for s in SIDES}
+
+    m = spec.motor
+    loss = motor_loss_W(speed_rpm, rated_power_W=m.rated_power_W,
+                        base_speed_rpm=m.base_speed_rpm, load_fraction=m.load_fraction,
+                        efficiency=m.efficiency, heat_share=m.heat_share)
+    split = motor_heat_split_W(loss)
+    volumes = {m.rotor: spec.region_volume_m3(m.rotor), m.stator: spec.region_volume_m3(m.stator)}
+    motor_heat = {m.rotor: split["rotor"] / volumes[m.rotor],
+                  m.stator: split["stator"] / volumes[m.stator]}
+
+    convection = {}
+    for name, conv in spec.convection.items():
+        h = film_coefficient(conv, spec, speed_rpm, ambient_C)
+        convection[name] = (h, coolant if conv.fluid == "coolant" else float(ambient_C))
+
+    return BoundaryConditions(
+        speed_rpm=float(speed_rpm), ambient_C=float(ambient_C), coolant_C=coolant,
+        H_front=H["front"], H_rear=H["rear"], R_front=R["front"], R_rear=R["rear"],
+        motor_heat=motor_heat, convection=convection,
+        bearing_regions={s: spec.bearing_regions(s) for s in SIDES},
+        interfaces={s: spec.bearings[s].interface for s in SIDES},
+        bearing_volume_m3={s: spec.bearing_volume_m3(s) for s in SIDES},
+        motor_volume_m3=volumes,
+    )

@@ -1,0 +1,152 @@
+"""Files of an open-loop run: keypoints.csv, fields.pvd + fields/*.vtu, summary.json.
+
+Every file is written atomically (a temporary file in the same folder, then os.replace).
+keypoints.csv has the columns of a recorded run (time_s, speed_rpm, ambient_C,
+T1_C..T5_C, disp_z_um, disp_r_um), so a simulated run can be replayed like a measured one.
+The .vtu files carry, on the thermal mesh nodes: temperature_C, displacement_m (u_r, u_z, 0;
+relative to the start of the run) and von_mises_Pa (thermal stress of the warming), and
+the region number per cell.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import tempfile
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from twin.spindle.model import SpindleModel
+from twin.spindle.simulate import SimulationResult
+
+
+def write_atomic(path: Path, data: str | bytes) -> None:
+    """Write text or bytes to `path` via a temporary file in the same folder."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data.encode() if isinstance(data, str) else data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def keypoints_csv(result: SimulationResult) -> str:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    kp = result.keypoints()
+    cols = list(kp)
+    writer.writerow([cols[0], "speed_rpm", "ambient_C", *cols[1:]])
+    for i in range(result.time_s.size):
+        writer.writerow([f"{kp['time_s'][i]:.6g}", f"{result.speed_rpm:.6g}",
+                         f"{result.ambient_C:.6g}", *(f"{kp[c][i]:.6f}" for c in cols[1:])])
+    return buf.getvalue()
+
+
+def summary(model: SpindleModel, result: SimulationResult) -> dict:
+    """The JSON summary of a run (max temperature and where, drift, energy balance)."""
+    last = result.conditions[-1]
+    rel = result.relative_residual
+    return {
+        "speed_rpm": result.speed_rpm,
+        "minutes": float(result.time_s[-1] / 60.0),
+        "ambient_C": result.ambient_C,
+        "coolant_C": result.coolant_C,
+        "dt_s": result.dt_s,
+        "max_temperature_C": result.max_temperature_C,
+        "max_temperature_at": {"r_m": result.max_temperature_at_m[0],
+                               "z_m": result.max_temperature_at_m[1],
+                               "region": result.max_temperature_region},
+        "region_max_C": result.region_max_C,
+        "region_mean_C": result.region_mean_C,
+        "final_keypoints_C": {f"T{i + 1}": float(v) for i, v in enumerate(result.sensors_C[-1])},
+        "nose_drift_um": {"axial": float(result.disp_z_um[-1]),
+                          "radial": float(result.disp_r_um[-1]),
+                          "axial_max_abs": float(np.abs(result.disp_z_um).max())},
+        "energy_balance": {
+            "max_relative_residual": float(rel.max()),
+            "final_step_W": {"heat_in": float(result.heat_in_W[-1]),
+                             "heat_out": float(result.heat_out_W[-1]),
+                             "stored": float(result.stored_W[-1]),
+                             "residual": float(result.residual_W[-1])},
+        },
+        "final_boundary_conditions": {
+            "H_front_W_m3": last.H_front, "H_rear_W_m3": last.H_rear,
+            "R_front_m2K_W": last.R_front, "R_rear_m2K_W": last.R_rear,
+            "heat_W": last.heat_W(),
+            "convection": {k: {"h_W_m2K": h, "T_inf_C": t}
+                           for k, (h, t) in last.convection.items()},
+        },
+        "mesh": {"file": str(model.mesh_path), "nodes": int(model.mesh.glued.p.shape[1]),
+                 "cells": int(model.mesh.n_cells), "order": model.order},
+        "wall_time_s": result.wall_time_s,
+    }
+
+
+def _vtu_bytes(model: SpindleModel, T: np.ndarray, T_start: np.ndarray) -> bytes:
+    import meshio
+
+    mesh = model.mesh
+    n_nodes = mesh.thermal.p.shape[1]
+    elastic = model.elastic
+    # displacement and stress of the warming since the start (see model docstring)
+    T_rel = T - T_start + elastic.T_ref
+    u = elastic.solve(T_rel)
+    stress = elastic.stresses(u, T_rel)
+    glued = mesh.node_map  # thermal node → glued node
+    n_glued = mesh.glued.p.shape[1]
+    disp = np.zeros((n_nodes, 3))
+    disp[:, 0] = u[0][:n_glued][glued]
+    disp[:, 1] = u[1][:n_glued][glued]
+    region_id = np.zeros(mesh.n_cells, dtype=np.int32)
+    for i, region in enumerate(sorted(model.spec.regions)):
+        region_id[mesh.region(region)] = i
+    out = meshio.Mesh(
+        np.ascontiguousarray(np.column_stack([mesh.thermal.p.T, np.zeros(n_nodes)])),
+        [("triangle", np.ascontiguousarray(mesh.thermal.t.T))],
+        point_data={"temperature_C": np.ascontiguousarray(T[:n_nodes]),
+                    "displacement_m": disp,
+                    "von_mises_Pa": np.ascontiguousarray(stress["von_mises"][:n_glued][glued])},
+        cell_data={"region": [region_id]},
+    )
+    with tempfile.TemporaryDirectory() as tmp:
+        f = Path(tmp) / "f.vtu"
+        meshio.write(f, out, file_format="vtu", binary=True, compression=None)
+        return f.read_bytes()
+
+
+def write_fields(model: SpindleModel, result: SimulationResult, out_dir: Path) -> Path:
+    """fields/step_NNNN.vtu per kept snapshot and a ParaView collection fields.pvd."""
+    if not result.fields:
+        raise ValueError("the run kept no field snapshots (simulate(field_every_s=...))")
+    T_start = result.fields[0][1]
+    entries = []
+    for time_s, T in result.fields:
+        name = f"fields/step_{int(round(time_s / result.dt_s)):05d}.vtu"
+        write_atomic(out_dir / name, _vtu_bytes(model, T, T_start))
+        entries.append(f'    <DataSet timestep="{time_s:g}" part="0" file={quoteattr(name)}/>')
+    pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+           + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+    path = out_dir / "fields.pvd"
+    write_atomic(path, pvd)
+    return path
+
+
+def write_simulation(model: SpindleModel, result: SimulationResult, out_dir: str | Path,
+                     fields: bool = True) -> dict:
+    """Write keypoints.csv, fields (if kept and `fields`) and summary.json; return summary."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_atomic(out_dir / "keypoints.csv", keypoints_csv(result))
+    if fields and result.fields:
+        write_fields(model, result, out_dir)
+    info = summary(model, result)
+    write_atomic(out_dir / "summary.json", json.dumps(info, indent=2) + "\n")
+    return info
