@@ -106,21 +106,34 @@ def replay_method(
     solver: WindowSolver | None = None,
     keep_fields: bool = True,
     on_window: Callable[[int, int], None] | None = None,
+    field_at_s: float | None = None,
 ) -> MethodReplay:
-    """Replay `run` with one correction method; see the module doc."""
+    """Replay `run` with one correction method; see the module doc.
+
+    keep_fields  keep the temperature field at every window end
+    field_at_s   instead, stop at the solver step nearest this time and keep that field
+    """
     t_wall = time.perf_counter()
     solver = solver or direct_window_solver(model)
     windows = n_windows(run)
     if windows < 2:
         raise ValueError(f"{run.name}: a replay needs at least two 60 s windows of data")
+    field_step = None
+    if field_at_s is not None:
+        if not (0.0 < field_at_s <= windows * WINDOW_S):
+            raise ValueError(
+                f"time {field_at_s:g} s is outside the replayed span (0, {windows * WINDOW_S:g}] s"
+            )
+        field_step = max(1, int(round(field_at_s / STEP_S)))  # 1-based solver step
+        windows = int(np.ceil(field_step / STEPS_PER_WINDOW))
     T0 = initial_temperature_C(run)
     T = np.full(model.n_dofs, T0)
 
     measured_T = np.where(run.valid_T, run.T_C, np.nan)
-    starts = WINDOW_S * np.arange(windows)
-    state = run.before(starts)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)
+    starts = WINDOW_S * np.arange(windows)
+    state = run.before(starts)
     sim_T = np.empty((n_steps + 1, 5))
     sim_T[0] = model.sensor_matrix @ T
     sim_time = np.r_[0.0, time_s]
@@ -168,7 +181,9 @@ def replay_method(
         sim_T[sl.start + 1 : sl.stop + 1] = (model.sensor_matrix @ steps.T).T
         drift[sl] = 1e6 * ((steps - T0) @ model.probe_vectors.T)
         records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck))
-        if keep_fields:
+        if field_step is not None and sl.start < field_step <= sl.stop:
+            fields[STEP_S * field_step] = steps[field_step - sl.start - 1].copy()
+        elif keep_fields and field_step is None:
             fields[start + WINDOW_S] = T.copy()
         previous, previous_nominal = corr.values, nominal
         if on_window is not None:

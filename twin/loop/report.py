@@ -1,0 +1,246 @@
+"""The aggregate replay report: one self-contained HTML page (images embedded).
+
+Built from a replay folder only (summary.json and each run's files), so `twin report DIR`
+can rebuild it at any time:
+- a per-run table in the style of the reference paper's Table 2 (speed, ambient,
+  temperature and deformation accuracy per method, with averages);
+- per run: T1–T5 measured vs twin over time (the paper's Fig. 11), the nose drift, the
+  correction factors per window, the data-quality notes and any snapshots.
+"""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from twin.loop.metrics import SENSORS, mean_metrics
+from twin.loop.outputs import write_json_atomic, write_text_atomic
+
+METHOD_COLORS = {"open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728"}
+
+
+def _read_csv(path: Path) -> dict[str, list[str]]:
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return {k: [r[k] for r in rows] for k in (rows[0].keys() if rows else [])}
+
+
+def _floats(values: list[str]) -> np.ndarray:
+    return np.array([float(v) if v not in ("", None) else np.nan for v in values])
+
+
+def _png(fig) -> str:  # noqa: ANN001
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80, bbox_inches="tight")
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _img(b64: str, alt: str) -> str:
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{b64}"/>'
+
+
+def _plots(run_dir: Path) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = []
+    kp = _read_csv(run_dir / "keypoints.csv")
+    if not kp:
+        return out
+    methods = list(dict.fromkeys(kp["method"]))
+    method_col = np.array(kp["method"])
+    t_min = _floats(kp["time_s"]) / 60.0
+
+    fig, axes = plt.subplots(1, 5, figsize=(17, 3.2), sharex=True)
+    for i, s in enumerate(SENSORS):
+        ax = axes[i]
+        first = method_col == methods[0]
+        ax.plot(t_min[first], _floats(kp[f"{s}_meas_C"])[first], "k.", ms=2, label="measured")
+        for m in methods:
+            sel = method_col == m
+            ax.plot(
+                t_min[sel],
+                _floats(kp[f"{s}_twin_C"])[sel],
+                color=METHOD_COLORS.get(m),
+                lw=1.3,
+                label=m,
+            )
+        ax.set_title(s)
+        ax.set_xlabel("time [min]")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("temperature [°C]")
+    axes[0].legend(fontsize=7)
+    out.append(_img(_png(fig), "T1-T5 measured vs twin"))
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 3.2))
+    first = method_col == methods[0]
+    meas = _floats(kp["disp_z_meas_um"])[first]
+    if np.isfinite(meas).any():
+        ax1.plot(t_min[first], meas, "k.", ms=2, label="measured")
+    for m in methods:
+        sel = method_col == m
+        ax1.plot(
+            t_min[sel], _floats(kp["disp_z_twin_um"])[sel], color=METHOD_COLORS.get(m), label=m
+        )
+    ax1.set_title("axial nose drift")
+    ax1.set_xlabel("time [min]")
+    ax1.set_ylabel("drift [µm]")
+    ax1.grid(alpha=0.3)
+    ax1.legend(fontsize=7)
+    corr = _read_csv(run_dir / "corrections.csv")
+    if corr:
+        cm = np.array(corr["method"])
+        for m in methods:
+            sel = cm == m
+            if m == "open_loop":
+                continue
+            w = _floats(corr["window"])[sel]
+            for key, style in (
+                ("C_H_front", "-"),
+                ("C_H_rear", "--"),
+                ("C_C_front", ":"),
+                ("C_C_rear", "-."),
+            ):
+                ax2.plot(
+                    w,
+                    _floats(corr[key])[sel],
+                    style,
+                    color=METHOD_COLORS.get(m),
+                    label=f"{m} {key}",
+                )
+    ax2.set_title("correction factors per window")
+    ax2.set_xlabel("window")
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=6, ncol=2)
+    out.append(_img(_png(fig), "drift and corrections"))
+    return out
+
+
+def _fmt(v: float | None, digits: int = 2) -> str:
+    return "–" if v is None else f"{v:.{digits}f}"
+
+
+def _table(summary: dict) -> str:
+    runs = summary.get("runs", [])
+    methods = list(dict.fromkeys(m for r in runs for m in r["methods"]))
+    head = "<tr><th rowspan=2>run</th><th rowspan=2>speed [rpm]</th><th rowspan=2>ambient [°C]</th>"
+    head += "".join(f"<th colspan=3>{html.escape(m)}</th>" for m in methods) + "</tr><tr>"
+    head += (
+        "".join("<th>T acc [%]</th><th>rise acc [%]</th><th>deform acc [%]</th>" for _ in methods)
+        + "</tr>"
+    )
+    body = []
+    for r in runs:
+        cells = [html.escape(r["run"]), f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}"]
+        for m in methods:
+            a = r["methods"].get(m, {})
+            cells += [
+                _fmt(a.get("temperature_accuracy_pct")),
+                _fmt(a.get("temperature_rise_accuracy_pct")),
+                _fmt(a.get("deformation_accuracy_pct")),
+            ]
+        body.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
+    mean = summary.get("mean", {})
+    cells = ["<b>average</b>", "", ""]
+    for m in methods:
+        a = mean.get(m, {})
+        cells += [
+            _fmt(a.get("temperature_accuracy_pct")),
+            _fmt(a.get("temperature_rise_accuracy_pct")),
+            _fmt(a.get("deformation_accuracy_pct")),
+        ]
+    body.append("<tr class=avg>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
+    return f"<table>{head}{''.join(body)}</table>"
+
+
+def _quality(run_dir: Path) -> str:
+    try:
+        findings = json.loads((run_dir / "quality.json").read_text())
+    except (OSError, ValueError):
+        return "<p>no data-quality file</p>"
+    items = findings if isinstance(findings, list) else findings.get("findings", findings)
+    if not items:
+        return "<p>data quality: no findings</p>"
+    lis = []
+    for f in items if isinstance(items, list) else [items]:
+        lis.append("<li>" + html.escape(json.dumps(f, ensure_ascii=False)) + "</li>")
+    return (
+        "<details><summary>data-quality findings ("
+        + str(len(lis))
+        + ")</summary><ul>"
+        + "".join(lis)
+        + "</ul></details>"
+    )
+
+
+def collect_summary(out_root: Path) -> dict:
+    """summary.json rebuilt from every run folder's accuracy.json (failures kept)."""
+    runs = []
+    for acc in sorted(Path(out_root).glob("*/accuracy.json")):
+        runs.append(json.loads(acc.read_text()))
+    summary = {"runs": runs, "mean": mean_metrics(runs)}
+    try:
+        old = json.loads((Path(out_root) / "summary.json").read_text())
+        done = {r["run"] for r in runs}
+        failed = [f for f in old.get("failed", []) if f.get("run") not in done]
+        if failed:
+            summary["failed"] = failed
+    except (OSError, ValueError):
+        pass
+    return summary
+
+
+def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
+    """Write DIR/report.html (and DIR/summary.json when rebuilding) from a replay folder."""
+    out_root = Path(out_root)
+    if rebuild_summary:
+        summary = collect_summary(out_root)
+        write_json_atomic(out_root / "summary.json", summary)
+    else:
+        summary = json.loads((out_root / "summary.json").read_text())
+    parts = [
+        "<!doctype html><html><head><meta charset='utf-8'>",
+        "<title>spindle twin replay report</title>",
+        "<style>body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:"
+        "collapse}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+        "tr.avg{background:#eef}img{max-width:100%}h2{margin-top:2em}.err{color:#b00}</style>",
+        "</head><body><h1>spindle twin — replay report</h1>",
+        "<p>Accuracy over every 4 s solver step after the first 60 s window. Temperature "
+        "accuracy: 100·(1 − mean |T_twin − T_meas| / |T_meas|) in °C (the reference paper's "
+        "measure); rise accuracy: 100·(1 − Σ|error| / Σ|rise|); deformation accuracy: axial "
+        "nose drift, 100·(1 − Σ|δ error| / Σ|δ|).</p>",
+        _table(summary),
+    ]
+    for f in summary.get("failed", []):
+        parts.append(
+            f"<p class=err>failed: {html.escape(f.get('run', '?'))}: "
+            f"{html.escape(f.get('error', ''))}</p>"
+        )
+    for r in summary.get("runs", []):
+        run_dir = out_root / r["run"]
+        parts.append(f"<h2>{html.escape(r['run'])}</h2>")
+        parts.append(
+            f"<p>{r['speed_rpm']:.0f} rpm, ambient {r['ambient_C']:.2f} °C, "
+            f"{r['duration_s'] / 60:.1f} min</p>"
+        )
+        if (run_dir / "keypoints.csv").is_file():
+            parts += _plots(run_dir)
+        parts.append(_quality(run_dir))
+        for png in sorted((run_dir / "snapshots").glob("*.png"))[-2:]:
+            b64 = base64.b64encode(png.read_bytes()).decode("ascii")
+            parts.append(_img(b64, png.name))
+    parts.append("</body></html>")
+    path = out_root / "report.html"
+    write_text_atomic(path, "\n".join(parts))
+    return path

@@ -1,0 +1,130 @@
+"""Headless pictures of a field state (pyvista, off-screen).
+
+The axisymmetric section is revolved by 270° about the spindle axis into a 3-D cut-away,
+so the section itself shows on the two cut faces; `section=True` draws the flat r–z
+view instead.  The scalar bar carries units; the hottest point and the nose drift are
+annotated.  `twin replay --snapshots` and `twin snapshot` both use `render_snapshot`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+FIELDS = {
+    "temperature": ("temperature_C", "Temperature [°C]", "inferno"),
+    "displacement": ("displacement_um", "Displacement |u| [µm]", "viridis"),
+}
+
+
+def render_snapshot(
+    model,  # noqa: ANN001 - twin.spindle.model.SpindleModel
+    T: np.ndarray,
+    out_png: str | Path,
+    field: str = "temperature",
+    title: str = "",
+    T_initial_C: float | None = None,
+    section: bool = False,
+    window_size: tuple[int, int] = (1200, 800),
+) -> Path:
+    """Render one field state to a PNG (written atomically); returns the path."""
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    import pyvista as pv
+
+    from twin.fields import field_arrays
+
+    if field not in FIELDS:
+        raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")
+    key, label, cmap = FIELDS[field]
+    arrays = field_arrays(model, T, T_initial_C)
+    mesh = model.mesh
+    n = mesh.thermal.p.shape[1]
+    # r → x, z → z: the spindle axis is the 3-D z axis, revolved about it
+    points = np.zeros((n, 3))
+    points[:, 0] = 1e3 * mesh.thermal.p[0]
+    points[:, 2] = 1e3 * mesh.thermal.p[1]
+    cells = np.hstack([np.full((mesh.n_cells, 1), 3), mesh.thermal.t.T]).ravel()
+    surf = pv.PolyData(points, cells)
+    values = arrays[key]
+    if values.ndim == 2:
+        values = np.linalg.norm(values, axis=1)
+    surf.point_data[label] = values
+    if section:
+        body = surf
+    else:
+        body = surf.extrude_rotate(
+            resolution=72, angle=270.0, capping=True, rotation_axis=(0.0, 0.0, 1.0)
+        )
+
+    plotter = pv.Plotter(off_screen=True, window_size=list(window_size))
+    plotter.set_background("white")
+    plotter.add_mesh(
+        body,
+        scalars=label,
+        cmap=cmap,
+        show_edges=False,
+        smooth_shading=True,
+        scalar_bar_args={
+            "title": label,
+            "color": "black",
+            "fmt": "%.1f",
+            "vertical": True,
+            "position_x": 0.82,
+            "position_y": 0.1,
+            "title_font_size": 16,
+            "label_font_size": 14,
+        },
+    )
+    hot = int(np.argmax(arrays["temperature_C"]))
+    hot_xyz = points[hot]
+    t_max = float(arrays["temperature_C"][hot])
+    drift_z = float(arrays["displacement_um"][:, 1][_nose_vertex(model)])
+    plotter.add_point_labels(
+        [hot_xyz],
+        [f"max {t_max:.1f} °C"],
+        point_size=14,
+        font_size=16,
+        point_color="red",
+        text_color="black",
+        shape_opacity=0.6,
+        always_visible=True,
+    )
+    lines = [title] if title else []
+    lines.append(f"hottest {t_max:.1f} °C at r = {hot_xyz[0]:.0f} mm, z = {hot_xyz[2]:.0f} mm")
+    lines.append(f"nose drift (axial) {drift_z:+.2f} µm")
+    plotter.add_text("\n".join(lines), position="upper_left", font_size=11, color="black")
+    if section:
+        plotter.view_xz()
+    else:
+        # look into the removed quadrant (x > 0, y < 0), so both cut faces show
+        cx, cy, cz = body.center
+        d = 2.2 * max(body.length, 1.0)
+        plotter.camera_position = [
+            (cx + 0.55 * d, cy - 0.55 * d, cz + 0.25 * d),
+            (cx, cy, cz),
+            (0.0, 0.0, 1.0),
+        ]
+    out_png = Path(out_png)
+    out_png.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=out_png.parent, prefix=f".{out_png.stem}.", suffix=".png")
+    os.close(fd)
+    try:
+        plotter.screenshot(tmp)
+        os.replace(tmp, out_png)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    finally:
+        plotter.close()
+    return out_png
+
+
+def _nose_vertex(model) -> int:  # noqa: ANN001
+    """Thermal-mesh vertex nearest the axial nose probe."""
+    probe = model.spec.probes["nose_axial"]
+    p = model.mesh.thermal.p
+    d = (p[0] - probe.r_mm * 1e-3) ** 2 + (p[1] - probe.z_mm * 1e-3) ** 2
+    return int(np.argmin(d))
