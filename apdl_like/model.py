@@ -36,11 +36,12 @@ class ElementType:
 
     @property
     def physics(self) -> str:
-        return ELEMENT_TYPES[self.name][0]
+        """thermal, structural, or unsupported (3-D types read from an archive)."""
+        return ELEMENT_TYPES[self.name][0] if self.name in ELEMENT_TYPES else "unsupported"
 
     @property
     def quadratic(self) -> bool:
-        return ELEMENT_TYPES[self.name][2]
+        return ELEMENT_TYPES[self.name][2] if self.name in ELEMENT_TYPES else False
 
     @property
     def axisymmetric(self) -> bool:

@@ -35,6 +35,7 @@ class Statement:
     name: str  # upper-case command name, or "=" for an assignment
     fields: tuple[str, ...]  # text after the name, split at commas (assignment: (name, expr))
     text: str = ""  # the raw line (for /COM, /TITLE and messages)
+    block: tuple[str, ...] = ()  # NBLOCK/EBLOCK/CMBLOCK: the format line and the data lines
 
     def error(self, message: str) -> ApdlError:
         return ApdlError(message, file=self.file, line=self.line, command=self.shown)
@@ -142,17 +143,64 @@ def _if_is_block(st: Statement) -> bool:
     return action == "THEN"
 
 
+BLOCK_COMMANDS = ("NBLOCK", "EBLOCK", "CMBLOCK")
+MAX_BLOCK_LINES = 5_000_000
+
+
+def _block_lines(st: Statement, lines: list[str], start: int) -> tuple[tuple[str, ...], int]:
+    """The format line and data lines that follow a block command (archive format).
+
+    NBLOCK ends at `N,R5.3,LOC,...` or `-1`, EBLOCK at `-1`; CMBLOCK holds its count of
+    numbers, eight per line.
+    """
+    if start >= len(lines) or not lines[start].lstrip().startswith("("):
+        raise st.error("the block must be followed by its format line, e.g. (3i9,6e21.13e3)")
+    out = [lines[start]]
+    i = start + 1
+    if st.name == "CMBLOCK":
+        try:
+            count = int(st.fields[2])
+        except (IndexError, ValueError):
+            raise st.error("field 3 (count of numbers) must be an integer") from None
+        if not 0 <= count <= 8 * MAX_BLOCK_LINES:
+            raise st.error(f"field 3 (count) out of range: {count}")
+        n = -(-count // 8)
+        if i + n > len(lines):
+            raise st.error(f"the block ends early: {n} data lines expected")
+        out += lines[i : i + n]
+        return tuple(out), 1 + n
+    while i < len(lines):
+        line = lines[i]
+        head = line.strip().upper()
+        if head.startswith("N,R5.3,LOC") or head == "-1" or head.startswith("-1 "):
+            return tuple(out), i - start + 1
+        out.append(line)
+        i += 1
+        if len(out) > MAX_BLOCK_LINES:
+            raise st.error("the block is too long")
+    raise st.error("the block is never terminated (-1)")
+
+
 def parse_deck(text: str, file: str = "<deck>") -> Program:
     """Lex a whole deck and match its blocks; raises ApdlError with file:line."""
     if len(text) > MAX_DECK_BYTES:
         raise ApdlError(f"deck larger than {MAX_DECK_BYTES // 1_000_000} MB", file=file)
     statements = []
-    for number, raw in enumerate(text.splitlines(), start=1):
+    lines = text.splitlines()
+    number = 0
+    while number < len(lines):
+        raw = lines[number]
+        number += 1
         st = lex_line(raw, file, number)
-        if st is not None:
-            if st.name == "/EOF":
-                break
-            statements.append(st)
+        if st is None:
+            continue
+        if st.name == "/EOF":
+            break
+        if st.name in BLOCK_COMMANDS:
+            data, used = _block_lines(st, lines, number)
+            st = Statement(st.file, st.line, st.name, st.fields, st.text, data)
+            number += used
+        statements.append(st)
     program = Program(file, statements)
     _match_blocks(program)
     return program

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import apdl_like.commands.begin  # noqa: F401  (registers commands)
+import apdl_like.commands.blocks  # noqa: F401
 import apdl_like.commands.loads  # noqa: F401
 import apdl_like.commands.post1  # noqa: F401
 import apdl_like.commands.prep7  # noqa: F401

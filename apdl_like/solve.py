@@ -115,6 +115,9 @@ def _check_axisymmetric(session: Session, physics: str) -> None:
     types = {int(t) for t in np.unique(db.elements.type)}
     for t in types:
         et = db.element_types[t]
+        if et.physics == "unsupported":
+            raise ApdlError(f"element type {t} ({et.name}) is not supported: redefine it, e.g. "
+                            f"ET,{t},PLANE55 and KEYOPT,{t},3,1")
         if et.physics != physics:
             raise ApdlError(f"element type {t} ({et.name}) is not a {physics} element; a load "
                             f"step solves one physics (use ETCHG to switch)")

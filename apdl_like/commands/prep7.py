@@ -26,16 +26,21 @@ def _entity_number(c: Call, i: int, what: str) -> int:
     return n
 
 
+# 3-D types that archives written by other tools carry (mapdl-archive writes triangles as
+# SHELL181): accepted so the archive reads, to be redefined (ET,n,PLANE55) before SOLVE
+FOREIGN_TYPES = {181: "SHELL181", 185: "SOLID185", 186: "SOLID186", 187: "SOLID187"}
+_BY_NUMBER = {int(name[5:]): name for name in ELEMENT_TYPES} | FOREIGN_TYPES | \
+    {172: "CONTA172", 169: "TARGE169"}
+
+
 def _element_name(c: Call) -> str:
     text = c.label(2)
     if not text:
         raise ApdlError("field 2 (element name) is required")
-    name = text if not text.isdigit() else f"PLANE{int(text)}"
-    if name in CONTACT_TYPES:
+    name = _BY_NUMBER.get(int(text), "") if text.isdigit() else text
+    if name in CONTACT_TYPES or name in ELEMENT_TYPES or name in FOREIGN_TYPES.values():
         return name
-    if name not in ELEMENT_TYPES:
-        raise ApdlError(f"element {text} is not supported (PLANE55, PLANE77, PLANE182, PLANE183)")
-    return name
+    raise ApdlError(f"element {text} is not supported (PLANE55, PLANE77, PLANE182, PLANE183)")
 
 
 @command("ET", PREP7, 8)

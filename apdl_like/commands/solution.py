@@ -123,6 +123,9 @@ def solve(s: Session, c: Call) -> None:
 
         s.recorded_solves.append(record_solve(s))
         return
+    if "unsupported" in types:
+        types = {"unsupported"}
+        solve_thermal(s)  # raises the message naming the element type to redefine
     if len(types) != 1:
         raise ApdlError("the model mixes thermal and structural elements" if types else
                         "the model has no elements to solve")

@@ -1,0 +1,114 @@
+"""The `apdl-like` console script (also `python -m apdl_like`).
+
+    apdl-like run DECK --out DIR       params.json, result_NNN.vtu, log.txt
+    apdl-like export-cdb --out FILE    the default spindle mesh as an ANSYS archive
+
+Bad input (an `ApdlError`, or any `twin.errors.InputError`) prints one line and exits 2;
+anything else is an internal error, exit 1; neither prints a traceback.
+"""
+
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from twin.errors import InputError
+
+app = typer.Typer(
+    name="apdl-like",
+    help="Run APDL-subset decks on the spindle twin's axisymmetric FEM; export the mesh as CDB.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+def _report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except InputError as exc:
+            typer.echo(f"error: {exc}", err=True)
+            raise typer.Exit(2) from None
+        except typer.Exit:
+            raise
+        except KeyboardInterrupt:
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(130) from None
+        except Exception as exc:  # noqa: BLE001 - the last line of defence of a CLI
+            typer.echo(f"internal error: {type(exc).__name__}: {exc}", err=True)
+            raise typer.Exit(1) from None
+
+    return wrapper
+
+
+@app.command("run")
+@_report_errors
+def run(
+    deck: Path = typer.Argument(..., help="The APDL deck (.inp, .mac, .cdb); /INPUT is "
+                                          "resolved in its folder."),
+    out: Path = typer.Option(..., "--out", help="Output folder (created if missing)."),
+    quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
+) -> None:
+    """Run a deck: DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt."""
+    from apdl_like.errors import ApdlError
+    from apdl_like.outputs import write_outputs
+    from apdl_like.session import Session
+
+    if not deck.is_file():
+        raise ApdlError("deck not found", file=str(deck))
+    session = Session(base_dir=deck.parent)
+    session.run_file(deck)
+    written = write_outputs(session, out)
+    if not quiet:
+        typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
+                   f"{len(written)} files to {out}")
+
+
+@app.command("export-cdb")
+@_report_errors
+def export_cdb(
+    out: Path = typer.Option(..., "--out", help="The archive to write (.cdb)."),
+    mesh: Path = typer.Option(None, "--mesh", help="A gmsh .msh instead of the default "
+                                                   "spindle mesh (materials then omitted)."),
+    quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
+) -> None:
+    """Write the default spindle mesh as an ANSYS archive (NBLOCK, EBLOCK, CMBLOCK)."""
+    from apdl_like.cdb import write_cdb
+    from twin.fem import AxiMesh
+
+    if mesh is None:
+        from twin.spindle.model import DEFAULT_MESH_PATH, fem_material
+        from twin.spindle.spec import load_spec
+
+        spec = load_spec()
+        axi = AxiMesh.from_msh(DEFAULT_MESH_PATH, interfaces=spec.interfaces())
+        materials = {region: fem_material(spec, region) for region in spec.regions}
+        title = spec.spindle.name
+    else:
+        if not mesh.is_file():
+            raise InputError("mesh file not found", file=str(mesh))
+        try:
+            axi = AxiMesh.from_msh(mesh)
+        except ValueError as exc:
+            raise InputError(str(exc), file=str(mesh)) from None
+        materials, title = None, mesh.stem
+    write_cdb(axi, out, materials, title)
+    if not quiet:
+        typer.echo(f"wrote {out}: {axi.thermal.p.shape[1]} nodes, {axi.n_cells} elements, "
+                   f"{len(axi.regions) + len(axi.boundaries) + 2 * len(axi.interfaces)} "
+                   "components")
+
+
+def main() -> None:
+    app(prog_name="apdl-like")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,95 @@
+"""Run outputs: params.json, result_NNN.vtu per solved load step (meshio), log.txt.
+
+VTU points are every APDL node at (X, Y, 0) = (r, z, 0) in metres; nodal arrays TEMP (°C),
+U (m, 3 components, U_z = 0) and S (Pa, 6 components XX YY ZZ XY YZ XZ with ZZ the hoop
+stress) plus SEQV; NaN marks nodes outside the elements.  Every file is written atomically.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
+
+
+def _atomic(path: Path, write: Callable[[Path], None]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _cells(session: Session) -> list[tuple[str, np.ndarray]]:
+    db = session.db
+    el = db.elements
+    idx = db.nodes.index(el.nodes.ravel()).reshape(el.nodes.shape)
+    tri6_type = np.array([db.element_types[int(t)].triangle6 for t in el.type], bool)
+    quadratic = np.array([db.element_types[int(t)].quadratic for t in el.type], bool)
+    degenerate = (el.nodes[:, 2] == el.nodes[:, 3]) & ~tri6_type
+    blocks = []
+    lin = ~quadratic
+    if np.any(lin & degenerate):
+        blocks.append(("triangle", idx[lin & degenerate][:, :3]))
+    if np.any(lin & ~degenerate):
+        blocks.append(("quad", idx[lin & ~degenerate][:, :4]))
+    q8 = quadratic & ~degenerate & ~tri6_type
+    if np.any(q8):
+        blocks.append(("quad8", idx[q8]))
+    t6 = quadratic & degenerate
+    if np.any(t6):
+        blocks.append(("triangle6", idx[t6][:, [0, 1, 2, 4, 5, 7]]))
+    if np.any(tri6_type):
+        blocks.append(("triangle6", idx[tri6_type][:, :6]))
+    return blocks
+
+
+def write_result_vtu(session: Session, result_index: int, path: Path) -> None:
+    import meshio
+
+    res = session.results[result_index]
+    fem = session.fem
+    assert fem is not None
+    points = np.column_stack([session.db.nodes.xy, np.zeros(len(session.db.nodes.ids))])
+    data = {"TEMP": fem.thermal_nodal(res.temperature)}
+    if res.displacement is not None:
+        n = points.shape[0]
+        u = np.zeros((n, 3))
+        u[:, 0] = fem.glued_nodal(res.displacement[0])
+        u[:, 1] = fem.glued_nodal(res.displacement[1])
+        s = np.zeros((n, 6))
+        for j, key in enumerate(("rr", "zz", "tt", "rz")):
+            s[:, j] = fem.glued_nodal(res.stress[key])
+        data.update(U=u, S=s, SEQV=fem.glued_nodal(res.stress["von_mises"]))
+    mesh = meshio.Mesh(points, _cells(session), point_data=data)
+    _atomic(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
+
+
+def write_outputs(session: Session, out_dir: str | Path) -> list[Path]:
+    """params.json, result_NNN.vtu (one per solved load step) and log.txt under `out_dir`."""
+    out = Path(out_dir)
+    written = []
+    params = out / "params.json"
+    _atomic(params, lambda tmp: tmp.write_text(
+        json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n"))
+    written.append(params)
+    for i, res in enumerate(session.results):
+        path = out / f"result_{res.load_step:03d}.vtu"
+        write_result_vtu(session, i, path)
+        written.append(path)
+    log = out / "log.txt"
+    _atomic(log, lambda tmp: tmp.write_text("\n".join(session.log) + "\n", encoding="utf-8"))
+    written.append(log)
+    return written
