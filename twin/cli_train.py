@@ -44,7 +44,8 @@ def train(
         sets.append(build_samples(run_curves(run, simulator)))
     samples = SampleSet.concatenate(sets)
     chosen = PAPER if paper_config else DEFAULT
-    meta = {"runs": [str(p) for p in runs], "simulation": getattr(simulator, "__name__", "")}
+    # file names only: the model file must not depend on where the runs were kept
+    meta = {"runs": [p.name for p in runs], "simulation": getattr(simulator, "__name__", "")}
     results = {}
     for config in (DEFAULT, PAPER):
         if not quiet:

@@ -53,15 +53,36 @@ def default_simulator() -> Simulator:
 
 
 def _open_loop_spindle(run: object) -> SimulatedRun:
-    """Open-loop run of the spindle model (issue 3) under the run's speed and ambient."""
-    try:
-        from twin.spindle import simulate_open_loop_for_training  # not there yet
-    except ImportError:
-        raise RuntimeError(
-            "twin train needs the spindle model's open-loop simulation "
-            "(twin.spindle) or the twin loop (twin.loop); neither is available yet"
-        ) from None
-    return simulate_open_loop_for_training(run)
+    """Open-loop run of the spindle model (issue 3) at the run's speed and ambient.
+
+    A stand-in until the twin loop exists: the spindle model runs one constant speed, so a
+    run whose speed changes is simulated at its first speed (the training runs of the
+    paper are constant-speed runs).  Nominal values follow the spindle model's own
+    temperature-dependent Eq. 1 / Eq. 4 window by window; they are also the values used.
+    """
+    from twin.spindle import SpindleModel, simulate
+
+    model = _spindle_model(SpindleModel)
+    speed = float(np.asarray(run.speed_rpm)[0])
+    ambient = float(np.nanmean(np.asarray(run.ambient_C)))
+    coolant = getattr(run, "coolant_C", None)
+    coolant_C = None if coolant is None else float(np.nanmean(np.asarray(coolant)))
+    minutes = float(run.time_s[-1] - run.time_s[0]) / 60.0
+    result = simulate(model, speed, minutes, ambient, coolant_C)
+    nominal = np.array([[bc.H_front, bc.H_rear, bc.R_front, bc.R_rear]
+                        for bc in result.conditions])
+    return SimulatedRun(result.time_s + float(run.time_s[0]), result.sensors_C, nominal,
+                        nominal, "open_loop")
+
+
+_SPINDLE_CACHE: dict[str, object] = {}
+
+
+def _spindle_model(cls: type) -> object:
+    # the model assembles its operators once; every training run shares it
+    if "model" not in _SPINDLE_CACHE:
+        _SPINDLE_CACHE["model"] = cls.load()
+    return _SPINDLE_CACHE["model"]
 
 
 def run_curves(run: object, simulator: Simulator | None = None) -> RunCurves:

@@ -1,0 +1,86 @@
+"""`twin train` end to end on small synthetic runs (lumped plant stands in for the twin)."""
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from twin.correction import training_data
+from twin.correction.modelfile import load_model
+from twin.correction.toy_plant import ToyPlant
+from twin.correction.training_data import SimulatedRun
+from twin.runs import write_run
+
+PLANT = ToyPlant()
+
+
+def _toy_simulator(run):
+    speed = float(run.speed_rpm[0])
+    ambient = float(run.ambient_C[0])
+    t = np.arange(0.0, run.time_s[-1] + 1e-9, 4.0)
+    H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
+    T = PLANT.simulate(t, speed, ambient, H, R)
+    nominal = np.tile(np.r_[H, R], (int(np.ceil(t[-1] / 60.0)), 1))
+    return SimulatedRun(t, T, nominal, nominal, "open_loop")
+
+
+@pytest.fixture
+def runs(tmp_path, monkeypatch):
+    monkeypatch.setattr(training_data, "default_simulator", lambda: _toy_simulator)
+    paths = []
+    for i, speed in enumerate((6000.0, 8000.0, 11000.0)):
+        t = np.arange(0, 901, 5.0)
+        H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
+        T = PLANT.simulate(t, speed, 25.0, H * 1.1, R * 1.2)
+        T += np.random.default_rng(i).normal(0, 0.05, T.shape)
+        cols = {"time_s": t, "speed_rpm": np.full(t.size, speed),
+                "ambient_C": np.full(t.size, 25.0)}
+        cols.update({f"T{j + 1}_C": T[:, j] for j in range(5)})
+        path = tmp_path / f"run_{speed:.0f}.csv"
+        write_run(path, cols)
+        paths.append(path)
+    return paths
+
+
+def _invoke(args):
+    from twin import commands  # noqa: F401  (registers the commands)
+    from twin.cli import app
+
+    return CliRunner().invoke(app, args)
+
+
+def test_train_writes_model_and_report(runs, tmp_path):
+    out = tmp_path / "model" / "m.safetensors"
+    before = [p.read_bytes() for p in runs]
+    result = _invoke(["train", *map(str, runs), "--out", str(out), "--epochs", "60",
+                      "--seed", "3", "--quiet"])
+    assert result.exit_code == 0, result.output
+    model = load_model(out)
+    assert model.config_name == "default"
+    assert model.metadata["training_runs"] == ["run_11000", "run_6000", "run_8000"]
+    report = json.loads((out.parent / "m.safetensors.report.json").read_text())
+    assert set(report["configs"]) == {"default", "paper"}
+    assert report["configs"]["default"]["r2"]["heat_front"]["epochs"] <= 60
+    page = (out.parent / "m.safetensors.report.html").read_text()
+    assert page.count("data:image/png;base64,") == 3
+    assert [p.read_bytes() for p in runs] == before  # inputs never modified
+
+    # the same seed gives the same weights; --paper-config saves the paper's networks
+    again = tmp_path / "again.safetensors"
+    _invoke(["train", *map(str, runs), "--out", str(again), "--epochs", "60", "--seed", "3",
+             "--quiet"])
+    assert load_model(again).metadata["sha256"] == model.metadata["sha256"]
+    paper = tmp_path / "paper.safetensors"
+    assert _invoke(["train", *map(str, runs), "--out", str(paper), "--epochs", "20",
+                    "--paper-config", "--quiet"]).exit_code == 0
+    assert load_model(paper).config_name == "paper"
+
+
+def test_train_bad_run_exits_2(tmp_path, monkeypatch):
+    monkeypatch.setattr(training_data, "default_simulator", lambda: _toy_simulator)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time_s,speed_rpm\n0,9000\n")
+    result = _invoke(["train", str(bad), "--out", str(tmp_path / "m.safetensors")])
+    assert result.exit_code == 2
+    assert "bad.csv" in result.output
