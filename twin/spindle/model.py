@@ -153,14 +153,12 @@ class SpindleModel:
                 for r in self.spec.regions}
 
     def dof_region(self, dof: int, T: np.ndarray) -> str:
-        """Region of the hottest cell touching a vertex dof (region of a hot spot)."""
-        t = self.mesh.thermal.t
-        cells = np.where(np.any(t == dof, axis=0))[0]
+        """Region of the hottest cell holding a dof (where a hot spot lies)."""
+        element_dofs = self.thermal.basis.element_dofs
+        cells = np.where(np.any(element_dofs == dof, axis=0))[0]
         if cells.size == 0:
             return ""
-        n_nodes = self.mesh.thermal.p.shape[1]
-        centroid_T = T[:n_nodes][t[:, cells]].mean(axis=0)
-        cell = cells[int(np.argmax(centroid_T))]
+        cell = cells[int(np.argmax(T[element_dofs[:, cells]].mean(axis=0)))]
         for region, idx in self.mesh.regions.items():
             if region in self.spec.regions and np.any(idx == cell):
                 return region

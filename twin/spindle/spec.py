@@ -106,6 +106,14 @@ class Rectangle(_Strict):
         return (math.pi * (self.r_outer_mm**2 - self.r_inner_mm**2)
                 * (self.z_end_mm - self.z_start_mm) * 1e-9)
 
+    def overlap_volume_m3(self, other: Rectangle) -> float:
+        """Revolved volume of the intersection of two rectangles."""
+        r0, r1 = max(self.r_inner_mm, other.r_inner_mm), min(self.r_outer_mm, other.r_outer_mm)
+        z0, z1 = max(self.z_start_mm, other.z_start_mm), min(self.z_end_mm, other.z_end_mm)
+        if r1 <= r0 or z1 <= z0:
+            return 0.0
+        return math.pi * (r1**2 - r0**2) * (z1 - z0) * 1e-9
+
 
 class PartSpec(Rectangle):
     name: str
@@ -231,8 +239,10 @@ class SpindleSpec(_Strict):
         return [p for p in self.parts if p.region == region]
 
     def region_volume_m3(self, region: str) -> float:
-        """Revolved volume of a region from its rectangles (exact for the mesh too)."""
-        return sum(p.volume_m3 for p in self.region_parts(region))
+        """Revolved volume of a region: its rectangles minus the coolant channels cut out
+        of them (exact for the linear mesh too)."""
+        return sum(p.volume_m3 - sum(p.overlap_volume_m3(c) for c in self.coolant_channels)
+                   for p in self.region_parts(region))
 
     def region_box(self, region: str) -> Rectangle:
         parts = self.region_parts(region)
@@ -382,6 +392,10 @@ def parse_spec(data: dict, source: str = "<spec>") -> SpindleSpec:
             more = len(cause.errors) - 1
         else:
             field_name, message = _field_path(first["loc"]), first["msg"]
+            if first["type"] == "missing":
+                message = "missing required field"
+            elif first["type"] == "extra_forbidden":
+                message = "unknown field (check the spelling and the unit in the name)"
             more = exc.error_count() - 1
         suffix = f" (and {more} more problem{'s' if more > 1 else ''})" if more > 0 else ""
         raise InputError(f"field {field_name}: {message}{suffix}", file=source) from None

@@ -1,0 +1,129 @@
+"""Open-loop runs: plausibility against the reference system, energy balance, CLI files."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from twin.spindle import SpindleModel, simulate
+
+BEARING_OR_ROTOR = {"rotor", "front_inner_ring", "front_rolling_band", "front_outer_ring",
+                    "rear_inner_ring", "rear_rolling_band", "rear_outer_ring"}
+
+
+@pytest.fixture(scope="module")
+def model():
+    return SpindleModel.load()
+
+
+@pytest.fixture(scope="module")
+def runs(model):
+    return {n: simulate(model, n, 30.0, 25.3) for n in (3000, 6000, 9000, 12000, 15000)}
+
+
+def test_reference_operating_point_is_plausible(runs):
+    # REFERENCE.md §1: 9000 rpm, 25.34 °C, 30 min → rotor hottest at 57.0 °C, 8.47 µm
+    r = runs[9000]
+    assert r.max_temperature_region in BEARING_OR_ROTOR
+    assert 45.0 <= r.max_temperature_C <= 70.0
+    assert 4.0 <= r.disp_z_um[-1] <= 15.0
+    assert r.time_s[-1] == 1800.0 and np.allclose(np.diff(r.time_s), 4.0)
+    # the housing surface stays near ambient, the rings are warmer than their sleeves
+    t = r.sensors_C[-1]
+    assert t[4] < min(t[:4])
+    assert t[0] > t[1] and t[2] > t[3]
+
+
+def test_temperatures_and_drift_grow_with_speed(runs):
+    speeds = sorted(runs)
+    final = np.array([runs[n].sensors_C[-1] for n in speeds])
+    assert np.all(np.diff(final, axis=0) > 0), final
+    drift = [runs[n].disp_z_um[-1] for n in speeds]
+    assert np.all(np.diff(drift) > 0), drift
+    # the motor power is constant above the base speed (12000 rpm): up to it the hottest
+    # point also rises with speed
+    tmax = [runs[n].max_temperature_C for n in speeds if n <= 12000]
+    assert np.all(np.diff(tmax) > 0), tmax
+
+
+def test_energy_balance_closes_every_step(runs, model):
+    for r in runs.values():
+        assert r.relative_residual.max() < 0.01
+        # early on most heat is stored, later more leaves through the films
+        assert r.stored_W[0] > r.heat_out_W[0]
+        assert r.heat_out_W[-1] > r.heat_out_W[0]
+
+
+def test_energy_balance_agrees_with_the_fem(model):
+    # our per-step dot products vs twin.fem's energy_balance on the same step
+    r = simulate(model, 9000.0, 1.0, 25.3, field_every_s=4.0)
+    loads = r.conditions[0].to_thermal_loads()
+    (_, T0), (_, T1) = r.fields[0], r.fields[1]
+    eb = model.thermal.energy_balance(T0, T1, loads, 4.0)
+    assert r.heat_in_W[0] == pytest.approx(eb["heat_in_W"], rel=1e-9)
+    assert r.heat_out_W[0] == pytest.approx(eb["heat_out_W"], rel=1e-6, abs=1e-9)
+    assert r.stored_W[0] == pytest.approx(eb["stored_W"], rel=1e-9)
+
+
+def test_cold_start_hold_versus_feedback(model):
+    held = simulate(model, 9000.0, 10.0, 25.3, update_every_s=None)
+    fed = simulate(model, 9000.0, 10.0, 25.3)
+    assert len(held.conditions) == 1 and len(fed.conditions) == 10
+    # warm oil → less bearing heat → cooler outer ring than with the cold-start heat
+    assert fed.sensors_C[-1, 0] < held.sensors_C[-1, 0]
+
+
+def test_simulate_cli_writes_the_files(tmp_path):
+    from twin import commands  # noqa: F401
+    from twin.cli import app
+
+    out = tmp_path / "run"
+    result = CliRunner().invoke(app, ["simulate", "--speed", "6000", "--minutes", "3",
+                                      "--ambient", "24", "--coolant", "22", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["fields", "fields.pvd", "keypoints.csv", "summary.json"]
+    rows = list(csv.DictReader(open(out / "keypoints.csv")))
+    assert len(rows) == 3 * 15 + 1
+    assert list(rows[0]) == ["time_s", "speed_rpm", "ambient_C", "T1_C", "T2_C", "T3_C",
+                             "T4_C", "T5_C", "disp_z_um", "disp_r_um"]
+    assert float(rows[0]["T1_C"]) == pytest.approx(24.0)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["coolant_C"] == 22.0
+    assert summary["energy_balance"]["max_relative_residual"] < 0.01
+    assert summary["max_temperature_at"]["region"]
+    pvd = (out / "fields.pvd").read_text()
+    vtus = sorted(p.name for p in (out / "fields").iterdir())
+    assert len(vtus) == 4 and all(f"fields/{v}" in pvd for v in vtus)
+    import meshio
+
+    last = meshio.read(out / "fields" / vtus[-1])
+    assert {"temperature_C", "displacement_m", "von_mises_Pa"} <= set(last.point_data)
+    assert last.point_data["temperature_C"].max() > 24.0
+    assert np.all(np.isfinite(last.point_data["von_mises_Pa"]))
+    assert not any(p.name.startswith(".") for p in out.rglob("*"))  # no temp files
+
+
+def test_simulate_cli_rejects_bad_speed(tmp_path):
+    from twin import commands  # noqa: F401
+    from twin.cli import app
+
+    for speed in ("-100", "20000"):
+        result = CliRunner().invoke(app, ["simulate", "--speed", speed, "--minutes", "1",
+                                          "--ambient", "24", "--out", str(tmp_path / "x")])
+        assert result.exit_code == 2, result.output
+        assert "speed_rpm" in result.output
+    assert not (tmp_path / "x").exists()
+
+
+def test_p2_elements_agree_with_the_default_p1_run(model):
+    # discretisation check: quadratic elements on the same mesh change the 10 min key
+    # points by well under the sensors' accuracy
+    p2 = SpindleModel.load(order=2)
+    a = simulate(model, 9000.0, 10.0, 25.3)
+    b = simulate(p2, 9000.0, 10.0, 25.3)
+    assert np.abs(a.sensors_C[-1] - b.sensors_C[-1]).max() < 0.3
+    assert b.disp_z_um[-1] == pytest.approx(a.disp_z_um[-1], rel=0.05)
+    assert b.max_temperature_region in BEARING_OR_ROTOR
