@@ -1,0 +1,62 @@
+"""`twin synth`: an emulated recorded run from the spindle's truth model."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from twin.cli import command
+from twin.errors import InputError
+
+
+@command("synth")
+def synth(
+    out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
+                             "RUN.parquet); the truth goes to RUN.truth.csv beside it."),
+    minutes: float = typer.Option(..., "--minutes", help="Run length, minutes."),
+    ambient: float = typer.Option(..., "--ambient", help="Ambient temperature at the start, °C."),
+    seed: int = typer.Option(..., "--seed", help="Seed of every random choice (deterministic)."),
+    speed: float | None = typer.Option(None, "--speed", help="Constant speed, rpm."),
+    profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
+                                        "(time_s, speed_rpm[, ambient_C])."),
+    scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
+                                         "factors, sensors, faults)."),
+    rate: float = typer.Option(1.0, "--rate", help="Sample rate, Hz (0.1 to 10)."),
+    coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
+                                         "at the start, °C (default: the spindle spec's)."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
+) -> None:
+    """Emulate a recorded run: the truth model plus sensor lag, noise and faults."""
+    from twin.plant.emulator import synthesize, write_synth
+    from twin.plant.profile import read_speed_profile
+    from twin.plant.scenario import load_scenario
+
+    if (speed is None) == (profile is None):
+        raise InputError("give exactly one of --speed and --profile", column="--speed")
+    if speed is not None and not speed >= 0.0:
+        raise InputError(f"speed must be ≥ 0 rpm, got {speed:g}", column="--speed")
+    if not 2.0 <= minutes <= 24 * 60.0:
+        raise InputError(f"minutes must lie in 2..1440 (two 60 s windows at least), "
+                         f"got {minutes:g}", column="--minutes")
+    if not -30.0 <= ambient <= 60.0:
+        raise InputError(f"ambient must lie in -30..60 °C, got {ambient:g}", column="--ambient")
+    if not 0.1 <= rate <= 10.0:
+        raise InputError(f"rate must lie in 0.1..10 Hz, got {rate:g}", column="--rate")
+    if out.suffix.lower() not in (".csv", ".parquet"):
+        raise InputError("the run must be written as .csv or .parquet", file=str(out),
+                         column="--out")
+    if not out.parent.is_dir():
+        raise InputError("output folder does not exist", file=str(out.parent), column="--out")
+    run = synthesize(
+        speed_rpm=speed,
+        profile=None if profile is None else read_speed_profile(profile),
+        minutes=minutes, ambient_C=ambient, seed=seed,
+        scenario=load_scenario(scenario), rate_hz=rate, coolant_C=coolant,
+        scenario_name=None if scenario is None else scenario.name,
+        profile_name=None if profile is None else profile.name,
+    )
+    run_path, truth_path = write_synth(run, out)
+    if not quiet:
+        typer.echo(f"wrote {run_path} ({run.n_samples} samples, {run.elapsed_s:.1f} s) "
+                   f"and {truth_path}")

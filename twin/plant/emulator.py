@@ -1,0 +1,268 @@
+"""The emulated spindle: a truth FEM run on a finer mesh, seen through real sensors.
+
+    run = synthesize(speed_rpm=9000, minutes=30, ambient_C=25.3, seed=1)
+    run_path, truth_path = write_synth(run, Path("out/run.csv"))
+
+The truth differs from the twin's nominal model the way a real spindle does (see
+`twin.plant.truth`): a finer mesh (`Scenario.model.size_factor`), shorter steps (2 s
+instead of 4 s), bearing heat and contact resistance multiplied by time-varying truth
+factors, coolant inlet and ambient drifting, X/Y drift the axisymmetric model cannot
+produce.  The nominal loads themselves follow the truth's own state as in the twin
+(`nominal_conditions` with the ring and sleeve temperatures: oil viscosity, Eq. 5 fit),
+re-evaluated every `UPDATE_S`.  The sensors then add thermocouple lag, noise and faults.
+
+Displacement probes are zeroed at the start of the run (as on a test stand), so
+`disp_z_um` is the thermal drift of the nose from the cold start.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import InputError
+from twin.plant.profile import SpeedProfile
+from twin.plant.scenario import Scenario
+from twin.plant.sensors import add_noise, apply_faults, first_order_lag
+from twin.plant.timetable import StepTable
+from twin.plant.truth import TruthTables, default_tables, truth_tables
+
+DT_S = 2.0
+"""Truth time step, s (the twin uses 4 s)."""
+UPDATE_S = 20.0
+"""The truth's loads are re-evaluated this often, s (the twin corrects every 60 s)."""
+
+_MODELS: dict[float, object] = {}
+
+
+def truth_model(size_factor: float):  # noqa: ANN201 - SpindleModel, imported lazily
+    """The spindle model at a mesh size factor, built once per process."""
+    if size_factor not in _MODELS:
+        from twin.spindle import SpindleModel
+
+        _MODELS[size_factor] = SpindleModel.load(size_factor=size_factor)
+    return _MODELS[size_factor]
+
+
+@dataclass
+class TruthRun:
+    """The truth at the solver steps: metal temperatures, nose drift, applied loads."""
+
+    time_s: np.ndarray  # (n+1,)
+    sensors_C: np.ndarray  # (n+1, 5) metal temperature at T1..T5 (no lag, no noise)
+    disp_z_um: np.ndarray  # (n+1,) axial nose drift from the start
+    loads: dict[str, np.ndarray]  # per step (n+1,): H/R nominal and true, speed, ...
+    heat_in_W: np.ndarray  # (n,)
+    residual_W: np.ndarray  # (n,) energy balance of each step
+
+
+@dataclass
+class SynthRun:
+    """An emulated recorded run and its truth, ready to be written."""
+
+    columns: dict[str, np.ndarray]
+    metadata: dict[str, str]
+    truth: dict[str, np.ndarray]
+    elapsed_s: float = 0.0
+    max_relative_residual: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.columns["time_s"].size)
+
+
+def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  # noqa: ANN001
+              dt: float = DT_S, update_s: float = UPDATE_S) -> TruthRun:
+    """Backward-Euler transient of the truth from a uniform start at the ambient.
+
+    Loads are held over update intervals that also break at every speed change.
+    """
+    from twin.spindle import nominal_conditions
+
+    n = int(math.ceil(duration_s / dt - 1e-9))
+    t = np.arange(n + 1) * dt
+    steps_per_update = max(1, int(round(update_s / dt)))
+    # a load update at every regular interval and at the first step after a speed change
+    starts = set(range(0, n, steps_per_update))
+    starts.update(int(math.ceil(c / dt - 1e-9)) for c in speed.changes_in(0.0, duration_s))
+    starts = sorted(s for s in starts if s < n)
+
+    thermal = model.thermal
+    S, W = model.sensor_matrix, model.probe_vectors[0]
+    T0 = np.full(model.n_dofs, float(tables.ambient_C(0.0)))
+    T = T0.copy()
+    cap = model.capacity_vector / dt
+    sensors = np.empty((n + 1, S.shape[0]))
+    disp = np.zeros(n + 1)
+    sensors[0] = S @ T
+    names = ("speed_rpm", "H_front_nominal", "H_rear_nominal", "R_front_nominal",
+             "R_rear_nominal", "H_front", "H_rear", "R_front", "R_rear", "coolant_C",
+             "ambient_C")
+    loads_log = {k: np.empty(n + 1) for k in names}
+    heat_in, residual = np.empty(n), np.empty(n)
+    films_at_speed: dict[float, dict[str, float]] = {}
+    for a, b in zip(starts, [*starts[1:], n], strict=True):
+        mid = 0.5 * (t[a] + t[b])  # drifting temperatures: the interval's mean value
+        s = sensors[a]
+        bc = nominal_conditions(model, float(speed(t[a])), float(tables.ambient_C(mid)),
+                                float(tables.coolant_C(mid)),
+                                T_bearings_C=(s[0], s[2]) if a else None,
+                                T_sleeves_C=(s[1], s[3]) if a else None)
+        # Film coefficients depend on speed, and on the ambient only through air properties
+        # (≪ 1 % per K): hold them per speed so that the drift of the ambient and coolant
+        # moves only the bulk temperatures, and the step matrix factorization is reused.
+        h = films_at_speed.setdefault(bc.speed_rpm, {k: v[0] for k, v in bc.convection.items()})
+        bc = replace(bc, convection={k: (h[k], v[1]) for k, v in bc.convection.items()})
+        true = {"H_front": bc.H_front * float(tables.H_front(t[a])),
+                "H_rear": bc.H_rear * float(tables.H_rear(t[a])),
+                "R_front": bc.R_front * float(tables.R_front(t[a])),
+                "R_rear": bc.R_rear * float(tables.R_rear(t[a]))}
+        loads = bc.to_thermal_loads(**true)
+        row = {"speed_rpm": bc.speed_rpm, "H_front_nominal": bc.H_front,
+               "H_rear_nominal": bc.H_rear, "R_front_nominal": bc.R_front,
+               "R_rear_nominal": bc.R_rear, **true, "coolant_C": bc.coolant_C,
+               "ambient_C": bc.ambient_C}
+        for k, v in row.items():
+            loads_log[k][a:b] = v
+        stepper = thermal.transient(loads, dt=dt, theta=1.0)
+        q_in = sum(q * thermal.source_vector(r).sum() for r, q in loads.sources.items())
+        films = [(h, t_inf, thermal.facet_load(bd)) for bd, (h, t_inf) in loads.convection.items()]
+        film_vec = sum(h * f for h, _, f in films)
+        film_const = sum(h * t_inf * f.sum() for h, t_inf, f in films)
+        for k in range(a, b):
+            T_new = stepper.step(T)
+            out = float(film_vec @ T_new) - film_const
+            heat_in[k] = q_in
+            residual[k] = q_in - out - float(cap @ (T_new - T))
+            T = T_new
+            sensors[k + 1] = S @ T
+            disp[k + 1] = W @ (T - T0)
+    for k in names:
+        loads_log[k][n] = loads_log[k][n - 1]
+    return TruthRun(time_s=t, sensors_C=sensors, disp_z_um=disp * 1e6, loads=loads_log,
+                    heat_in_W=heat_in, residual_W=residual)
+
+
+def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float | None = None,
+               profile: SpeedProfile | None = None, scenario: Scenario | None = None,
+               rate_hz: float = 1.0, coolant_C: float | None = None,
+               scenario_name: str | None = None, profile_name: str | None = None,
+               model=None) -> SynthRun:  # noqa: ANN001
+    """An emulated recorded run (see the module doc).  Deterministic given the inputs.
+
+    Exactly one of `speed_rpm` (constant) and `profile` is given.  `coolant_C` is the
+    coolant inlet at the start (default: the ambient, like the nominal model).  `model`
+    overrides the truth's SpindleModel (default: the reference spindle at the scenario's
+    size factor).
+    """
+    start = time.perf_counter()
+    if (speed_rpm is None) == (profile is None):
+        raise ValueError("give exactly one of speed_rpm and profile")
+    scenario = scenario or Scenario()
+    duration = float(minutes) * 60.0
+    if profile is not None:
+        speed = profile.speed_rpm
+        ambient_base = profile.ambient_C.shifted(0.0) if profile.ambient_C else None
+    else:
+        speed = StepTable.constant(float(speed_rpm))
+        ambient_base = None
+    if ambient_base is None:
+        ambient_base = StepTable.constant(float(ambient_C))
+    model = model or truth_model(scenario.model.size_factor)
+    limit = model.spec.spindle.max_speed_rpm
+    if np.max(speed.values) > limit:
+        raise InputError(f"speed {np.max(speed.values):g} rpm exceeds the spindle's limit "
+                         f"{limit:g} rpm", column="speed_rpm")
+
+    truth_seed, noise_seed = np.random.SeedSequence(seed).spawn(2)
+    coolant0 = float(ambient_base(0.0)) if coolant_C is None else float(coolant_C)
+    defaults = default_tables(np.random.default_rng(truth_seed), duration, speed,
+                              ambient_base, coolant0)
+    tables = truth_tables(scenario, defaults)
+    truth = run_truth(model, duration, speed, tables)
+
+    # --- what the test stand records -------------------------------------------------
+    rng = np.random.default_rng(noise_seed)
+    sensors = scenario.sensors
+    t_out = np.arange(0.0, duration + 1e-9, 1.0 / rate_hz)
+    lagged = first_order_lag(truth.sensors_C, DT_S, sensors.lag_s)
+    T_meas = np.stack([np.interp(t_out, truth.time_s, lagged[:, j]) for j in range(5)], axis=1)
+    disp_z = np.interp(t_out, truth.time_s, truth.disp_z_um)
+    x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
+    columns = {
+        "time_s": t_out,
+        "speed_rpm": speed(t_out).astype(float),
+        "ambient_C": add_noise(rng, tables.ambient_C(t_out), sensors.noise_C),
+        **{f"T{j + 1}_C": add_noise(rng, T_meas[:, j], sensors.noise_C) for j in range(5)},
+        "coolant_C": add_noise(rng, tables.coolant_C(t_out), sensors.noise_C),
+        "disp_x_um": add_noise(rng, x_true, sensors.noise_um),
+        "disp_y_um": add_noise(rng, y_true, sensors.noise_um),
+        "disp_z_um": add_noise(rng, disp_z, sensors.noise_um),
+    }
+    columns = apply_faults(t_out, columns, scenario.faults)
+
+    step_index = np.clip(np.searchsorted(truth.time_s, t_out, side="right") - 1, 0,
+                         truth.time_s.size - 1)
+    truth_cols = {"time_s": t_out}
+    for k, v in truth.loads.items():
+        truth_cols[k] = v[step_index]  # held over each update interval
+    for side in ("front", "rear"):
+        truth_cols[f"factor_H_{side}"] = truth_cols[f"H_{side}"] / truth_cols[f"H_{side}_nominal"]
+        truth_cols[f"factor_R_{side}"] = truth_cols[f"R_{side}"] / truth_cols[f"R_{side}_nominal"]
+    for j in range(5):
+        truth_cols[f"T{j + 1}_true_C"] = np.interp(t_out, truth.time_s, truth.sensors_C[:, j])
+    truth_cols.update(disp_z_true_um=disp_z, disp_x_true_um=x_true, disp_y_true_um=y_true)
+
+    if speed_rpm is not None:
+        label = f"{speed_rpm:g}rpm"
+    else:
+        label = Path(profile_name).stem if profile_name else "profile"
+    metadata = {
+        "name": f"synth_{label}_{minutes:g}min_seed{seed}",
+        "source": "twin synth (emulated spindle)",
+        "speed_rpm": f"{speed_rpm:g}" if speed_rpm is not None else "profile",
+        "profile": profile_name or "",
+        "minutes": f"{minutes:g}",
+        "ambient_C": f"{ambient_C:g}",
+        "coolant_C": f"{coolant0:g}",
+        "seed": str(seed),
+        "rate_hz": f"{rate_hz:g}",
+        "scenario": scenario_name or "",
+        "truth_mesh_size_factor": f"{scenario.model.size_factor:g}",
+        "thermocouple_lag_s": f"{sensors.lag_s:g}",
+        "noise_C": f"{sensors.noise_C:g}",
+        "noise_um": f"{sensors.noise_um:g}",
+        "displacement_reference": "probes zeroed at t = 0 (cold start)",
+    }
+    metadata = {k: v for k, v in metadata.items() if v != ""}
+    rel = np.abs(truth.residual_W) / np.maximum(np.abs(truth.heat_in_W), 1e-12)
+    return SynthRun(columns=columns, metadata=metadata, truth=truth_cols,
+                    elapsed_s=time.perf_counter() - start,
+                    max_relative_residual=float(rel.max()),
+                    extra={"truth_run": truth, "tables": tables})
+
+
+def truth_path_for(run_path: Path) -> Path:
+    """RUN.csv → RUN.truth.csv (also for .parquet runs: the truth is always CSV)."""
+    return run_path.with_name(run_path.stem + ".truth.csv")
+
+
+def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:
+    """Write RUN (CSV or Parquet) and RUN.truth.csv beside it, each atomically."""
+    from twin.runs import write_run
+    from twin.runs.csv_format import write_csv_table
+
+    out = Path(out)
+    truth_path = truth_path_for(out)
+    formats = {k: "%.6g" for k in run.truth if k.startswith(("H_", "R_"))}
+    formats.update({k: "%.5f" for k in run.truth if k.startswith("factor_")})
+    write_csv_table(truth_path, run.truth,
+                    {"run": out.name, "note": "evaluation only: the twin never reads this file"},
+                    formats)
+    write_run(out, run.columns, run.metadata)
+    return out, truth_path
