@@ -92,6 +92,7 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -173,3 +174,9 @@ def load_model(path: str | Path) -> CorrectionModel:
         raise InputError("checksum mismatch: the weights were modified or damaged",
                          file=str(path))
     return CorrectionModel(nets, meta)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
