@@ -253,7 +253,10 @@ def truth_path_for(run_path: Path) -> Path:
 
 
 def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:
-    """Write RUN (CSV or Parquet) and RUN.truth.csv beside it, each atomically."""
+    """Write RUN (CSV or Parquet) and RUN.truth.csv beside it, each atomically.
+
+    The run's `name` metadata becomes the file stem.
+    """
     from twin.runs import write_run
     from twin.runs.csv_format import write_csv_table
 
@@ -264,5 +267,6 @@ def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:
     write_csv_table(truth_path, run.truth,
                     {"run": out.name, "note": "evaluation only: the twin never reads this file"},
                     formats)
-    write_run(out, run.columns, run.metadata)
+    # the run is named after its file, as every command names its outputs
+    write_run(out, run.columns, {**run.metadata, "name": out.stem})
     return out, truth_path

@@ -9,13 +9,13 @@ from __future__ import annotations
 import csv
 import math
 import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
 from twin.errors import InputError
+from twin.runs.atomic import atomic_target
 from twin.runs.schema import ALL_COLUMNS
 from twin.runs.table import RawTable
 
@@ -124,17 +124,11 @@ def write_csv_table(
     arrays = [np.asarray(columns[name], dtype=float) for name in names]
     if len({a.shape for a in arrays}) > 1 or any(a.ndim != 1 for a in arrays):
         raise ValueError("columns must be 1-D arrays of equal length")
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", newline="") as out:
-            for key, value in (metadata or {}).items():
-                out.write(f"# {key}: {value}\n")
-            out.write(",".join(names) + "\n")
-            fmts = [formats.get(name, "%.4f") for name in names]
-            for row in zip(*arrays, strict=True):
-                out.write(",".join(_format(v, f) for v, f in zip(row, fmts, strict=True)) + "\n")
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    # the file is closed before atomic_target moves it into place
+    with atomic_target(path) as tmp, open(tmp, "w", newline="") as out:
+        for key, value in (metadata or {}).items():
+            out.write(f"# {key}: {value}\n")
+        out.write(",".join(names) + "\n")
+        fmts = [formats.get(name, "%.4f") for name in names]
+        for row in zip(*arrays, strict=True):
+            out.write(",".join(_format(v, f) for v, f in zip(row, fmts, strict=True)) + "\n")

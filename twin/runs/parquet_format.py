@@ -6,13 +6,12 @@ Rows are numbered 1-based over the data (Parquet has no lines a user would edit)
 from __future__ import annotations
 
 import os
-import tempfile
 from collections.abc import Mapping
-from pathlib import Path
 
 import numpy as np
 
 from twin.errors import InputError
+from twin.runs.atomic import atomic_target
 from twin.runs.schema import ALL_COLUMNS
 from twin.runs.table import RawTable
 
@@ -85,12 +84,5 @@ def write_parquet_table(
 
     table = pa.table({name: np.asarray(values, dtype=float) for name, values in columns.items()})
     table = table.replace_schema_metadata({str(k): str(v) for k, v in (metadata or {}).items()})
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    try:
+    with atomic_target(path) as tmp:
         pq.write_table(table, tmp)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise

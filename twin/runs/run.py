@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -12,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.errors import InputError
+from twin.runs.atomic import atomic_target
 from twin.runs.csv_format import read_csv_table, write_csv_table
 from twin.runs.parquet_format import read_parquet_table, write_parquet_table
 from twin.runs.quality import QualityConfig, finding, repair
@@ -203,13 +203,6 @@ def write_quality(run: RecordedRun, path: str | os.PathLike[str]) -> None:
     """Write `quality.json` (the run's data-quality findings), atomically."""
     doc = {"run": run.name, "file": run.path, "n_samples": int(run.time_s.size),
            "duration_s": run.duration_s, "findings": run.quality}
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w") as out:
-            json.dump(doc, out, indent=2)
-            out.write("\n")
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_target(path) as tmp, open(tmp, "w") as out:
+        json.dump(doc, out, indent=2)
+        out.write("\n")
