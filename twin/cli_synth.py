@@ -24,7 +24,8 @@ def synth(
                                          "factors, sensors, faults)."),
     rate: float = typer.Option(1.0, "--rate", help="Sample rate, Hz (0.1 to 10)."),
     coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
-                                         "at the start, °C (default: the spindle spec's)."),
+                                         "at the start, °C (default: the ambient, as the "
+                                         "nominal model assumes)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Emulate a recorded run: the truth model plus sensor lag, noise and faults."""
@@ -53,8 +54,8 @@ def synth(
         profile=None if profile is None else read_speed_profile(profile),
         minutes=minutes, ambient_C=ambient, seed=seed,
         scenario=load_scenario(scenario), rate_hz=rate, coolant_C=coolant,
-        scenario_name=None if scenario is None else scenario.name,
-        profile_name=None if profile is None else profile.name,
+        scenario_name=None if scenario is None else str(scenario),
+        profile_name=None if profile is None else str(profile),
     )
     run_path, truth_path = write_synth(run, out)
     if not quiet:

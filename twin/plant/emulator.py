@@ -177,7 +177,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     limit = model.spec.spindle.max_speed_rpm
     if np.max(speed.values) > limit:
         raise InputError(f"speed {np.max(speed.values):g} rpm exceeds the spindle's limit "
-                         f"{limit:g} rpm", column="speed_rpm")
+                         f"{limit:g} rpm", file=profile_name, column="speed_rpm")
 
     truth_seed, noise_seed = np.random.SeedSequence(seed).spawn(2)
     coolant0 = float(ambient_base(0.0)) if coolant_C is None else float(coolant_C)
@@ -228,7 +228,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         "speed_rpm": f"{speed_rpm:g}" if speed_rpm is not None else "profile",
         "profile": profile_name or "",
         "minutes": f"{minutes:g}",
-        "ambient_C": f"{ambient_C:g}",
+        "ambient_C": f"{float(tables.ambient_C(0.0)):g}",
         "coolant_C": f"{coolant0:g}",
         "seed": str(seed),
         "rate_hz": f"{rate_hz:g}",
