@@ -58,11 +58,12 @@ def command(name: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
 
 
 def main() -> None:
-    # Command modules register themselves on import; they keep heavy imports inside
-    # their functions.
-    from twin import commands  # noqa: F401
-
     app(prog_name="twin")
+
+
+# Command modules register themselves on import (they keep heavy imports inside their
+# functions); imported last because they use `command` from this module.
+from twin import commands  # noqa: E402, F401
 
 
 if __name__ == "__main__":

@@ -46,7 +46,7 @@ def field_mesh(model: SpindleModel, T: np.ndarray, T_initial_C: float | None = N
     points = np.zeros((mesh.thermal.p.shape[1], 3))
     points[:, :2] = mesh.thermal.p.T
     region_id = np.zeros(mesh.n_cells, dtype=np.int32)
-    for i, name in enumerate(sorted(mesh.regions), start=1):
+    for i, name in enumerate(sorted(model.spec.regions), start=1):
         region_id[mesh.regions[name]] = i
     return meshio.Mesh(
         points,

@@ -189,7 +189,8 @@ class AxiMesh:
         # Both meshes keep this vertex order per cell (sort_t=False): the thermal strain is
         # integrated with the temperature basis on one mesh and the displacement basis on
         # the other, so their quadrature points must coincide cell by cell.
-        cells = np.sort(cells, axis=0)
+        cells = np.ascontiguousarray(np.sort(cells, axis=0))
+        points = np.ascontiguousarray(points)
         glued = MeshTri(points, cells, sort_t=False)
         n_glued = points.shape[1]
         g_keys = _facet_keys(glued.facets, n_glued)

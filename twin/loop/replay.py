@@ -86,6 +86,53 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
     return solve
 
 
+def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # noqa: ANN001
+    """Solve each window through its APDL-like deck in one persistent session.
+
+    The deck (apdl_like.writer) carries the window's loads only; the session holds the
+    mesh, materials and assembled operators, so nothing is re-assembled between windows.
+    The temperature state is handed in explicitly, so one session serves every method.
+    """
+    from apdl_like.loadset import LoadSet
+    from apdl_like.session import Session
+    from apdl_like.writer import window_deck
+
+    if session is None:
+        session = Session.from_mesh(
+            model.mesh, model.materials, order=model.order, T_ref_C=model.elastic.T_ref
+        )
+
+    def solve(
+        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int
+    ) -> tuple[np.ndarray, str]:
+        loads = bc.to_thermal_loads(
+            H_front=corr.H_front_W_m3,
+            H_rear=corr.H_rear_W_m3,
+            R_front=corr.R_front_m2K_W,
+            R_rear=corr.R_rear_m2K_W,
+        )
+        load_set = LoadSet(
+            window=window,
+            start_s=start_s,
+            dt_s=STEP_S,
+            n_steps=STEPS_PER_WINDOW,
+            heat_generation=loads.sources,
+            convection=loads.convection,
+            contact_resistance=loads.contact_resistance,
+        )
+        deck = window_deck(load_set, session.layout)
+        if start_s == 0.0:
+            # the first deck is a new analysis (ANTYPE,TRANS): it starts from TUNIF, which
+            # is the run's uniform initial field
+            session.db.settings.tunif = float(T[0])
+        else:
+            session.set_state(T, start_s)
+        session.run_text(deck, file=f"window_{window:03d}.inp")
+        return np.asarray(session.substep_temperatures), deck
+
+    return solve
+
+
 def n_windows(run: RecordedRun) -> int:
     """Whole 60 s windows the run covers."""
     return int(np.floor(run.duration_s / WINDOW_S + 1e-9))
@@ -114,7 +161,7 @@ def replay_method(
     field_at_s   instead, stop at the solver step nearest this time and keep that field
     """
     t_wall = time.perf_counter()
-    solver = solver or direct_window_solver(model)
+    solver = solver or deck_window_solver(model)
     windows = n_windows(run)
     if windows < 2:
         raise ValueError(f"{run.name}: a replay needs at least two 60 s windows of data")

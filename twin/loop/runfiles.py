@@ -30,7 +30,7 @@ from twin.loop.outputs import (
     write_text_atomic,
     write_vtu_atomic,
 )
-from twin.loop.replay import MethodReplay, replay_method
+from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
 
 DONE_FILE = ".done.json"
 SNAPSHOT_CHOICES = ("none", "end", "every")
@@ -89,6 +89,7 @@ def replay_run_to_dir(
     (out_dir / DONE_FILE).unlink(missing_ok=True)
 
     correctors = [make_corrector(m, model_path if m == "bpnn" else None) for m in methods]
+    solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
     results: dict[str, MethodReplay] = {}
     for corrector in correctors:
@@ -101,7 +102,7 @@ def replay_run_to_dir(
             corrector,
             keep_fields=corrector.name == primary,
             on_window=callback,
-            solver=deck_solver(model),
+            solver=solver,
         )
 
     first = next(iter(results.values()))
@@ -235,10 +236,3 @@ def default_spindle():  # noqa: ANN201
     from twin.spindle.model import SpindleModel
 
     return SpindleModel.load()
-
-
-def deck_solver(model):  # noqa: ANN001, ANN201
-    """The window solver the loop uses (the apdl_like deck path once wired)."""
-    from twin.loop.replay import direct_window_solver
-
-    return direct_window_solver(model)
