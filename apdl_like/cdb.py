@@ -22,8 +22,10 @@ import numpy as np
 from apdl_like.errors import ApdlError
 from apdl_like.writer import DeckLayout, component_name
 
-_NFORMAT = re.compile(r"\(\s*(\d+)\s*i\s*(\d+)\s*,\s*(\d+)\s*e\s*(\d+)\s*\.\s*\d+(?:\s*e\s*\d+)?\s*\)",
-                      re.I)
+_NFORMAT = re.compile(
+    r"\(\s*(\d+)\s*i\s*(\d+)\s*,\s*(\d+)\s*e\s*(\d+)\s*\.\s*\d+(?:\s*e\s*\d+)?\s*\)",
+    re.I,
+)
 _IFORMAT = re.compile(r"\(\s*(\d+)\s*i\s*(\d+)\s*\)", re.I)
 
 

@@ -65,6 +65,7 @@ class FemModel:
         self.glued_dof = np.full(n_nodes, -1, np.int64)
         self.glued_dof[vertex_node] = glued_vertex
         self.midside_nodes = np.zeros(0, np.int64)
+        self.midside_ends = np.zeros((2, 0), np.int64)  # node indices of each edge's corners
         if midside is not None and midside.size:
             if order != 2:
                 raise ApdlError("mid-side nodes need quadratic elements (PLANE77/PLANE183)")
@@ -74,6 +75,7 @@ class FemModel:
             self.thermal_dof[midside[0]] = n_vert + t_f
             self.glued_dof[midside[0]] = mesh.glued.p.shape[1] + g_f
             self.midside_nodes = midside[0]
+            self.midside_ends = vertex_node[midside[1:]]
         # exterior faces of the thermal mesh = the faces SF/SFE can load
         self.face_facets = thermal.boundary_facets()
         fv = thermal.facets[:, self.face_facets]

@@ -69,6 +69,21 @@ def _strip_comment(line: str) -> str:
     return line
 
 
+def _split_fields(body: str) -> list[str]:
+    """Split at commas outside parentheses: `*GET,T,NODE,NODE(0.1,0),TEMP` has 5 fields."""
+    parts, depth, start = [], 0, 0
+    for i, ch in enumerate(body):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth = max(depth - 1, 0)
+        elif ch == "," and depth == 0:
+            parts.append(body[start:i])
+            start = i + 1
+    parts.append(body[start:])
+    return parts
+
+
 def lex_line(raw: str, file: str, number: int) -> Statement | None:
     """One deck line -> a statement, or None for blank and comment lines."""
     if len(raw) > MAX_LINE_CHARS:
@@ -91,7 +106,7 @@ def lex_line(raw: str, file: str, number: int) -> Statement | None:
     m = _ASSIGNMENT.match(body)
     if m is not None and "," not in body[: m.start(2)]:
         return Statement(file, number, "=", (m.group(1).upper(), m.group(2).strip()), raw)
-    parts = body.split(",")
+    parts = _split_fields(body) if "(" in body else body.split(",")
     name = parts[0].strip().upper()
     if not _COMMAND_NAME.match(name):
         shown = parts[0].strip() or "(empty)"

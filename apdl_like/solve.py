@@ -143,7 +143,9 @@ def _groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[np.ndar
 def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> ThermalLoads:
     """The database's thermal loads as twin.fem ThermalLoads (ramped to `fraction`)."""
     db = session.db
-    prev = session.previous_loads if fraction < 1.0 else None
+    prev = None
+    if fraction < 1.0:
+        prev = session.previous_loads or _first_step_loads(session)
     tunif = db.settings.tunif
     el = db.elements.arrays
     cell_hgen = el["hgen"][fem.cell_element]
@@ -197,6 +199,16 @@ def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> The
     return ThermalLoads(sources=sources, convection=convection, flux=flux,
                         contact_resistance=contact,
                         fixed_dofs=(fem.thermal_dof[fixed], values) if fixed.size else None)
+
+
+def _first_step_loads(session: Session) -> dict:
+    """Ramps of the first load step start from no load (NaN: zero, or TUNIF)."""
+    db = session.db
+    n_faces = db.faces.keys.size
+    return {"hgen": np.full(len(db.elements.ids), np.nan),
+            "d_temp": np.full(len(db.nodes.ids), np.nan),
+            "faces": {k: np.full(n_faces, np.nan) for k in ("conv_h", "conv_bulk", "hflux")},
+            "key": session.fem_key}
 
 
 def _snapshot(session: Session) -> dict:
@@ -281,6 +293,8 @@ def _constraints(session: Session, fem: FemModel) -> dict[str, str]:
     for label, nodal, face in (("UX", ux, face_ux), ("UY", uy, face_uy)):
         covered = np.zeros(nodal.size, bool)
         covered[fn[0, face]] = covered[fn[1, face]] = True
+        ends = fem.midside_ends  # a mid-side node between two held corners is held with them
+        covered[fem.midside_nodes] = covered[ends[0]] & covered[ends[1]]
         lone = nodal & ~covered & (fem.glued_dof >= 0)
         if lone.any():
             n = int(session.db.nodes.ids[np.nonzero(lone)[0][0]])

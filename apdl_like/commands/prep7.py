@@ -261,3 +261,19 @@ def amesh(s: Session, c: Call) -> None:
         raise ApdlError("no unmeshed areas to mesh")
     mesh_areas(s, chosen)
     s.db.meshed_areas.update(chosen)
+
+
+@command("EMODIF", PREP7, 3)
+def emodif(s: Session, c: Call) -> None:
+    """EMODIF,IEL|ALL,MAT|TYPE|REAL,value: change an attribute of elements."""
+    from apdl_like.commands.loads import element_targets
+
+    what = c.label(2)
+    if what not in ("MAT", "TYPE", "REAL"):
+        raise ApdlError(f"field 2 must be MAT, TYPE or REAL, got {what or '(empty)'!r}")
+    value = _entity_number(c, 3, what)
+    if what == "TYPE" and value not in s.db.element_types:
+        raise ApdlError(f"element type {value} is not defined (ET first)")
+    idx = element_targets(s, c, 1)
+    getattr(s.db.elements, what.lower())[idx] = value
+    s.db.elements.version += 1

@@ -1,0 +1,232 @@
+"""apdl_like language layer: lexing, expressions, control flow, /INPUT, limits, errors."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from apdl_like.errors import ApdlError
+from apdl_like.expressions import evaluate
+from apdl_like.interpreter import MAX_LOOP_ITERATIONS
+from apdl_like.parser import lex_line, parse_deck
+from apdl_like.session import Session
+
+
+def run(text: str, **kw) -> Session:
+    s = Session(**kw)
+    s.run_text(text, "deck.inp")
+    return s
+
+
+# ------------------------------------------------------------------ lexing
+def test_fields_comments_and_case():
+    st_ = lex_line("nsel , s,LOC, x ,, 0.1  ! the outer face", "f", 3)
+    assert st_.name == "NSEL"
+    assert st_.fields == ("s", "LOC", "x", "", "0.1")
+    assert lex_line("   ! only a comment", "f", 1) is None
+    assert lex_line("Ri = 0.02 ! m", "f", 1).fields == ("RI", "0.02")
+    com = lex_line("/COM, keep ! this, text", "f", 1)
+    assert com.name == "/COM" and com.fields == ("keep ! this, text",)
+
+
+@pytest.mark.parametrize("text, value", [
+    ("1+2*3", 7.0), ("-2**2", -4.0), ("2**3**2", 512.0), ("(1+2)*3/4", 2.25),
+    ("1.5D3", 1500.0), (".5e-1", 0.05), ("2*-3", -6.0), ("SQRT(16)+ABS(-1)", 5.0),
+    ("max(1,7,3)-min(4,2)", 5.0), ("exp(log(3))", 3.0), ("atan(1)*4", math.pi),
+    ("sin(0)+cos(0)+tan(0)", 1.0), ("a*B", 6.0),
+])
+def test_expressions_against_hand_values(text, value):
+    assert evaluate(text, {"A": 2.0, "B": 3.0}) == pytest.approx(value, rel=1e-15)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("1/0", "division by zero"), ("sqrt(-1)", "undefined"), ("(-8)**(1/3)", "not a real"),
+    ("10**400", "overflows"), ("x+1", "undefined parameter X"), ("foo(1)", "unknown function"),
+    ("1+", "unexpected end"), ("1 2", "unexpected"), ("max()", "unexpected"),
+    ("sqrt(1,2)", "takes 1 argument"), ("1e308*10", "not a finite"), ("a$b", "character"),
+    ("(" * 40 + "1" + ")" * 40, "nesting deeper"),
+])
+def test_expression_errors(text, message):
+    with pytest.raises(ApdlError, match=message):
+        evaluate(text, {"A": 1.0})
+
+
+def test_parameters_do_and_if():
+    s = run("""
+        TOTAL = 0
+        *DO,I,1,10
+          *IF,I,EQ,5,CYCLE
+          *IF,I,GT,8,EXIT
+          TOTAL = TOTAL + I
+        *ENDDO
+        *SET,K,2.5
+        *IF,K,LT,1,THEN
+          BRANCH = 1
+        *ELSEIF,K,LT,3
+          BRANCH = 2
+        *ELSE
+          BRANCH = 3
+        *ENDIF
+        *IF,K,GT,0,AND,K,LT,2,THEN
+          BOTH = 1
+        *ELSE
+          BOTH = 0
+        *ENDIF
+        *DO,J,3,1,-1
+          LAST = J
+        *ENDDO
+    """)
+    # 1+2+3+4+6+7+8 (5 cycled, 9 and 10 exited)
+    assert s.params["TOTAL"] == 31.0
+    assert s.params["BRANCH"] == 2.0 and s.params["BOTH"] == 0.0 and s.params["LAST"] == 1.0
+
+
+def test_nested_loops():
+    s = run("N = 0\n*DO,I,1,4\n*DO,J,1,I\nN = N + 1\n*ENDDO\n*ENDDO\n")
+    assert s.params["N"] == 10.0
+
+
+@pytest.mark.parametrize("deck, line, message", [
+    ("A = 1\nB = C + 1\n", 2, "undefined parameter C"),
+    ("/PREP7\nFROBNICATE,1\n", 2, "unknown or unsupported command FROBNICATE"),
+    ("*DO,I,1,3\nA = I\n", 1, "never closed"),
+    ("A = 1\n*ENDIF\n", 2, "does not close"),
+    ("*ELSE\n", 1, "without an open"),
+    ("*DO,I,1,3,0\n*ENDDO\n", 1, "must not be zero"),
+    (f"*DO,I,1,{MAX_LOOP_ITERATIONS + 1}\n*ENDDO\n", 1, "exceeds the limit"),
+    ("/PREP7\nN,1,0,0\nN,2,1,0\nET,1,PLANE55\nE,1,2,7\n", 5, "node 7 does not exist"),
+    ("/PREP7\nN,1,0,0,0.5\n", 2, "Z"),
+    ("N,1,0,0\n", 1, "not valid in the begin level"),
+    ("/PREP7\nMP,KXX,1,-5\n", 2, "KXX must be positive"),
+    ("/PREP7\nET,1,SOLID999\n", 2, "not supported"),
+    ("/SOLU\nANTYPE,STATIC\nTIME,1\n", 3, "never solved"),
+    ("/INPUT,../secret,inp\n", 1, "outside the deck's folder"),
+    ("*IF,1,EQ,1,:LABEL\n", 1, "GO labels are not supported"),
+    ("A = 'text'\n", 1, "character parameters"),
+])
+def test_bad_decks_name_file_line_and_command(deck, line, message, tmp_path):
+    s = Session(base_dir=tmp_path)
+    with pytest.raises(ApdlError, match=message) as info:
+        s.run_text(deck, "deck.inp")
+    assert info.value.file == "deck.inp"
+    assert info.value.line == line
+    assert str(info.value).startswith(f"deck.inp:{line}: ")
+
+
+def test_runaway_loops_stop(tmp_path):
+    # nested loops: each small, the product over the limit
+    deck = "*DO,I,1,1000\n*DO,J,1,1000\n*ENDDO\n*ENDDO\n"
+    with pytest.raises(ApdlError, match="loop iterations"):
+        run(deck)
+
+
+def test_input_stays_in_the_deck_folder(tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "part.mac").write_text("FROM_PART = A * 2\n/INPUT,sub/leaf,inp\n")
+    (tmp_path / "sub" / "leaf.inp").write_text("LEAF = 1\nB = UNDEFINED_NAME\n")
+    (tmp_path / "main.inp").write_text("A = 21\n/INPUT,sub/part,mac\n")
+    s = Session()
+    with pytest.raises(ApdlError, match="undefined parameter UNDEFINED_NAME") as info:
+        s.run_file(tmp_path / "main.inp")
+    assert info.value.file.endswith("leaf.inp") and info.value.line == 2
+    assert s.params["FROM_PART"] == 42.0 and s.params["LEAF"] == 1.0
+    outside = tmp_path.parent / f"{tmp_path.name}_outside.inp"
+    outside.write_text("X = 1\n")
+    (tmp_path / "escape.inp").write_text(f"/INPUT,../{outside.name}\n")
+    with pytest.raises(ApdlError, match="outside the deck's folder"):
+        Session().run_file(tmp_path / "escape.inp")
+    (tmp_path / "self.inp").write_text("/INPUT,self,inp\n")
+    with pytest.raises(ApdlError, match="nested deeper"):
+        Session().run_file(tmp_path / "self.inp")
+
+
+def test_file_size_limit(tmp_path, monkeypatch):
+    import apdl_like.parser as parser
+
+    monkeypatch.setattr(parser, "MAX_DECK_BYTES", 100)
+    big = tmp_path / "big.inp"
+    big.write_text("A = 1\n" * 50)
+    with pytest.raises(ApdlError, match="over the 0 MB limit|larger than"):
+        Session().run_file(big)
+
+
+# -------------------------------------------------------------- fuzzing
+VALID_DECK = """/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,50
+*DO,I,0,4
+N,I+1,0.01+0.01*I,0
+N,I+11,0.01+0.01*I,0.01
+*ENDDO
+*DO,I,1,4
+E,I,I+1,I+11,I+10
+*ENDDO
+/SOLU
+NSEL,S,LOC,X,0.01
+SF,ALL,HFLUX,1E4
+NSEL,S,LOC,X,0.05
+D,ALL,TEMP,20
+ALLSEL
+SOLVE
+*GET,T1,NODE,1,TEMP
+"""
+_LINES = VALID_DECK.splitlines()
+
+
+def _only_apdl_errors(text: str) -> None:
+    try:
+        Session().run_text(text, "fuzz.inp")
+    except ApdlError:
+        pass
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.text(alphabet=st.characters(codec="utf-8", exclude_categories=["Cs"]), max_size=300))
+def test_fuzz_arbitrary_text(text):
+    _only_apdl_errors(text)
+
+
+_TOKENS = st.sampled_from(["", ",", "ALL", "-1", "0", "1e400", "I", "*DO", "*ENDDO", "*IF",
+                           "(", ")", "**", "X", "TEMP", "/INPUT", "1/0", "'", "!", "P", "99"])
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.integers(0, len(_LINES) - 1),
+                          st.sampled_from(["drop", "dup", "edit", "swap"]), _TOKENS,
+                          st.integers(0, 60)), max_size=4))
+def test_fuzz_mutated_valid_deck(mutations):
+    lines = list(_LINES)
+    for index, how, token, pos in mutations:
+        index %= len(lines) if lines else 1
+        if not lines:
+            break
+        if how == "drop":
+            del lines[index]
+        elif how == "dup":
+            lines.insert(index, lines[index])
+        elif how == "swap":
+            j = (index + 1) % len(lines)
+            lines[index], lines[j] = lines[j], lines[index]
+        else:
+            line = lines[index]
+            p = min(pos, len(line))
+            lines[index] = line[:p] + token + line[p + 1:]
+    _only_apdl_errors("\n".join(lines))
+
+
+def test_the_fuzzed_deck_itself_is_valid():
+    s = run(VALID_DECK)
+    # q ri / k ln(ro / ri) + T_o, the log profile of a hollow cylinder (4 elements: ~1 %)
+    exact = 20.0 + 1e4 * 0.01 / 50 * math.log(5.0)
+    assert s.params["T1"] == pytest.approx(exact, rel=0.02)
+
+
+def test_parse_only_never_raises_other_errors():
+    for text in ["\x00", "*DO", ",,,", "=", "A==1", "1A = 2", "*IF,1,EQ,1,THEN\n*ELSE\n*ELSE"]:
+        try:
+            parse_deck(text)
+        except ApdlError:
+            pass

@@ -1,0 +1,241 @@
+"""apdl_like session for the twin: window decks, operator reuse, load-set round trip, CDB
+exchange with mapdl-archive, and the `apdl-like` CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from apdl_like.errors import ApdlError
+from apdl_like.loadset import LoadSet, read_window_deck
+from apdl_like.session import Session
+from apdl_like.writer import DeckLayout, window_deck
+from twin.fem import AxiMesh, Material, ThermalLoads, ThermalProblem
+
+STEEL = Material(k=49.8, rho=7830.0, c=465.0, E=210e9, nu=0.265, alpha=12.2e-6)
+BRONZE = Material(k=60.0, rho=8800.0, c=380.0)
+
+
+@pytest.fixture(scope="module")
+def mesh() -> AxiMesh:
+    r = np.linspace(0.0, 0.04, 13)
+    z = np.linspace(0.0, 0.08, 25)
+    return AxiMesh.structured(
+        r, z,
+        regions={"shaft": lambda r, z: r < 0.02, "sleeve": lambda r, z: r > 0.02,
+                 "bearing_front": lambda r, z: (r > 0.02) & (z > 0.05),
+                 "bearing_rear": lambda r, z: (r > 0.02) & (z < 0.02)},
+        boundaries={"coolant": lambda r, z: np.isclose(r, 0.04),
+                    "nose_face": lambda r, z: np.isclose(z, 0.08),
+                    "mount": lambda r, z: np.isclose(z, 0.0)},
+        interfaces={"contact_front": lambda r, z: np.isclose(r, 0.02)},
+    )
+
+
+def loadset(window: int, q_front: float = 1.1e6, r_front: float = 1.5e-4) -> LoadSet:
+    return LoadSet(window=window, start_s=60.0 * window,
+                   heat_generation={"bearing_front": q_front, "bearing_rear": 4.0e5},
+                   convection={"coolant": (450.0, 22.5), "nose_face": (12.0, 24.0)},
+                   contact_resistance={"contact_front": r_front})
+
+
+def test_window_deck_round_trip(mesh):
+    ls = loadset(7)
+    deck = window_deck(ls, DeckLayout.for_mesh(mesh))
+    back = read_window_deck(deck, Session.from_mesh(mesh, {"shaft": STEEL, "sleeve": BRONZE}))
+    assert back == ls
+
+
+finite = st.floats(min_value=1e-9, max_value=1e9, allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=40, deadline=None)
+@given(window=st.integers(0, 10_000), dt=st.floats(0.01, 100.0), n=st.integers(1, 50),
+       q=st.floats(-1e9, 1e9), h=st.floats(0.0, 1e5), tb=st.floats(-50.0, 500.0),
+       r=finite)
+def test_round_trip_is_exact_for_any_values(mesh, window, dt, n, q, h, tb, r):
+    ls = LoadSet(window=window, start_s=window * n * dt, dt_s=dt, n_steps=n,
+                 heat_generation={"bearing_rear": q}, convection={"coolant": (h, tb)},
+                 contact_resistance={"contact_front": r})
+    deck = window_deck(ls, DeckLayout.for_mesh(mesh))
+    back = read_window_deck(deck, Session.from_mesh(mesh, {"shaft": STEEL, "sleeve": BRONZE}))
+    assert back == ls
+    # the resistance the solver uses is the given one to the last bit or within one ulp
+    assert math.isclose(back.contact_resistance["contact_front"], r, rel_tol=2.3e-16)
+
+
+def test_window_decks_reuse_operators_and_match_the_fem_api(mesh):
+    mats = {"shaft": STEEL, "sleeve": BRONZE}
+    s = Session.from_mesh(mesh, mats, T_initial_C=20.0)
+    s.run_text(window_deck(loadset(0), s.layout), "window_000.inp")
+    problem = s.thermal
+    terms = set(problem.ops._terms)
+    sources = set(problem._source_vectors)
+    T_first = s.state.copy()
+    s.run_text(window_deck(loadset(1, q_front=1.3e6, r_front=1.1e-4), s.layout), "w1.inp")
+    assert s.thermal is problem  # mesh, materials, operators kept
+    assert set(problem.ops._terms) == terms and set(problem._source_vectors) == sources
+    assert s.time == 120.0 and len(s.substep_temperatures) == 15
+
+    # the same two windows through twin.fem directly, loads written by hand
+    ref = ThermalProblem(mesh, mats)
+    T = np.full(ref.n_dofs, 20.0)
+    for q_front, r_front in ((1.1e6, 1.5e-4), (1.3e6, 1.1e-4)):
+        stepper = ref.transient(ThermalLoads(
+            sources={"bearing_front": q_front, "bearing_rear": 4.0e5},
+            convection={"coolant": (450.0, 22.5), "nose_face": (12.0, 24.0)},
+            contact_resistance={"contact_front": r_front}), dt=4.0)
+        for _ in range(15):
+            T = stepper.step(T)
+        if q_front == 1.1e6:
+            np.testing.assert_allclose(T_first, T, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(s.state, T, rtol=1e-12, atol=1e-12)
+
+
+def test_window_deck_needs_its_session_components(mesh):
+    s = Session()  # no model
+    with pytest.raises(ApdlError, match="does not exist"):
+        s.run_text(window_deck(loadset(0), DeckLayout.for_mesh(mesh)), "w.inp")
+
+
+def test_window_deck_round_trip_on_the_spindle_mesh():
+    from twin.spindle.model import DEFAULT_MESH_PATH, fem_material
+    from twin.spindle.spec import load_spec
+
+    spec = load_spec()
+    mesh = AxiMesh.from_msh(DEFAULT_MESH_PATH, interfaces=spec.interfaces())
+    materials = {region: fem_material(spec, region) for region in spec.regions}
+    layout = DeckLayout.for_mesh(mesh)
+    ls = LoadSet(
+        window=3, start_s=180.0,
+        heat_generation={name: 1e5 * (i + 1) for i, name in enumerate(sorted(mesh.regions))},
+        convection={name: (10.0 * (i + 1), 20.0 + i) for i, name in
+                    enumerate(sorted(mesh.boundaries))},
+        contact_resistance={name: 1e-4 * (i + 1) for i, name in
+                            enumerate(sorted(mesh.interfaces))})
+    # every region and boundary maps back to itself: the node components of the
+    # boundaries select exactly their own faces
+    assert read_window_deck(window_deck(ls, layout), Session.from_mesh(mesh, materials)) == ls
+
+
+# ----------------------------------------------------------------- CDB
+def test_export_cdb_reads_back_with_mapdl_archive(tmp_path):
+    from mapdl_archive import Archive
+
+    from twin.spindle.model import DEFAULT_MESH_PATH
+    from twin.spindle.spec import load_spec
+
+    out = tmp_path / "spindle.cdb"
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "export-cdb", "--out", str(out),
+                           "--quiet"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    mesh = AxiMesh.from_msh(DEFAULT_MESH_PATH, interfaces=load_spec().interfaces())
+    archive = Archive(str(out))
+    assert archive.n_node == mesh.thermal.p.shape[1]
+    assert archive.n_elem == mesh.n_cells
+    assert len(archive.element_components) == len(mesh.regions)
+    assert len(archive.node_components) == len(mesh.boundaries) + 2 * len(mesh.interfaces)
+    # and our own /INPUT reads the same archive
+    (tmp_path / "read.inp").write_text("/INPUT,spindle,cdb\n*GET,NN,NODE,0,NUM,COUNT\n"
+                                       "*GET,NE,ELEM,0,NUM,COUNT\n")
+    s = Session()
+    s.run_file(tmp_path / "read.inp")
+    assert s.params["NN"] == archive.n_node and s.params["NE"] == archive.n_elem
+    assert len(s.db.components) == len(archive.element_components) + len(
+        archive.node_components)
+
+
+def test_input_of_a_cdb_written_by_mapdl_archive(tmp_path):
+    """mapdl-archive writes triangles as SHELL181; the deck redefines the type as PLANE55
+    axisymmetric and solves the hollow-cylinder log profile."""
+    import pyvista as pv
+    from mapdl_archive import save_as_archive
+    from skfem import MeshTri
+
+    ri, ro, h, k, q = 0.02, 0.05, 0.01, 50.0, 2e5
+    base = MeshTri.init_tensor(np.linspace(ri, ro, 31), np.linspace(0.0, h, 3))
+    points = np.column_stack([base.p.T, np.zeros(base.p.shape[1])])
+    cells = np.hstack([np.full((base.t.shape[1], 1), 3), base.t.T]).ravel()
+    grid = pv.UnstructuredGrid(cells, np.full(base.t.shape[1], pv.CellType.TRIANGLE), points)
+    save_as_archive(str(tmp_path / "strip.cdb"), grid)
+    (tmp_path / "deck.inp").write_text(f"""
+/INPUT,strip,cdb
+/PREP7
+ET,4,PLANE55
+KEYOPT,4,3,1
+EMODIF,ALL,MAT,1        ! mapdl-archive numbers a material per cell
+MP,KXX,1,{k}
+FINISH
+/SOLU
+NSEL,S,LOC,X,{ri}
+SF,ALL,HFLUX,{q}
+NSEL,S,LOC,X,{ro}
+D,ALL,TEMP,30
+ALLSEL
+SOLVE
+*GET,T_IN,NODE,NODE({ri},0),TEMP
+""")
+    s = Session()
+    s.run_file(tmp_path / "deck.inp")
+    exact = 30.0 + q * ri / k * math.log(ro / ri)
+    assert s.params["T_IN"] == pytest.approx(exact, rel=2e-3)
+
+
+# ------------------------------------------------------------------ CLI
+def test_cli_run_writes_params_and_vtu(tmp_path):
+    import meshio
+
+    deck = tmp_path / "d.inp"
+    deck.write_text("""/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,10
+RECTNG,0.01,0.02,0,0.01
+ESIZE,0.005
+AMESH,ALL
+/SOLU
+NSEL,S,LOC,X,0.01
+D,ALL,TEMP,100
+NSEL,S,LOC,X,0.02
+D,ALL,TEMP,50
+ALLSEL
+SOLVE
+FINISH
+/POST1
+PRNSOL,TEMP
+*GET,NMAX,NODE,0,NUM,MAX
+""")
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
+                           str(out)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    params = json.loads((out / "params.json").read_text())
+    assert set(params) == {"NMAX"}
+    vtu = meshio.read(out / "result_001.vtu")
+    T = vtu.point_data["TEMP"]
+    r = vtu.points[:, 0]
+    # T = T_i − (T_i − T_o) ln(r/r_i)/ln(r_o/r_i): the nodes on the two radii are exact
+    assert np.allclose(T[np.isclose(r, 0.01)], 100.0) and np.allclose(T[np.isclose(r, 0.02)],
+                                                                          50.0)
+    assert "PRNSOL" in (out / "log.txt").read_text()
+
+
+@pytest.mark.parametrize("text, where", [
+    ("/PREP7\nN,1,0,0\nBOGUS,1\n", "d.inp:3: BOGUS"),
+    ("/SOLU\nSOLVE\n", "d.inp:2: SOLVE"),
+    ("A = 1/0\n", "d.inp:1: A="),
+])
+def test_cli_bad_deck_exits_2_without_traceback(tmp_path, text, where):
+    deck = tmp_path / "d.inp"
+    deck.write_text(text)
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
+                           str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert where in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "o" / "params.json").exists()

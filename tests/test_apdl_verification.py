@@ -1,0 +1,331 @@
+"""Deck-based verification of apdl_like on twin.fem against closed forms.
+
+Every expected value is a textbook formula evaluated here, never a number from the code.
+Meshes come both from N/E commands and from RECTNG/ESIZE/AMESH.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from apdl_like.session import Session
+
+RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
+K = 50.0  # W/mK
+
+
+def run(text: str) -> Session:
+    s = Session()
+    s.run_text(text, "verify.inp")
+    return s
+
+
+def ring_nodes_elements(n: int, element: str, quad8: bool = False) -> str:
+    """N/E of a radial strip RI..RO × 0..H with n elements (4-node or 8-node quads)."""
+    if not quad8:
+        return f"""
+ET,1,{element},,,1
+*DO,I,0,{n}
+  N,I+1,RI+(RO-RI)*I/{n},0
+  N,I+1001,RI+(RO-RI)*I/{n},H
+*ENDDO
+*DO,I,1,{n}
+  E,I,I+1,I+1001,I+1000
+*ENDDO
+"""
+    # corner nodes at even positions, mid-side nodes at odd ones (2n+1 along r)
+    return f"""
+ET,1,{element},,,1
+*DO,I,0,{2 * n}
+  N,I+1,RI+(RO-RI)*I/{2 * n},0
+  N,I+1001,RI+(RO-RI)*I/{2 * n},H
+*ENDDO
+*DO,I,0,{n}
+  N,2*I+2001,RI+(RO-RI)*2*I/{2 * n},H/2
+*ENDDO
+*DO,I,1,{n}
+  A0 = 2*I-1
+  E,A0,A0+2,A0+1002,A0+1000,A0+1,2*I+2001,A0+1001,2*I+1999
+*ENDDO
+"""
+
+
+AMESH_STRIP = """
+ET,1,{element},,,1
+RECTNG,RI,RO,0,H
+ESIZE,{size}
+AMESH,ALL
+"""
+
+
+def log_profile(r, q_in, t_outer):
+    """Hollow cylinder, flux q_in (W/m²) into the bore at RI, T fixed at RO."""
+    return t_outer + q_in * RI / K * np.log(RO / r)
+
+
+MESHES = {
+    "N/E PLANE55": (ring_nodes_elements(20, "PLANE55"), 3e-3),
+    "N/E PLANE77": (ring_nodes_elements(10, "PLANE77", quad8=True), 2e-4),
+    "AMESH PLANE55": (AMESH_STRIP.format(element="PLANE55", size=0.002), 3e-3),
+    "AMESH PLANE77": (AMESH_STRIP.format(element="PLANE77", size=0.004), 3e-4),
+}
+
+
+@pytest.mark.parametrize("name", list(MESHES))
+def test_steady_flux_and_fixed_temperature(name):
+    mesh, tol = MESHES[name]
+    s = run(f"""
+/PREP7
+RI = {RI}
+RO = {RO}
+H = {H}
+{mesh}
+MP,KXX,1,{K}
+/SOLU
+ANTYPE,STATIC
+NSEL,S,LOC,X,RI
+SF,ALL,HFLUX,2E5
+NSEL,S,LOC,X,RO
+D,ALL,TEMP,30
+ALLSEL
+SOLVE
+*GET,T_IN,NODE,NODE(RI,0),TEMP
+*GET,T_MID,NODE,NODE((RI+RO)/2,H),TEMP
+X_MID = NX(NODE((RI+RO)/2,H))
+""")
+    p = s.params
+    assert p["T_IN"] == pytest.approx(log_profile(RI, 2e5, 30.0), rel=tol)
+    assert p["T_MID"] == pytest.approx(log_profile(p["X_MID"], 2e5, 30.0), rel=tol)
+
+
+@pytest.mark.parametrize("name", ["N/E PLANE55", "AMESH PLANE77"])
+def test_steady_convection(name):
+    mesh, tol = MESHES[name]
+    h, t_bulk, q = 800.0, 25.0, 1e5
+    s = run(f"""
+/PREP7
+RI = {RI}
+RO = {RO}
+H = {H}
+{mesh}
+MP,KXX,1,{K}
+FINISH
+/SOLU
+NSEL,S,LOC,X,RI
+SF,ALL,HFLUX,{q}
+NSEL,S,LOC,X,RO
+SF,ALL,CONV,{h},{t_bulk}
+ALLSEL
+SOLVE
+FINISH
+/POST1
+*GET,T_IN,NODE,NODE(RI,H),TEMP
+*GET,T_OUT,NODE,NODE(RO,0),TEMP
+""")
+    t_out = t_bulk + q * RI / (h * RO)  # all heat entering at RI leaves at RO
+    t_in = t_out + q * RI / K * math.log(RO / RI)
+    assert s.params["T_OUT"] == pytest.approx(t_out, rel=tol)
+    assert s.params["T_IN"] == pytest.approx(t_in, rel=tol)
+
+
+def test_convection_by_sfe_on_element_faces():
+    """SFE (element face 2 = J-K, the outer face of the last element) = SF on those nodes."""
+    h, t_bulk, q = 800.0, 25.0, 1e5
+    s = run(f"""
+/PREP7
+RI = {RI}
+RO = {RO}
+H = {H}
+{ring_nodes_elements(20, "PLANE55")}
+MP,KXX,1,{K}
+/SOLU
+SFE,1,4,HFLUX,,{q}
+SFE,20,2,CONV,1,{h}
+SFE,20,2,CONV,2,{t_bulk}
+SOLVE
+*GET,T_OUT0,NODE,21,TEMP
+*GET,T_OUT1,NODE,1021,TEMP
+""")
+    # the heat balance holds exactly for the face mean (both ends of the face are at RO)
+    t_mean = 0.5 * (s.params["T_OUT0"] + s.params["T_OUT1"])
+    assert t_mean == pytest.approx(t_bulk + q * RI / (h * RO), rel=1e-9)
+
+
+TRANSIENT_BLOCK = """
+/PREP7
+ET,1,PLANE55
+KEYOPT,1,3,1
+MP,KXX,1,45
+MP,DENS,1,7800
+MP,C,1,460
+RECTNG,0.01,0.03,0,0.02
+ESIZE,0.005
+AMESH,ALL
+/SOLU
+ANTYPE,TRANS
+TUNIF,20
+BFE,ALL,HGEN,,5E6
+TIME,12
+DELTIM,1.5
+KBC,{kbc}
+SOLVE
+*GET,T_A,NODE,1,TEMP
+*GET,T_B,NODE,NODE(0.03,0.02),TEMP
+"""
+
+
+def test_transient_uniform_heating_stepped():
+    """Insulated body, uniform HGEN: T = T0 + q t/(ρc) exactly (any mesh, any Δt)."""
+    s = run(TRANSIENT_BLOCK.format(kbc=1))
+    expected = 20.0 + 5e6 * 12.0 / (7800 * 460)
+    assert s.params["T_A"] == pytest.approx(expected, rel=1e-10)
+    assert s.params["T_B"] == pytest.approx(expected, rel=1e-10)
+    assert len(s.substep_temperatures) == 8
+
+
+def test_transient_uniform_heating_ramped():
+    """KBC,0 ramps HGEN from 0: backward Euler adds q·(k/n)·Δt/(ρc) in step k, so
+    T(t_end) = T0 + q Δt (n+1) / (2 ρc) (hand sum over n = 8 steps)."""
+    s = run(TRANSIENT_BLOCK.format(kbc=0))
+    expected = 20.0 + 5e6 * 1.5 * 9 / (2 * 7800 * 460)
+    assert s.params["T_A"] == pytest.approx(expected, rel=1e-10)
+
+
+def test_transient_conduction_series_solution():
+    """Slab 0..L (a cylinder insulated on r), T(0, t) = T1 for t > 0, insulated at z = L:
+    T(L, t) = T1 + (T0 − T1) Σ 4(−1)^n/((2n+1)π) exp(−((2n+1)π/2L)² α t)."""
+    k, rho, c, L, t_end = 1.0, 1000.0, 1000.0, 0.01, 20.0
+    alpha = k / (rho * c)
+    s = run(f"""
+/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,{k}
+MP,DENS,1,{rho}
+MP,C,1,{c}
+NZE = 40
+*DO,I,0,NZE
+  N,I+1,0.01,{L}*I/NZE
+  N,I+101,0.02,{L}*I/NZE
+*ENDDO
+*DO,I,1,NZE
+  E,I,I+100,I+101,I+1
+*ENDDO
+/SOLU
+ANTYPE,TRANS
+TUNIF,0
+NSEL,S,LOC,Y,0
+D,ALL,TEMP,100
+ALLSEL
+KBC,1
+TIME,{t_end}
+DELTIM,0.05
+SOLVE
+*GET,T_END,NODE,NZE+1,TEMP
+""")
+    series = sum(4 * (-1) ** n / ((2 * n + 1) * math.pi)
+                 * math.exp(-((2 * n + 1) * math.pi / (2 * L)) ** 2 * alpha * t_end)
+                 for n in range(50))
+    expected = 100.0 + (0.0 - 100.0) * series
+    # backward Euler with Δt = 0.05 s: first-order error ≈ 0.4 °C of the 100 °C step
+    assert s.params["T_END"] == pytest.approx(expected, abs=0.6)
+
+
+STRESS_STEPS = """
+/SOLU
+ANTYPE,STATIC
+D,ALL,TEMP,{t_hot}
+SOLVE
+FINISH
+/PREP7
+ETCHG,TTS
+MP,EX,1,{E}
+MP,PRXY,1,{nu}
+MP,ALPX,1,{alpha}
+TREF,20
+/SOLU
+DDELE,ALL,TEMP
+NSEL,S,LOC,X,{ro}
+D,ALL,UX,0
+NSEL,S,LOC,Y,0
+D,ALL,UY,0
+ALLSEL
+LDREAD,TEMP
+SOLVE
+FINISH
+/POST1
+NP = NODE({ro}/2,{h})
+*GET,UY_TOP,NODE,NP,U,Y
+*GET,UX_MID,NODE,NP,U,X
+*GET,S_R,NODE,NP,S,X
+*GET,S_Z,NODE,NP,S,Y
+*GET,S_HOOP,NODE,NP,S,Z
+*GET,S_EQV,NODE,NP,S,EQV
+"""
+
+
+@pytest.mark.parametrize("how", ["N/E", "AMESH"])
+def test_thermal_stress_radially_held_cylinder(how):
+    """Solid cylinder heated uniformly by ΔT, outer surface held radially, ends free:
+    u_r = 0, σ_rr = σ_θθ = −EαΔT/(1−ν), σ_zz = 0, u_z = αΔT (1+ν)/(1−ν) z."""
+    E, nu, alpha, dT, ro, h = 200e9, 0.3, 1.2e-5, 80.0, 0.04, 0.03
+    if how == "N/E":
+        mesh = f"""
+ET,1,PLANE55,,,1
+*DO,I,0,4
+  *DO,J,0,3
+    N,10*J+I+1,{ro}*I/4,{h}*J/3
+  *ENDDO
+*ENDDO
+*DO,I,1,4
+  *DO,J,0,2
+    E,10*J+I,10*J+I+1,10*J+I+11,10*J+I+10
+  *ENDDO
+*ENDDO
+"""
+    else:
+        mesh = f"ET,1,PLANE55\nKEYOPT,1,3,1\nRECTNG,0,{ro},0,{h}\nESIZE,0.01\nAMESH,ALL\n"
+    s = run(f"/PREP7\n{mesh}MP,KXX,1,40\n" + STRESS_STEPS.format(
+        t_hot=20 + dT, E=E, nu=nu, alpha=alpha, ro=ro, h=h))
+    p = s.params
+    sigma = -E * alpha * dT / (1 - nu)
+    assert p["UY_TOP"] == pytest.approx(alpha * dT * (1 + nu) / (1 - nu) * h, rel=1e-8)
+    assert abs(p["UX_MID"]) < 1e-8 * alpha * dT * ro
+    assert p["S_R"] == pytest.approx(sigma, rel=1e-6)
+    assert p["S_HOOP"] == pytest.approx(sigma, rel=1e-6)
+    assert abs(p["S_Z"]) < 1e-6 * abs(sigma)
+    assert p["S_EQV"] == pytest.approx(abs(sigma), rel=1e-6)
+
+
+def test_free_thermal_expansion_quadratic_triangles():
+    """PLANE183 as 6-node triangles (KEYOPT(1)=1) from AMESH, body temperature by BF:
+    a free body heated uniformly expands u_r = αΔT r with no stress."""
+    alpha, dT = 1.1e-5, 50.0
+    s = run(f"""
+/PREP7
+ET,1,PLANE183
+KEYOPT,1,1,1
+KEYOPT,1,3,1
+MP,EX,1,2E11
+MP,PRXY,1,0.28
+MP,ALPX,1,{alpha}
+TREF,20
+RECTNG,0.01,0.05,0,0.04
+ESIZE,0.01
+AMESH,ALL
+/SOLU
+NSEL,S,LOC,Y,0
+D,ALL,UY,0
+ALLSEL
+BF,ALL,TEMP,{20 + dT}
+SOLVE
+NP = NODE(0.05,0.04)
+*GET,UX_OUT,NODE,NP,U,X
+*GET,UY_TOP,NODE,NP,U,Y
+*GET,S_EQV,NODE,NP,S,EQV
+""")
+    assert s.params["UX_OUT"] == pytest.approx(alpha * dT * 0.05, rel=1e-8)
+    assert s.params["UY_TOP"] == pytest.approx(alpha * dT * 0.04, rel=1e-8)
+    assert s.params["S_EQV"] < 1e-6 * 2e11 * alpha * dT
