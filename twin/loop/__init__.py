@@ -7,4 +7,13 @@ batch       many runs: local processes or dask, resume, summary.json
 outputs     atomic writers (CSV, JSON, VTU, PVD)
 snapshot    headless field pictures (pyvista)
 report      the self-contained report.html
+training    simulate_for_training: a run replayed with `ratio` (training samples)
 """
+
+
+def __getattr__(name: str):  # noqa: ANN202 - lazy: keep `import twin.loop.x` light
+    if name == "simulate_for_training":
+        from twin.loop.training import simulate_for_training
+
+        return simulate_for_training
+    raise AttributeError(name)
