@@ -38,7 +38,7 @@ from apdl_like.model import Material as MpTable
 from apdl_like.parser import Program, parse_deck, read_deck
 from apdl_like.solve import TCC_LOCATION, StepResult
 from apdl_like.writer import DeckLayout, component_name
-from twin.fem import AxiMesh, Material
+from twin.fem import AxiMesh, Material, ThermalProblem
 
 
 class Session:
@@ -92,8 +92,13 @@ class Session:
         T_initial_C: float = 20.0,
         T_ref_C: float = 20.0,
         base_dir: str | Path | None = None,
+        thermal: ThermalProblem | None = None,
     ) -> Session:
-        """A session whose database holds `mesh` (see the module docstring for numbering)."""
+        """A session whose database holds `mesh` (see the module docstring for numbering).
+
+        thermal  an already assembled ThermalProblem of this mesh, materials and order to
+                 adopt instead of assembling another one
+        """
         from apdl_like.fem_bridge import FemModel
 
         s = cls(base_dir)
@@ -134,6 +139,10 @@ class Session:
         fem = FemModel(mesh, np.arange(n), np.arange(mesh.n_cells), order, db.nodes.ids)
         db.faces.rekey(fem.face_keys)
         s.fem, s.fem_key, s.external_mesh = fem, (db.nodes.version, db.elements.version), True
+        if thermal is not None:
+            from apdl_like.solve import adopt_thermal_problem
+
+            adopt_thermal_problem(s, thermal)
         return s
 
     def set_state(self, temperature: np.ndarray, time_s: float) -> None:

@@ -68,14 +68,16 @@ def _require(props: dict[str, float], label: str, mat: int, why: str) -> float:
 def _materials(session: Session, fem: FemModel, kind: str) -> dict[str, Material]:
     db = session.db
     mats = {}
-    used = np.unique(db.elements.mat[fem.cell_element])
+    cell_mat = db.elements.mat[fem.cell_element]
     transient = session.db.settings.antype == "TRANS"
-    for m in used:
+    for m in np.unique(cell_mat):
         m = int(m)
         props = db.materials.get(m)
         if props is None:
             raise ApdlError(f"material {m} is used by elements but has no MP properties")
         p = props.props
+        # the region of these cells: the mesh's own name when it has exactly this set
+        region = fem.region_for(np.nonzero(cell_mat == m)[0])
         try:
             if kind == "thermal":
                 k = _require(p, "KXX", m, "for heat conduction")
@@ -83,17 +85,15 @@ def _materials(session: Session, fem: FemModel, kind: str) -> dict[str, Material
                     p.get("DENS", _PLACEHOLDER)
                 c = _require(p, "C", m, "for a transient") if transient else \
                     p.get("C", _PLACEHOLDER)
-                mats[f"MAT{m}"] = Material(k=k, rho=rho, c=c, name=f"MAT{m}")
+                mats[region] = Material(k=k, rho=rho, c=c, name=f"MAT{m}")
             else:
                 E = _require(p, "EX", m, "for a structural analysis")
                 nu = p.get("PRXY", p.get("NUXY", 0.3))
-                mats[f"MAT{m}"] = Material(k=p.get("KXX", _PLACEHOLDER), rho=_PLACEHOLDER,
-                                           c=_PLACEHOLDER, E=E, nu=nu, alpha=p.get("ALPX", 0.0),
-                                           name=f"MAT{m}")
+                mats[region] = Material(k=p.get("KXX", _PLACEHOLDER), rho=_PLACEHOLDER,
+                                        c=_PLACEHOLDER, E=E, nu=nu, alpha=p.get("ALPX", 0.0),
+                                        name=f"MAT{m}")
         except ValueError as exc:
             raise ApdlError(str(exc)) from None
-        if f"MAT{m}" not in fem.mesh.regions:
-            fem.mesh.add_region(f"MAT{m}", np.nonzero(db.elements.mat[fem.cell_element] == m)[0])
     return mats
 
 
@@ -108,6 +108,19 @@ def thermal_problem(session: Session, fem: FemModel) -> ThermalProblem:
         session.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
         session.thermal_key = key
     return session.thermal  # type: ignore[return-value]
+
+
+def adopt_thermal_problem(session: Session, problem: ThermalProblem) -> None:
+    """Use an assembled ThermalProblem (same mesh, materials and order) as the cached one."""
+    fem = fem_model(session)
+    if problem.mesh is not fem.mesh or problem.order != fem.order:
+        raise ValueError("the ThermalProblem belongs to another mesh or element order")
+    mats = _materials(session, fem, "thermal")
+    by_constants = sorted((m.k, m.rho_c) for m in mats.values())
+    if by_constants != sorted((m.k, m.rho_c) for m in problem.materials.values()):
+        raise ValueError("the ThermalProblem has other materials than the session")
+    session.thermal = problem
+    session.thermal_key = (id(fem), _material_key(mats), fem.order)
 
 
 def _check_axisymmetric(session: Session, physics: str) -> None:

@@ -99,6 +99,16 @@ def test_window_decks_reuse_operators_and_match_the_fem_api(mesh):
     np.testing.assert_allclose(s.state, T, rtol=1e-12, atol=1e-12)
 
 
+def test_session_adopts_an_assembled_thermal_problem(mesh):
+    mats = {"shaft": STEEL, "sleeve": BRONZE}
+    problem = ThermalProblem(mesh, mats)
+    s = Session.from_mesh(mesh, mats, thermal=problem)
+    s.run_text(window_deck(loadset(0), s.layout), "w.inp")
+    assert s.thermal is problem
+    with pytest.raises(ValueError, match="other materials"):
+        Session.from_mesh(mesh, {"shaft": STEEL, "sleeve": STEEL}, thermal=problem)
+
+
 def test_window_deck_needs_its_session_components(mesh):
     s = Session()  # no model
     with pytest.raises(ApdlError, match="does not exist"):
