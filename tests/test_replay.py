@@ -24,18 +24,21 @@ os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
 MINUTES = 5
 
 
-def make_recorded_run(path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15,
-                      resistance=0.7, seed=0):
+def make_recorded_run(
+    path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7, seed=0
+):
     model = default_spindle()
     T = np.full(model.n_dofs, ambient_C)
     T0 = T.copy()
     times, temps, drift = [0.0], [model.sensor_matrix @ T], [0.0]
     for _ in range(minutes):
         s = model.sensor_matrix @ T
-        bc = nominal_conditions(model, speed_rpm, ambient_C, None,
-                                T_bearings_C=(s[0], s[2]), T_sleeves_C=(s[1], s[3]))
-        loads = bc.to_thermal_loads(H_front=heat * bc.H_front, H_rear=heat * bc.H_rear,
-                                    R_front=resistance * bc.R_front)
+        bc = nominal_conditions(
+            model, speed_rpm, ambient_C, None, T_bearings_C=(s[0], s[2]), T_sleeves_C=(s[1], s[3])
+        )
+        loads = bc.to_thermal_loads(
+            H_front=heat * bc.H_front, H_rear=heat * bc.H_rear, R_front=resistance * bc.R_front
+        )
         stepper = model.thermal.transient(loads, 4.0)
         for _ in range(15):
             T = stepper.step(T)
@@ -45,10 +48,13 @@ def make_recorded_run(path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, h
     rng = np.random.default_rng(seed)
     t = np.array(times)
     temps = np.array(temps) + 0.02 * rng.standard_normal((t.size, 5))
-    cols = {"time_s": t, "speed_rpm": np.full(t.size, speed_rpm),
-            "ambient_C": np.full(t.size, ambient_C),
-            **{f"T{i + 1}_C": temps[:, i] for i in range(5)},
-            "disp_z_um": np.array(drift) + 0.05 * rng.standard_normal(t.size)}
+    cols = {
+        "time_s": t,
+        "speed_rpm": np.full(t.size, speed_rpm),
+        "ambient_C": np.full(t.size, ambient_C),
+        **{f"T{i + 1}_C": temps[:, i] for i in range(5)},
+        "disp_z_um": np.array(drift) + 0.05 * rng.standard_normal(t.size),
+    }
     write_run(path, cols, {"source": "test: spindle model with +15 % heat, -30 % R_front"})
     return path
 
@@ -68,24 +74,45 @@ def invoke(*args):
 @pytest.fixture(scope="module")
 def replayed(runs_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("replay")
-    result = invoke("replay", str(runs_dir / "hot_9000.csv"), "--out", str(out),
-                    "--methods", "open_loop,ratio", "--snapshots", "end", "--quiet")
+    result = invoke(
+        "replay",
+        str(runs_dir / "hot_9000.csv"),
+        "--out",
+        str(out),
+        "--methods",
+        "open_loop,ratio",
+        "--snapshots",
+        "end",
+        "--quiet",
+    )
     assert result.exit_code == 0, result.output
     return out
 
 
 def test_replay_writes_the_design_layout_and_schemas(replayed, runs_dir):
     run_dir = replayed / "hot_9000"
-    for name in ("keypoints.csv", "corrections.csv", "accuracy.json", "quality.json",
-                 "fields.pvd", "decks"):
+    for name in (
+        "keypoints.csv",
+        "corrections.csv",
+        "accuracy.json",
+        "quality.json",
+        "fields.pvd",
+        "decks",
+    ):
         assert (run_dir / name).exists(), name
     acc = json.loads((run_dir / "accuracy.json").read_text())
     assert set(acc) == {"run", "speed_rpm", "ambient_C", "duration_s", "methods"}
     assert acc["speed_rpm"] == 9000.0 and acc["duration_s"] == 60.0 * MINUTES
     assert set(acc["methods"]) == {"open_loop", "ratio"}
     for metrics in acc["methods"].values():
-        assert set(metrics) == {"temperature_accuracy_pct", "temperature_rise_accuracy_pct",
-                                "deformation_accuracy_pct", "rmse_C", "rmse_um", "max_abs_C"}
+        assert set(metrics) == {
+            "temperature_accuracy_pct",
+            "temperature_rise_accuracy_pct",
+            "deformation_accuracy_pct",
+            "rmse_C",
+            "rmse_um",
+            "max_abs_C",
+        }
         assert set(metrics["rmse_C"]) == {"T1", "T2", "T3", "T4", "T5"}
     summary = json.loads((replayed / "summary.json").read_text())
     assert [r["run"] for r in summary["runs"]] == ["hot_9000"]
@@ -101,8 +128,10 @@ def test_corrections_move_the_twin_towards_the_measurement(replayed):
     acc = json.loads((replayed / "hot_9000" / "accuracy.json").read_text())["methods"]
     # the plant runs 15 % hotter than nominal: open loop must under-predict the rise
     assert acc["open_loop"]["temperature_rise_accuracy_pct"] < 97.0
-    assert (acc["ratio"]["temperature_rise_accuracy_pct"]
-            > acc["open_loop"]["temperature_rise_accuracy_pct"])
+    assert (
+        acc["ratio"]["temperature_rise_accuracy_pct"]
+        > acc["open_loop"]["temperature_rise_accuracy_pct"]
+    )
     assert acc["ratio"]["deformation_accuracy_pct"] > acc["open_loop"]["deformation_accuracy_pct"]
 
 
@@ -129,8 +158,19 @@ def test_snapshot_png_is_not_blank_and_has_the_size(replayed, runs_dir, tmp_path
     assert image.shape == (800, 1200, 3)
     assert image.std() > 10.0  # a field, not a blank canvas
     out = tmp_path / "t120.png"
-    result = invoke("snapshot", str(runs_dir / "hot_9000.csv"), "--time", "120", "--out",
-                    str(out), "--method", "ratio", "--field", "displacement", "--section")
+    result = invoke(
+        "snapshot",
+        str(runs_dir / "hot_9000.csv"),
+        "--time",
+        "120",
+        "--out",
+        str(out),
+        "--method",
+        "ratio",
+        "--field",
+        "displacement",
+        "--section",
+    )
     assert result.exit_code == 0, result.output
     assert np.asarray(Image.open(out).convert("RGB"), dtype=float).std() > 10.0
 
@@ -140,8 +180,18 @@ def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path
     bad.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C\n0,9000,25,25,25,25,25\n")
     before = bad.read_bytes()
     out = tmp_path / "out"
-    result = invoke("replay", str(bad), str(runs_dir / "hot_9000.csv"), "--out", str(out),
-                    "--methods", "open_loop", "--snapshots", "none", "--quiet")
+    result = invoke(
+        "replay",
+        str(bad),
+        str(runs_dir / "hot_9000.csv"),
+        "--out",
+        str(out),
+        "--methods",
+        "open_loop",
+        "--snapshots",
+        "none",
+        "--quiet",
+    )
     assert result.exit_code == 2
     assert "bad.csv" in result.output and "T5_C" in result.output
     assert "Traceback" not in result.output
@@ -153,8 +203,17 @@ def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path
 
 def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_path):
     out = tmp_path / "out"
-    args = [str(runs_dir / "hot_9000.csv"), str(runs_dir / "hot_12000.csv"), "--out", str(out),
-            "--methods", "open_loop", "--snapshots", "none", "--quiet"]
+    args = [
+        str(runs_dir / "hot_9000.csv"),
+        str(runs_dir / "hot_12000.csv"),
+        "--out",
+        str(out),
+        "--methods",
+        "open_loop",
+        "--snapshots",
+        "none",
+        "--quiet",
+    ]
     assert invoke("replay", *args).exit_code == 0
     # an interrupted run: its done-token never got written
     (out / "hot_12000" / ".done.json").unlink()
@@ -162,8 +221,14 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
     from twin.loop.batch import replay_batch
 
     seen = []
-    result = replay_batch([runs_dir / "hot_9000.csv", runs_dir / "hot_12000.csv"], out,
-                          ["open_loop"], None, resume=True, progress=lambda n, s: seen.append((n, s)))
+    result = replay_batch(
+        [runs_dir / "hot_9000.csv", runs_dir / "hot_12000.csv"],
+        out,
+        ["open_loop"],
+        None,
+        resume=True,
+        progress=lambda n, s: seen.append((n, s)),
+    )
     assert result.skipped == ["hot_9000"]
     assert ("hot_12000", "done") in seen
     assert (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns == stamp
@@ -178,10 +243,19 @@ def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
 
     seq = replay_batch(runs, tmp_path / "seq", ["ratio"], None, jobs=1)
     par = replay_batch(runs, tmp_path / "par", ["ratio"], None, jobs=2)
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                      host="127.0.0.1", dashboard_address=None) as cluster, Client(cluster):
-        dsk = replay_batch(runs, tmp_path / "dask", ["ratio"], None,
-                           dask_address=cluster.scheduler_address)
+    with (
+        LocalCluster(
+            n_workers=1,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+        ) as cluster,
+        Client(cluster),
+    ):
+        dsk = replay_batch(
+            runs, tmp_path / "dask", ["ratio"], None, dask_address=cluster.scheduler_address
+        )
     assert not seq.failed and not par.failed and not dsk.failed
     # deterministic: the same inputs give the same numbers whichever way they ran
     assert seq.accuracies == par.accuracies == dsk.accuracies
@@ -196,11 +270,25 @@ def test_report_rebuilds_from_a_folder(replayed):
 
 
 def test_cli_bad_input_is_exit_2_with_the_field(runs_dir, tmp_path):
-    result = invoke("replay", str(runs_dir / "hot_9000.csv"), "--out", str(tmp_path),
-                    "--methods", "open_loop,magic")
+    result = invoke(
+        "replay",
+        str(runs_dir / "hot_9000.csv"),
+        "--out",
+        str(tmp_path),
+        "--methods",
+        "open_loop,magic",
+    )
     assert result.exit_code == 2 and "--methods" in result.output and "magic" in result.output
-    result = invoke("snapshot", str(runs_dir / "hot_9000.csv"), "--time", "99999", "--out",
-                    str(tmp_path / "x.png"), "--method", "ratio")
+    result = invoke(
+        "snapshot",
+        str(runs_dir / "hot_9000.csv"),
+        "--time",
+        "99999",
+        "--out",
+        str(tmp_path / "x.png"),
+        "--method",
+        "ratio",
+    )
     assert result.exit_code == 2 and "--time" in result.output
     result = invoke("report", str(tmp_path / "nothing"))
     assert result.exit_code == 2

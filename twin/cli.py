@@ -65,6 +65,5 @@ def main() -> None:
 # functions); imported last because they use `command` from this module.
 from twin import commands  # noqa: E402, F401
 
-
 if __name__ == "__main__":
     sys.exit(main())

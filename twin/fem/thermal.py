@@ -411,18 +411,19 @@ class _LinearSolve:
 
 
 class _BaseFactorization:
-    """A factorized step matrix and its response to the interface jump columns.
+    """The step matrix without contact coupling, factorized, and its interface response.
 
-    When a new window changes only contact resistances (and sources, which touch just the
-    right-hand side), A_new = A_base + U W Uᵀ with U the interface jump columns (a few
-    dozen) and W = blockdiag(θ·Δ(1/R_i)·M_i).  Woodbury then gives
-        A_new⁻¹ b = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A_base⁻¹ b,  Z = A_base⁻¹ U,
-    so the window needs no sparse factorization at all.
+    The contact terms are low rank: A = A_base + U W Uᵀ with U the interface jump columns
+    (a few dozen) and W = blockdiag(θ·(1/R_i)·M_i).  Woodbury then gives
+        A⁻¹ b = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A_base⁻¹ b,  Z = A_base⁻¹ U,
+    so a window with new contact resistances needs no sparse factorization at all.  The
+    base leaves the contacts out entirely (rather than taking the first resistances seen),
+    so results never depend on which windows or runs came before: a batch gives the same
+    numbers in one process or many.
     """
 
-    def __init__(self, solver: _LinearSolve, coefficients: dict[str, float], U: sp.csc_matrix):
+    def __init__(self, solver: _LinearSolve, U: sp.csc_matrix):
         self.solver = solver
-        self.coefficients = coefficients
         self.U = U
         self.Z = solver.lu.solve(U.toarray()) if U.shape[1] else np.zeros((U.shape[0], 0))
         self.UtZ = U.T @ self.Z
@@ -431,9 +432,9 @@ class _BaseFactorization:
 class ThermalStepper:
     """θ-method time stepping with a fixed Δt and fixed loads.
 
-    The step matrix C/Δt + θK is factorized once per distinct set of film coefficients
-    (they change with speed); a window that changes only the contact resistances reuses
-    that factorization through a low-rank (Woodbury) update of the interface terms.
+    Without fixed temperatures, the step matrix C/Δt + θK less its contact terms is
+    factorized once per distinct set of film coefficients (they change with speed only),
+    and the contact terms of each window enter through a low-rank (Woodbury) update.
     """
 
     def __init__(self, problem: ThermalProblem, loads: ThermalLoads, dt: float, theta: float):
@@ -449,28 +450,26 @@ class ThermalStepper:
         if dofs.size or not problem.mesh.interfaces:
             self._solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
             return
-        films = tuple(sorted((k, v) for k, v in coeff.items() if k.startswith("film:")))
-        key = (dt, theta, films)
+        films = {k: v for k, v in coeff.items() if k.startswith("film:")}
+        key = (dt, theta, tuple(sorted(films.items())))
         base = problem._base_factorizations.get(key)
-        iface = {k: v for k, v in coeff.items() if k.startswith("interface:")}
         if base is None:
             if len(problem._base_factorizations) >= 8:  # bound memory: drop the oldest
                 problem._base_factorizations.pop(next(iter(problem._base_factorizations)))
             U = sp.hstack([problem._interface_factors[n][0] for n in problem.mesh.interfaces])
-            solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
-            base = _BaseFactorization(solver, iface, sp.csc_matrix(U))
+            k_base = problem.conduction_data + ops.data(films)
+            solver = _LinearSolve(ops.csr(c_data + theta * k_base), dofs, values)
+            base = _BaseFactorization(solver, sp.csc_matrix(U))
             problem._base_factorizations[key] = base
         self._solver = base.solver
-        blocks = [
-            theta
-            * (iface[f"interface:{n}"] - base.coefficients[f"interface:{n}"])
-            * problem._interface_factors[n][1]
-            for n in problem.mesh.interfaces
-        ]
-        if any(np.any(b) for b in blocks):
-            W = sla.block_diag(*blocks)
-            capacitance = np.eye(W.shape[0]) + W @ base.UtZ
-            self._update = (base, W, sla.lu_factor(capacitance))
+        W = sla.block_diag(
+            *[
+                theta * coeff[f"interface:{n}"] * problem._interface_factors[n][1]
+                for n in problem.mesh.interfaces
+            ]
+        )
+        capacitance = np.eye(W.shape[0]) + W @ base.UtZ
+        self._update = (base, W, sla.lu_factor(capacitance))
 
     def step(self, T: np.ndarray) -> np.ndarray:
         """Advance one Δt from nodal temperature T (°C)."""

@@ -19,18 +19,39 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def publish(tmp: str | Path, path: Path) -> Path:
+    """Move a finished temporary file into place with ordinary file permissions.
+
+    mkstemp creates files readable by their owner only; outputs are meant to be shared.
+    """
+    os.chmod(tmp, 0o666 & ~_umask())
+    os.replace(tmp, path)
+    return path
+
+
+def temporary_beside(path: Path, suffix: str) -> str:
+    """A new empty temporary file in `path`'s folder (created, closed)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=suffix)
+    os.close(fd)
+    return tmp
+
+
 def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    tmp = temporary_beside(path, ".tmp")
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
+        Path(tmp).write_bytes(data)
+        return publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
 
 
 def write_text_atomic(path: str | Path, text: str) -> Path:
@@ -74,16 +95,13 @@ def write_vtu_atomic(path: str | Path, mesh) -> Path:  # noqa: ANN001 - meshio.M
     import meshio
 
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".vtu")
-    os.close(fd)
+    tmp = temporary_beside(path, ".vtu")
     try:
         meshio.write(tmp, mesh, file_format="vtu")
-        os.replace(tmp, path)
+        return publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
 
 
 def write_pvd_atomic(path: str | Path, entries: Sequence[tuple[float, str]]) -> Path:

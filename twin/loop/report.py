@@ -122,7 +122,8 @@ def _plots(run_dir: Path) -> list[str]:
     ax2.set_title("correction factors per window")
     ax2.set_xlabel("window")
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=6, ncol=2)
+    if ax2.get_lines():  # open loop alone has no factors to show
+        ax2.legend(fontsize=6, ncol=2)
     out.append(_img(_png(fig), "drift and corrections"))
     return out
 

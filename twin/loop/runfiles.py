@@ -120,7 +120,7 @@ def replay_run_to_dir(
             meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
 
     accuracy = {
-        "run": run.name,
+        "run": run_name(run_path),
         "speed_rpm": float(np.mean(run.speed_rpm)),
         "ambient_C": float(np.mean(run.ambient_C)),
         "duration_s": float(run.duration_s),

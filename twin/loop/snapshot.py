@@ -9,7 +9,6 @@ annotated.  `twin replay --snapshots` and `twin snapshot` both use `render_snaps
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +34,7 @@ def render_snapshot(
     import pyvista as pv
 
     from twin.fields import field_arrays
+    from twin.loop.outputs import publish, temporary_beside
 
     if field not in FIELDS:
         raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")
@@ -108,12 +108,10 @@ def render_snapshot(
             (0.0, 0.0, 1.0),
         ]
     out_png = Path(out_png)
-    out_png.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out_png.parent, prefix=f".{out_png.stem}.", suffix=".png")
-    os.close(fd)
+    tmp = temporary_beside(out_png, ".png")
     try:
         plotter.screenshot(tmp)
-        os.replace(tmp, out_png)
+        publish(tmp, out_png)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

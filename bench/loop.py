@@ -1,0 +1,110 @@
+"""Replay benchmarks (issue 7 targets).
+
+- one 30 min run, three methods, no snapshots: wall time of `twin replay` in a fresh
+  process (everything a user waits for, imports and model load included) and of the
+  replay itself in a warm process; peak RSS of the fresh process;
+- a batch of 8 runs with --jobs 1 and --jobs 2 (speed-up; the machine has 2 cores).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+RUN = ROOT / "examples" / "runs" / "spindle_9000rpm_30min.csv"
+MODEL = ROOT / "examples" / "correction_model.safetensors"
+METHODS = "open_loop,ratio,bpnn"
+
+
+def _cli(*args: str) -> tuple[float, float]:
+    """Wall time (s) and peak RSS (MB) of `twin ARGS` in a fresh process."""
+    code = (
+        "import resource, sys, time; t = time.perf_counter()\n"
+        "from twin.cli import app\n"
+        "try:\n    app(sys.argv[1:], prog_name='twin')\nexcept SystemExit as e:\n"
+        "    assert not e.code, e.code\n"
+        "print('BENCH', time.perf_counter() - t, "
+        "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)\n"
+    )
+    env = {**os.environ, "PYVISTA_OFF_SCREEN": "true"}
+    out = subprocess.run(
+        [sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, check=True
+    )
+    line = [x for x in out.stdout.splitlines() if x.startswith("BENCH")][-1]
+    wall, rss = map(float, line.split()[1:])
+    return wall, rss
+
+
+def warm_replay_s() -> float:
+    """The replay itself (3 methods, writes included) with the model already loaded."""
+    from twin.loop.runfiles import default_spindle, replay_run_to_dir
+
+    default_spindle()
+    with tempfile.TemporaryDirectory() as tmp:
+        replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL))  # warm-up
+        best = float("inf")
+        for _ in range(3):
+            t = time.perf_counter()
+            replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL))
+            best = min(best, time.perf_counter() - t)
+    return best
+
+
+def run() -> dict:
+    out: dict = {}
+    tmp = Path(tempfile.mkdtemp())
+    try:
+        wall, rss = _cli(
+            "replay",
+            str(RUN),
+            "--out",
+            str(tmp / "one"),
+            "--methods",
+            METHODS,
+            "--model",
+            str(MODEL),
+            "--snapshots",
+            "none",
+            "--quiet",
+        )
+        out["replay_30min_3methods_cold_s"] = wall
+        out["replay_peak_rss_MB"] = rss
+        out["replay_30min_3methods_warm_s"] = warm_replay_s()
+        batch = tmp / "batch"
+        batch.mkdir()
+        for i in range(8):
+            shutil.copy(RUN, batch / f"run_{i}.csv")
+        runs = [str(p) for p in sorted(batch.glob("*.csv"))]
+        for jobs in (1, 2):
+            wall, _ = _cli(
+                "replay",
+                *runs,
+                "--out",
+                str(tmp / f"jobs{jobs}"),
+                "--methods",
+                METHODS,
+                "--model",
+                str(MODEL),
+                "--snapshots",
+                "none",
+                "--quiet",
+                "--jobs",
+                str(jobs),
+            )
+            out[f"batch8_jobs{jobs}_s"] = wall
+        out["batch8_speedup_jobs2"] = out["batch8_jobs1_s"] / out["batch8_jobs2_s"]
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    out["targets"] = "replay ≤ 1.5 s, RSS ≤ 1 GB, jobs 2 close to 2× jobs 1"
+    return out
+
+
+if __name__ == "__main__":
+    print(json.dumps(run(), indent=2))
