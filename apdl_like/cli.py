@@ -9,14 +9,12 @@ anything else is an internal error, exit 1; neither prints a traceback.
 
 from __future__ import annotations
 
-import functools
 import sys
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import typer
 
+from twin.cli import report_errors
 from twin.errors import InputError
 
 app = typer.Typer(
@@ -28,28 +26,8 @@ app = typer.Typer(
 )
 
 
-def _report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
-    @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return func(*args, **kwargs)
-        except InputError as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(2) from None
-        except typer.Exit:
-            raise
-        except KeyboardInterrupt:
-            typer.echo("interrupted", err=True)
-            raise typer.Exit(130) from None
-        except Exception as exc:  # noqa: BLE001 - the last line of defence of a CLI
-            typer.echo(f"internal error: {type(exc).__name__}: {exc}", err=True)
-            raise typer.Exit(1) from None
-
-    return wrapper
-
-
 @app.command("run")
-@_report_errors
+@report_errors
 def run(
     deck: Path = typer.Argument(..., help="The APDL deck (.inp, .mac, .cdb); /INPUT is "
                                           "resolved in its folder."),
@@ -72,7 +50,7 @@ def run(
 
 
 @app.command("export-cdb")
-@_report_errors
+@report_errors
 def export_cdb(
     out: Path = typer.Option(..., "--out", help="The archive to write (.cdb)."),
     mesh: Path = typer.Option(None, "--mesh", help="A gmsh .msh instead of the default "

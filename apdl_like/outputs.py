@@ -8,28 +8,21 @@ stress) plus SEQV; NaN marks nodes outside the elements.  Every file is written 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from twin.atomic import atomic_target
+
 if TYPE_CHECKING:
     from apdl_like.session import Session
 
 
 def _atomic(path: Path, write: Callable[[Path], None]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_target(path) as tmp:
+        write(tmp)
 
 
 def _cells(session: Session) -> list[tuple[str, np.ndarray]]:

@@ -20,13 +20,12 @@ number is written with `repr`, which reads back to the identical binary64 value.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from apdl_like.loadset import LoadSet
+from twin.atomic import write_text_atomic
 
 
 def component_name(name: str) -> str:
@@ -123,14 +122,4 @@ def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
 
 def write_window_deck(loads: LoadSet, layout: DeckLayout, path: str | Path) -> Path:
     """Write the window deck atomically (temp file in the same folder, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(window_deck(loads, layout))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_text_atomic(path, window_deck(loads, layout))

@@ -18,13 +18,12 @@ with x = r and y = z.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from twin.atomic import atomic_target
 from twin.spindle.spec import BOUNDARY_NAMES, SpindleSpec
 
 MM = 1e-3
@@ -317,14 +316,6 @@ def write_msh(mesh: SpindleMesh, path: str | Path) -> Path:
                    "gmsh:geometrical": [tri_tags, line_tag_arr]},
         field_data=field_data,
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".msh", dir=path.parent, prefix=f".{path.name}.")
-    os.close(fd)
-    try:
+    with atomic_target(path) as tmp:
         meshio.write(tmp, out, file_format="gmsh22", binary=False)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a mesh is a shareable artefact
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path

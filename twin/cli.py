@@ -25,7 +25,7 @@ app = typer.Typer(
 )
 
 
-def _report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
+def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     """Map user errors to exit 2 and internal errors to exit 1, both without a traceback."""
 
     @functools.wraps(func)
@@ -51,7 +51,7 @@ def command(name: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """Register a CLI command with the shared error handling."""
 
     def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
-        app.command(name)(_report_errors(func))
+        app.command(name)(report_errors(func))
         return func
 
     return decorate

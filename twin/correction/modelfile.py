@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from twin.atomic import write_bytes_atomic
 from twin.correction.features import HIDDEN_SIZES, INPUT_NAMES, OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.network import CONFIGS, TrainedNet
 from twin.errors import InputError
@@ -87,16 +86,7 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
         sha256=_digest(tensors),
     )
     data = save(tensors, metadata={METADATA_KEY: json.dumps(meta, sort_keys=True)})
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_bytes_atomic(path, data)
     return path
 
 
@@ -174,9 +164,3 @@ def load_model(path: str | Path) -> CorrectionModel:
         raise InputError("checksum mismatch: the weights were modified or damaged",
                          file=str(path))
     return CorrectionModel(nets, meta)
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

@@ -7,27 +7,14 @@ import base64
 import html
 import io
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from twin.atomic import write_bytes_atomic
 from twin.correction.features import OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.training import TrainingResult
-
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def report_paths(model_path: str | Path) -> tuple[Path, Path]:
@@ -103,7 +90,7 @@ def write_report(
         },
         "metadata": results[chosen].model.metadata,
     }
-    _atomic_write(json_path, json.dumps(summary, indent=2, default=_jsonable).encode())
+    write_bytes_atomic(json_path, json.dumps(summary, indent=2, default=_jsonable).encode())
 
     rows = []
     for output in OUTPUTS:
@@ -141,7 +128,7 @@ both are optimistic for unseen runs.</p>
 <p>Training time: {", ".join(f"{n} {r.seconds:.1f} s" for n, r in results.items())}.</p>
 {images}
 </body></html>"""
-    _atomic_write(html_path, page.encode())
+    write_bytes_atomic(html_path, page.encode())
     return json_path, html_path
 
 
@@ -151,9 +138,3 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, np.ndarray):
         return x.tolist()
     return str(x)
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

@@ -1,8 +1,5 @@
-"""Atomic writers for the replay outputs (CSV, JSON, VTU fields, the ParaView .pvd).
-
-Every file is written to a temporary name in its own folder and moved into place with
-os.replace, so a crash or a kill never leaves a half-written output that --resume would
-mistake for a finished one.
+"""Writers for the replay outputs (CSV, JSON, VTU fields, the ParaView .pvd), each
+atomic (`twin.atomic`): a crash never leaves a half-written output for --resume to trust.
 """
 
 from __future__ import annotations
@@ -10,52 +7,13 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def publish(tmp: str | Path, path: Path) -> Path:
-    """Move a finished temporary file into place with ordinary file permissions.
-
-    mkstemp creates files readable by their owner only; outputs are meant to be shared.
-    """
-    os.chmod(tmp, 0o666 & ~_umask())
-    os.replace(tmp, path)
-    return path
-
-
-def temporary_beside(path: Path, suffix: str) -> str:
-    """A new empty temporary file in `path`'s folder (created, closed)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=suffix)
-    os.close(fd)
-    return tmp
-
-
-def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
-    path = Path(path)
-    tmp = temporary_beside(path, ".tmp")
-    try:
-        Path(tmp).write_bytes(data)
-        return publish(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def write_text_atomic(path: str | Path, text: str) -> Path:
-    return write_bytes_atomic(path, text.encode("utf-8"))
+from twin.atomic import atomic_target, write_text_atomic
 
 
 def _json_default(value):  # noqa: ANN001, ANN202
@@ -94,14 +52,9 @@ def write_vtu_atomic(path: str | Path, mesh) -> Path:  # noqa: ANN001 - meshio.M
     """meshio.Mesh → .vtu (binary, compressed), atomically."""
     import meshio
 
-    path = Path(path)
-    tmp = temporary_beside(path, ".vtu")
-    try:
+    with atomic_target(path) as tmp:
         meshio.write(tmp, mesh, file_format="vtu")
-        return publish(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    return Path(path)
 
 
 def write_pvd_atomic(path: str | Path, entries: Sequence[tuple[float, str]]) -> Path:

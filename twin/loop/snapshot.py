@@ -33,8 +33,8 @@ def render_snapshot(
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
 
+    from twin.atomic import atomic_target
     from twin.fields import field_arrays
-    from twin.loop.outputs import publish, temporary_beside
 
     if field not in FIELDS:
         raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")
@@ -107,17 +107,12 @@ def render_snapshot(
             (cx, cy, cz),
             (0.0, 0.0, 1.0),
         ]
-    out_png = Path(out_png)
-    tmp = temporary_beside(out_png, ".png")
     try:
-        plotter.screenshot(tmp)
-        publish(tmp, out_png)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        with atomic_target(out_png) as tmp:
+            plotter.screenshot(str(tmp))
     finally:
         plotter.close()
-    return out_png
+    return Path(out_png)
 
 
 def _nose_vertex(model) -> int:  # noqa: ANN001

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.atomic import atomic_target
 from twin.errors import InputError
-from twin.runs.atomic import atomic_target
 from twin.runs.schema import ALL_COLUMNS
 from twin.runs.table import RawTable
 

@@ -10,8 +10,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from twin.atomic import atomic_target
 from twin.errors import InputError
-from twin.runs.atomic import atomic_target
 from twin.runs.schema import ALL_COLUMNS
 from twin.runs.table import RawTable
 

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.atomic import atomic_target
 from twin.errors import InputError
-from twin.runs.atomic import atomic_target
 from twin.runs.csv_format import read_csv_table, write_csv_table
 from twin.runs.parquet_format import read_parquet_table, write_parquet_table
 from twin.runs.quality import QualityConfig, finding, repair

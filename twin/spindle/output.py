@@ -13,29 +13,20 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 import tempfile
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from twin.atomic import write_bytes_atomic
 from twin.spindle.model import SpindleModel
 from twin.spindle.simulate import SimulationResult
 
 
 def write_atomic(path: Path, data: str | bytes) -> None:
-    """Write text or bytes to `path` via a temporary file in the same folder."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data.encode() if isinstance(data, str) else data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Write text or bytes to `path` atomically (twin.atomic)."""
+    write_bytes_atomic(path, data.encode() if isinstance(data, str) else data)
 
 
 def keypoints_csv(result: SimulationResult) -> str:
