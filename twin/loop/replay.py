@@ -99,7 +99,10 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
 
     if session is None:
         session = Session.from_mesh(
-            model.mesh, model.materials, order=model.order, T_ref_C=model.elastic.T_ref,
+            model.mesh,
+            model.materials,
+            order=model.order,
+            T_ref_C=model.elastic.T_ref,
             thermal=model.thermal,  # adopt the assembled operators: nothing re-assembled
         )
 

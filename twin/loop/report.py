@@ -19,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.atomic import write_bytes_atomic, write_text_atomic
 from twin.loop.metrics import SENSORS, mean_metrics
-from twin.loop.outputs import write_json_atomic, write_text_atomic
+from twin.loop.outputs import write_json_atomic
 
 METHOD_COLORS = {"open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728"}
 
@@ -35,29 +36,34 @@ def _floats(values: list[str]) -> np.ndarray:
     return np.array([float(v) if v not in ("", None) else np.nan for v in values])
 
 
-def _png(fig) -> str:  # noqa: ANN001
+PLOTS = ("temperatures.png", "drift_corrections.png")
+
+
+def _png(fig) -> bytes:  # noqa: ANN001
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=80, bbox_inches="tight")
     plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
+    return buf.getvalue()
 
 
 def _img(b64: str, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{b64}"/>'
 
 
-def _plots(run_dir: Path) -> list[str]:
+def render_run_plots(run_dir: Path) -> list[Path]:
+    """Draw a run's report figures into run_dir/plots/ (done by the batch worker that
+    replayed the run, so a parallel batch also draws in parallel)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    out = []
+    out: list[bytes] = []
     kp = _read_csv(run_dir / "keypoints.csv")
     if not kp:
-        return out
+        return []
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = _floats(kp["time_s"]) / 60.0
@@ -81,7 +87,7 @@ def _plots(run_dir: Path) -> list[str]:
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("temperature [°C]")
     axes[0].legend(fontsize=7)
-    out.append(_img(_png(fig), "T1-T5 measured vs twin"))
+    out.append(_png(fig))
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 3.2))
     first = method_col == methods[0]
@@ -124,8 +130,19 @@ def _plots(run_dir: Path) -> list[str]:
     ax2.grid(alpha=0.3)
     if ax2.get_lines():  # open loop alone has no factors to show
         ax2.legend(fontsize=6, ncol=2)
-    out.append(_img(_png(fig), "drift and corrections"))
-    return out
+    out.append(_png(fig))
+    return [
+        write_bytes_atomic(run_dir / "plots" / name, png)
+        for name, png in zip(PLOTS, out, strict=True)
+    ]
+
+
+def _plots(run_dir: Path) -> list[str]:
+    """The run's figures as <img> tags, drawn now if the replay did not leave them."""
+    paths = [run_dir / "plots" / name for name in PLOTS]
+    if not all(p.is_file() for p in paths):
+        paths = render_run_plots(run_dir)
+    return [_img(base64.b64encode(p.read_bytes()).decode("ascii"), p.stem) for p in paths]
 
 
 def _fmt(v: float | None, digits: int = 2) -> str:

@@ -8,6 +8,7 @@ Layout under DIR/<run-name>/ (shared DESIGN.md):
     decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/)
     fields/*.vtu + fields.pvd   the primary method's field at every window end
     snapshots/*.png             field pictures (--snapshots end|every)
+    plots/*.png                 the report's figures of this run
     .done.json                  written last: what --resume checks
 The primary method is bpnn when it runs, else the last method listed.
 """
@@ -78,6 +79,7 @@ def replay_run_to_dir(
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict."""
     from twin.correction.methods import make_corrector
+    from twin.loop.report import render_run_plots
     from twin.runs import read_run, write_quality
 
     if snapshots not in SNAPSHOT_CHOICES:
@@ -153,6 +155,7 @@ def replay_run_to_dir(
                 title=f"{run.name} · {primary} · t = {t:.0f} s",
                 T_initial_C=r.T_initial_C,
             )
+    render_run_plots(out_dir)
     write_json_atomic(out_dir / "accuracy.json", accuracy)
     write_json_atomic(out_dir / DONE_FILE, token)
     return accuracy
