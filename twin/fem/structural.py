@@ -22,7 +22,7 @@ from skfem import Basis, ElementVector, asm
 from twin.fem import forms
 from twin.fem.materials import Material
 from twin.fem.mesh import AxiMesh
-from twin.fem.thermal import element_for, probe_matrix
+from twin.fem.thermal import element_for, factorize_symmetric, probe_matrix
 
 COMPONENTS = {"r": 0, "z": 1}
 
@@ -87,12 +87,7 @@ class ElasticProblem:
         free[self.fixed_dofs] = False
         self.free_dofs = np.where(free)[0]
         K_free = self.K[self.free_dofs][:, self.free_dofs].tocsc()
-        self._lu = spla.splu(
-            K_free,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0,
-            options={"SymmetricMode": True},
-        )
+        self._lu = factorize_symmetric(K_free)
         self._stress_mass = None
 
     def _cell_constants(self, materials: Mapping[str, Material]):  # noqa: ANN202

@@ -376,6 +376,17 @@ def _field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: 
     return out
 
 
+def factorize_symmetric(A: sp.csc_matrix) -> spla.SuperLU:
+    """SuperLU of a symmetric positive-definite FE matrix.
+
+    Minimum-degree ordering on Aᵀ+A with diagonal pivots keeps the symmetric structure:
+    about half the fill and time of SuperLU's default (COLAMD, partial pivoting) here.
+    """
+    return spla.splu(
+        A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+    )
+
+
 class _LinearSolve:
     """Factorized SPD-pattern system with prescribed dofs eliminated."""
 
@@ -393,12 +404,7 @@ class _LinearSolve:
             A_free = A
         # A is symmetric: its CSR arrays read as CSC describe the same matrix
         A_csc = sp.csc_matrix((A_free.data, A_free.indices, A_free.indptr), shape=A_free.shape)
-        self.lu = spla.splu(
-            A_csc,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0,
-            options={"SymmetricMode": True},
-        )
+        self.lu = factorize_symmetric(A_csc)
         self.n = n
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
