@@ -2,20 +2,5 @@
 
 from __future__ import annotations
 
-import importlib
-
 # One module per command family; each owns its CLI signature.
-_COMMAND_MODULES = [
-    "twin.cli_mesh",
-    "twin.cli_simulate",
-    "twin.cli_synth",
-    "twin.cli_train",
-    "twin.cli_replay",
-]
-
-for _name in _COMMAND_MODULES:
-    try:
-        importlib.import_module(_name)
-    except ModuleNotFoundError as exc:  # a family not built yet
-        if exc.name != _name:
-            raise
+from twin import cli_mesh, cli_replay, cli_simulate, cli_synth, cli_train  # noqa: F401
