@@ -53,13 +53,20 @@ class ElementType:
         return self.name == "PLANE183" and self.keyopt.get(1, 0) == 1
 
 
-def _remap(old_ids: np.ndarray, new_ids: np.ndarray, arrays: dict[str, np.ndarray],
-           fills: dict[str, object]) -> dict[str, np.ndarray]:
+def _remap(
+    old_ids: np.ndarray,
+    new_ids: np.ndarray,
+    arrays: dict[str, np.ndarray],
+    fills: dict[str, object],
+) -> dict[str, np.ndarray]:
     """Carry per-entity arrays from `old_ids` to `new_ids` (both sorted)."""
     pos = np.searchsorted(old_ids, new_ids)
     pos_c = np.clip(pos, 0, max(len(old_ids) - 1, 0))
-    found = (pos < len(old_ids)) & (old_ids[pos_c] == new_ids) if len(old_ids) else \
-        np.zeros(len(new_ids), bool)
+    found = (
+        (pos < len(old_ids)) & (old_ids[pos_c] == new_ids)
+        if len(old_ids)
+        else np.zeros(len(new_ids), bool)
+    )
     out = {}
     for name, arr in arrays.items():
         new = np.full((len(new_ids), *arr.shape[1:]), fills[name], dtype=arr.dtype)
@@ -69,11 +76,58 @@ def _remap(old_ids: np.ndarray, new_ids: np.ndarray, arrays: dict[str, np.ndarra
     return out
 
 
-class NodeTable:
+class _NumberedTable:
+    """What node and element tables share: sorted ids, pending additions, selection.
+
+    Subclasses provide `ids`, `arrays` (with a "selected" mask) and `flush()`, which
+    merges pending additions into the sorted arrays.
+    """
+
+    ids: np.ndarray
+    arrays: dict[str, np.ndarray]
+
+    def flush(self) -> None:  # pragma: no cover - every table overrides it
+        raise NotImplementedError
+
+    def __len__(self) -> int:
+        self.flush()
+        return len(self.ids)
+
+    @property
+    def selected(self) -> np.ndarray:
+        self.flush()
+        return self.arrays["selected"]
+
+    @selected.setter
+    def selected(self, mask: np.ndarray) -> None:
+        self.flush()
+        self.arrays["selected"] = mask
+
+    def index(self, numbers: np.ndarray | int) -> np.ndarray:
+        """Positions of node or element numbers; -1 for numbers that do not exist."""
+        self.flush()
+        nums = np.atleast_1d(np.asarray(numbers, dtype=np.int64))
+        pos = np.searchsorted(self.ids, nums)
+        pos_c = np.clip(pos, 0, max(len(self.ids) - 1, 0))
+        ok = (
+            (pos < len(self.ids)) & (self.ids[pos_c] == nums)
+            if len(self.ids)
+            else np.zeros(nums.shape, bool)
+        )
+        return np.where(ok, pos_c, -1)
+
+
+class NodeTable(_NumberedTable):
     """Nodes by number: coordinates (x = r, y = z), selection and per-node loads (NaN: none)."""
 
-    ARRAYS = {"selected": True, "d_temp": np.nan, "d_ux": np.nan, "d_uy": np.nan,
-              "bf_temp": np.nan, "ic_temp": np.nan}
+    ARRAYS = {
+        "selected": True,
+        "d_temp": np.nan,
+        "d_ux": np.nan,
+        "d_uy": np.nan,
+        "bf_temp": np.nan,
+        "ic_temp": np.nan,
+    }
 
     def __init__(self) -> None:
         self.ids = np.zeros(0, dtype=np.int64)
@@ -90,8 +144,10 @@ class NodeTable:
         order = np.argsort(ids)
         self.ids = np.asarray(ids, np.int64)[order]
         self.xy = np.asarray(xy, float)[order]
-        self.arrays = {k: np.full(len(self.ids), v, dtype=bool if k == "selected" else float)
-                       for k, v in self.ARRAYS.items()}
+        self.arrays = {
+            k: np.full(len(self.ids), v, dtype=bool if k == "selected" else float)
+            for k, v in self.ARRAYS.items()
+        }
         self.pending.clear()
         self.version += 1
 
@@ -104,8 +160,9 @@ class NodeTable:
         nums = np.fromiter(self.pending, dtype=np.int64, count=len(self.pending))
         coords = np.array(list(self.pending.values()), dtype=float).reshape(-1, 2)
         new_ids = np.union1d(self.ids, nums)
-        carried = _remap(self.ids, new_ids, {"xy": self.xy, **self.arrays},
-                         {"xy": np.nan, **self.ARRAYS})
+        carried = _remap(
+            self.ids, new_ids, {"xy": self.xy, **self.arrays}, {"xy": np.nan, **self.ARRAYS}
+        )
         pos = np.searchsorted(new_ids, nums)
         carried["xy"][pos] = coords
         carried["selected"][pos] = True  # new entities join the selected set, as in APDL
@@ -114,32 +171,8 @@ class NodeTable:
         self.pending.clear()
         self.version += 1
 
-    def __len__(self) -> int:
-        self.flush()
-        return len(self.ids)
 
-    @property
-    def selected(self) -> np.ndarray:
-        self.flush()
-        return self.arrays["selected"]
-
-    @selected.setter
-    def selected(self, mask: np.ndarray) -> None:
-        self.flush()
-        self.arrays["selected"] = mask
-
-    def index(self, numbers: np.ndarray | int) -> np.ndarray:
-        """Positions of node numbers; -1 for numbers that do not exist."""
-        self.flush()
-        nums = np.atleast_1d(np.asarray(numbers, dtype=np.int64))
-        pos = np.searchsorted(self.ids, nums)
-        pos_c = np.clip(pos, 0, max(len(self.ids) - 1, 0))
-        ok = (pos < len(self.ids)) & (self.ids[pos_c] == nums) if len(self.ids) else \
-            np.zeros(nums.shape, bool)
-        return np.where(ok, pos_c, -1)
-
-
-class ElementTable:
+class ElementTable(_NumberedTable):
     """Elements by number: type, material, real set, node numbers (0 = none), selection, HGEN."""
 
     ARRAYS = {"selected": True, "hgen": np.nan, "hgen_record": -1}
@@ -151,14 +184,21 @@ class ElementTable:
         self.real = np.zeros(0, dtype=np.int64)
         self.nodes = np.zeros((0, MAX_ELEMENT_NODES), dtype=np.int64)
         self.arrays: dict[str, np.ndarray] = {
-            "selected": np.zeros(0, bool), "hgen": np.zeros(0),
+            "selected": np.zeros(0, bool),
+            "hgen": np.zeros(0),
             "hgen_record": np.zeros(0, np.int64),
         }
         self.pending: dict[int, tuple[int, int, int, tuple[int, ...]]] = {}
         self.version = 0
 
-    def set_arrays(self, ids: np.ndarray, etype: np.ndarray, mat: np.ndarray,
-                   real: np.ndarray, nodes: np.ndarray) -> None:
+    def set_arrays(
+        self,
+        ids: np.ndarray,
+        etype: np.ndarray,
+        mat: np.ndarray,
+        real: np.ndarray,
+        nodes: np.ndarray,
+    ) -> None:
         order = np.argsort(ids)
         self.ids = np.asarray(ids, np.int64)[order]
         self.type = np.asarray(etype, np.int64)[order]
@@ -168,8 +208,9 @@ class ElementTable:
         padded[:, : nodes.shape[1]] = nodes
         self.nodes = padded[order]
         dtypes = {"selected": bool, "hgen": float, "hgen_record": np.int64}
-        self.arrays = {k: np.full(len(self.ids), v, dtype=dtypes[k])
-                       for k, v in self.ARRAYS.items()}
+        self.arrays = {
+            k: np.full(len(self.ids), v, dtype=dtypes[k]) for k, v in self.ARRAYS.items()
+        }
         self.pending.clear()
         self.version += 1
 
@@ -182,9 +223,15 @@ class ElementTable:
         nums = np.fromiter(self.pending, dtype=np.int64, count=len(self.pending))
         new_ids = np.union1d(self.ids, nums)
         carried = _remap(
-            self.ids, new_ids,
-            {"type": self.type, "mat": self.mat, "real": self.real, "nodes": self.nodes,
-             **self.arrays},
+            self.ids,
+            new_ids,
+            {
+                "type": self.type,
+                "mat": self.mat,
+                "real": self.real,
+                "nodes": self.nodes,
+                **self.arrays,
+            },
             {"type": 0, "mat": 0, "real": 0, "nodes": 0, **self.ARRAYS},
         )
         pos = np.searchsorted(new_ids, nums)
@@ -194,37 +241,17 @@ class ElementTable:
             carried["nodes"][p, : len(nodes)] = nodes
         carried["selected"][pos] = True
         self.ids, self.type, self.mat, self.real, self.nodes = (
-            new_ids, carried.pop("type"), carried.pop("mat"), carried.pop("real"),
-            carried.pop("nodes"))
+            new_ids,
+            carried.pop("type"),
+            carried.pop("mat"),
+            carried.pop("real"),
+            carried.pop("nodes"),
+        )
         self.arrays = carried
         self.pending.clear()
         self.version += 1
 
-    def __len__(self) -> int:
-        self.flush()
-        return len(self.ids)
 
-    @property
-    def selected(self) -> np.ndarray:
-        self.flush()
-        return self.arrays["selected"]
-
-    @selected.setter
-    def selected(self, mask: np.ndarray) -> None:
-        self.flush()
-        self.arrays["selected"] = mask
-
-    def index(self, numbers: np.ndarray | int) -> np.ndarray:
-        self.flush()
-        nums = np.atleast_1d(np.asarray(numbers, dtype=np.int64))
-        pos = np.searchsorted(self.ids, nums)
-        pos_c = np.clip(pos, 0, max(len(self.ids) - 1, 0))
-        ok = (pos < len(self.ids)) & (self.ids[pos_c] == nums) if len(self.ids) else \
-            np.zeros(nums.shape, bool)
-        return np.where(ok, pos_c, -1)
-
-
-@dataclass
 class Component:
     entity: str  # "NODE" or "ELEM"
     numbers: np.ndarray  # sorted APDL numbers
@@ -241,8 +268,13 @@ class FaceLoads:
     hflux: np.ndarray = field(default_factory=lambda: np.zeros(0))
     hflux_record: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
-    FILLS = {"conv_h": np.nan, "conv_bulk": np.nan, "conv_record": -1, "hflux": np.nan,
-             "hflux_record": -1}
+    FILLS = {
+        "conv_h": np.nan,
+        "conv_bulk": np.nan,
+        "conv_record": -1,
+        "hflux": np.nan,
+        "hflux_record": -1,
+    }
 
     def rekey(self, new_keys: np.ndarray) -> None:
         """Carry the loads over to a new face table (faces that vanished lose their loads)."""
@@ -251,8 +283,12 @@ class FaceLoads:
             return
         names = list(self.FILLS)
         sorted_old = np.argsort(self.keys)
-        carried = _remap(self.keys[sorted_old], new_keys[order],
-                         {n: getattr(self, n)[sorted_old] for n in names}, self.FILLS)
+        carried = _remap(
+            self.keys[sorted_old],
+            new_keys[order],
+            {n: getattr(self, n)[sorted_old] for n in names},
+            self.FILLS,
+        )
         inverse = np.empty_like(order)
         inverse[order] = np.arange(order.size)
         for n in names:

@@ -42,6 +42,24 @@ def _cli(*args: str) -> tuple[float, float]:
     return wall, rss
 
 
+def _replay(runs: list[str], out: Path, *extra: str) -> tuple[float, float]:
+    """`twin replay` of `runs` with all three methods, no snapshots, in a fresh process."""
+    return _cli(
+        "replay",
+        *runs,
+        "--out",
+        str(out),
+        "--methods",
+        METHODS,
+        "--model",
+        str(MODEL),
+        "--snapshots",
+        "none",
+        "--quiet",
+        *extra,
+    )
+
+
 def warm_replay_s() -> float:
     """The replay itself (3 methods, writes included) with the model already loaded."""
     from twin.loop.runfiles import default_spindle, replay_run_to_dir
@@ -61,19 +79,7 @@ def run() -> dict:
     out: dict = {}
     tmp = Path(tempfile.mkdtemp())
     try:
-        wall, rss = _cli(
-            "replay",
-            str(RUN),
-            "--out",
-            str(tmp / "one"),
-            "--methods",
-            METHODS,
-            "--model",
-            str(MODEL),
-            "--snapshots",
-            "none",
-            "--quiet",
-        )
+        wall, rss = _replay([str(RUN)], tmp / "one")
         out["replay_30min_3methods_cold_s"] = wall
         out["replay_peak_rss_MB"] = rss
         out["replay_30min_3methods_warm_s"] = warm_replay_s()
@@ -83,21 +89,7 @@ def run() -> dict:
             shutil.copy(RUN, batch / f"run_{i}.csv")
         runs = [str(p) for p in sorted(batch.glob("*.csv"))]
         for jobs in (1, 2):
-            wall, _ = _cli(
-                "replay",
-                *runs,
-                "--out",
-                str(tmp / f"jobs{jobs}"),
-                "--methods",
-                METHODS,
-                "--model",
-                str(MODEL),
-                "--snapshots",
-                "none",
-                "--quiet",
-                "--jobs",
-                str(jobs),
-            )
+            wall, _ = _replay(runs, tmp / f"jobs{jobs}", "--jobs", str(jobs))
             out[f"batch8_jobs{jobs}_s"] = wall
         out["batch8_speedup_jobs2"] = out["batch8_jobs1_s"] / out["batch8_jobs2_s"]
     finally:
