@@ -252,6 +252,7 @@ class ElementTable(_NumberedTable):
         self.version += 1
 
 
+@dataclass
 class Component:
     entity: str  # "NODE" or "ELEM"
     numbers: np.ndarray  # sorted APDL numbers
