@@ -111,6 +111,30 @@ def test_ratio_dead_sensor_keeps_previous_value():
     assert c.C_H[0] == pytest.approx(1.0)
 
 
+class _ConstantNet:
+    """A stand-in model: every network answers nominal × 1.2."""
+
+    def predict(self, output, x):
+        return np.asarray(x)[:, 5] * 1.2
+
+
+def test_bpnn_dead_sensor_keeps_previous_factor_on_moving_nominal():
+    t, T = _measured()
+    nominal_old = _nominal()
+    # the nominal resistance fell since the last window (Eq. 5: the fit tightened)
+    nominal_new = BoundaryValues(*(np.array(nominal_old) * [1.0, 1.0, 0.6, 0.6]))
+    previous = BoundaryValues(*(np.array(nominal_old) * 1.07))
+    T = T.copy()
+    T[:, 1] = np.nan  # T2 (front sleeve) dead: the front resistance net has no input
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[t <= 600], T[t <= 600], t[t <= 600],
+                       T[t <= 600], nominal_new, previous, previous_nominal=nominal_old)
+    c = make_corrector("bpnn", model=_ConstantNet()).correct(f)
+    factor = np.array(c.values) / np.array(nominal_new)
+    # front resistance: the previous factor 1.07 on the new nominal, not the held value
+    assert factor[2] == pytest.approx(1.07, rel=1e-12)
+    assert factor[[0, 1, 3]] == pytest.approx([1.2, 1.2, 1.2], rel=1e-12)
+
+
 def test_speed_change_carries_the_factor():
     t, T = _measured()
     nominal_old = _nominal()

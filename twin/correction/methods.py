@@ -186,8 +186,9 @@ class BpnnCorrection:
     """The trained networks (one heat and one resistance network per bearing).
 
     Inference is plain numpy on the loaded weights (no torch needed at replay time).
-    Non-finite network inputs (a dead sensor) fall back to the previous window's value; the
-    output is kept within the guards' band around the nominal value.
+    Non-finite network inputs (a dead sensor) fall back to the previous window's correction
+    factor on the current nominal value; the output is kept within the guards' band around
+    the nominal value.
     """
 
     model: object = field(repr=False)
@@ -198,11 +199,15 @@ class BpnnCorrection:
         inputs = features.network_inputs()
         nominal = np.asarray(features.nominal, dtype=float)
         previous = np.asarray(features.previous, dtype=float)
+        previous_nominal = np.asarray(features.previous_nominal or features.nominal, dtype=float)
         values = np.empty(4)
         for i, output in enumerate(OUTPUTS):
             x = inputs[output]
             if not np.all(np.isfinite(x)):
-                values[i] = previous[i]
+                # keep the previous window's correction *factor*: the nominal value moves
+                # with speed and with the fit's temperatures (Eq. 5), a held absolute value
+                # would drift away from it (a stuck sleeve sensor held R at its cold value)
+                values[i] = previous[i] / previous_nominal[i] * nominal[i]
                 continue
             values[i] = float(self.model.predict(output, x)[0])
         values = limit_to_nominal(values, nominal, self.guards)
