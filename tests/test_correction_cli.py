@@ -22,12 +22,12 @@ def _toy_simulator(run):
     H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
     T = PLANT.simulate(t, speed, ambient, H, R)
     nominal = np.tile(np.r_[H, R], (int(np.ceil(t[-1] / 60.0)), 1))
-    return SimulatedRun(t, T, nominal, nominal, "open_loop")
+    return [SimulatedRun(t, T, nominal, nominal, "open_loop")]
 
 
 @pytest.fixture
 def runs(tmp_path, monkeypatch):
-    monkeypatch.setattr(training_data, "default_simulator", lambda: _toy_simulator)
+    monkeypatch.setattr(training_data, "default_simulator", lambda targets="fit": _toy_simulator)
     paths = []
     for i, speed in enumerate((6000.0, 8000.0, 11000.0)):
         t = np.arange(0, 901, 5.0)
@@ -78,7 +78,7 @@ def test_train_writes_model_and_report(runs, tmp_path):
 
 
 def test_train_bad_run_exits_2(tmp_path, monkeypatch):
-    monkeypatch.setattr(training_data, "default_simulator", lambda: _toy_simulator)
+    monkeypatch.setattr(training_data, "default_simulator", lambda targets="fit": _toy_simulator)
     bad = tmp_path / "bad.csv"
     bad.write_text("time_s,speed_rpm\n0,9000\n")
     result = _invoke(["train", str(bad), "--out", str(tmp_path / "m.safetensors")])

@@ -20,6 +20,12 @@ def train(
         help="Save the paper's configuration (linear hidden, logistic output, logistic "
         "scaling of X/1e6) instead of the default (tanh hidden, standardised factors).",
     ),
+    targets: str = typer.Option(
+        "fit", "--targets",
+        help="Target rule: 'fit' (each window's values fitted to the measured window by the "
+        "twin, with two passes driven off the fit) or 'ratio' (the paper's Eq. 2/5/6 on "
+        "fitted curves of a ratio-corrected simulation).",
+    ),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Train the 6-10-1 heat and 6-12-1 contact-resistance networks of both bearings.
@@ -30,22 +36,26 @@ def train(
     from twin.correction.modelfile import save_model
     from twin.correction.network import DEFAULT, PAPER
     from twin.correction.report import write_report
-    from twin.correction.samples import SampleSet, build_samples
+    from twin.correction.samples import SampleSet, samples_for
     from twin.correction.training import train_model
-    from twin.correction.training_data import default_simulator, run_curves
+    from twin.correction.training_data import TARGET_RULES, default_simulator, run_curves
+    from twin.errors import InputError
     from twin.runs import read_run
 
-    simulator = default_simulator()
+    if targets not in TARGET_RULES:
+        raise InputError(f"--targets must be one of {', '.join(TARGET_RULES)}, not {targets!r}")
+    simulator = default_simulator(targets)
     sets = []
     for path in runs:
         run = read_run(path)
         if not quiet:
             typer.echo(f"simulating {path.name} …", err=True)
-        sets.append(build_samples(run_curves(run, simulator)))
+        sets.extend(samples_for(curves) for curves in run_curves(run, simulator))
     samples = SampleSet.concatenate(sets)
     chosen = PAPER if paper_config else DEFAULT
     # file names only: the model file must not depend on where the runs were kept
-    meta = {"runs": [p.name for p in runs], "simulation": getattr(simulator, "__name__", "")}
+    meta = {"runs": [p.name for p in runs], "simulation": getattr(simulator, "__name__", ""),
+            "targets": targets}
     results = {}
     for config in (DEFAULT, PAPER):
         if not quiet:

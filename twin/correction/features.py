@@ -75,6 +75,19 @@ class BoundaryValues(NamedTuple):
     R_rear_m2K_W: float
 
 
+class TwinState(NamedTuple):
+    """The twin's own state at a window start, for methods that re-simulate the window.
+
+    Only the offline window fit that builds training targets (`twin.loop.windowfit`) uses
+    it; the online methods see nothing but the measured and simulated key points.
+    """
+
+    field_C: np.ndarray
+    """Temperature per degree of freedom of the twin's mesh, °C."""
+    conditions: object
+    """The window's nominal `twin.spindle.BoundaryConditions`."""
+
+
 @dataclass(frozen=True)
 class WindowFeatures:
     """Inputs of one correction step (window `window`, starting at `start_s`).
@@ -101,6 +114,8 @@ class WindowFeatures:
     window_s: float = WINDOW_S
     previous_nominal: BoundaryValues | None = None
     """Nominal values of the previous window, if the speed changed since (else = nominal)."""
+    twin_state: TwinState | None = None
+    """The twin's field and conditions at the window start (set by the loop)."""
 
     def __post_init__(self) -> None:
         pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))

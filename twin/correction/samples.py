@@ -1,4 +1,11 @@
-"""Training samples for the networks: the paper's five steps, from arrays.
+"""Training samples for the networks, from arrays.
+
+Two target rules (`RunCurves.fitted` decides, `samples_for` dispatches):
+
+- "fit" (default, `fit_samples`): one sample per window; the inputs are what the network
+  sees at the window start in the loop, the target the value the offline window fit
+  (`twin.loop.windowfit`) found for that window.
+- "ratio" (`build_samples`): the paper's five steps, below.
 
 Per run: (1) the recorded speed, ambient and T1..T5; (2) the nominal heat (Eq. 1) and
 resistance (Eq. 4) per window; (3) the same run simulated by the twin, with the values it
@@ -74,6 +81,8 @@ class RunCurves:
     nominal: np.ndarray
     used: np.ndarray
     window_s: float = WINDOW_S
+    fitted: np.ndarray | None = None
+    """(windows, 4): the window fit's values (the "fit" targets); None for the ratio rule."""
 
     def __post_init__(self) -> None:
         n = len(self.time_s)
@@ -86,7 +95,9 @@ class RunCurves:
             raise ValueError(f"RunCurves.simulated_C must have shape ({len(self.sim_time_s)}, 5)")
         if n < 2 or np.any(np.diff(self.time_s) <= 0):
             raise ValueError("RunCurves.time_s must be increasing with at least two samples")
-        for name in ("nominal", "used"):
+        for name in ("nominal", "used", "fitted"):
+            if getattr(self, name) is None and name == "fitted":
+                continue
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape[-1] != 4 or v.ndim > 2 or np.any(~(v > 0)):
                 raise ValueError(f"RunCurves.{name} must be positive, shape (windows, 4) or (4,)")
@@ -215,6 +226,38 @@ def build_samples(
         run=np.full(len(t0), c.name, dtype=object),
         fit_rms_C=fit_rms,
     )
+
+
+def fit_samples(curves: RunCurves, guards: RatioGuards = TARGET_GUARDS) -> SampleSet:
+    """One sample per window: the loop's network inputs at its start, the fitted value."""
+    c = curves
+    if c.fitted is None:
+        raise ValueError(f"{c.name}: no window-fit values; simulate the run with the window fit")
+    fitted = np.asarray(c.fitted, dtype=float)
+    windows = np.arange(len(fitted))
+    start = float(c.time_s[0])
+    t0 = start + c.window_s * windows
+    nominal = c.per_window("nominal", windows)
+    inputs = network_inputs(
+        speed_rpm=[last_at_or_before(c.time_s, c.speed_rpm, t)[0] for t in t0],
+        ambient_C=[last_at_or_before(c.time_s, c.ambient_C, t)[0] for t in t0],
+        run_time_s=t0 - start,
+        measured_C=np.array([last_at_or_before(c.time_s, c.measured_C, t) for t in t0]),
+        simulated_C=np.array([last_at_or_before(c.sim_time_s, c.simulated_C, t) for t in t0]),
+        nominal=nominal,
+    )
+    targets = limit_to_nominal(fitted, nominal, guards)
+    return SampleSet(
+        inputs=inputs,
+        targets={o: targets[:, i] for i, o in enumerate(OUTPUTS)},
+        time_s=t0 - start,
+        run=np.full(len(t0), c.name, dtype=object),
+    )
+
+
+def samples_for(curves: RunCurves) -> SampleSet:
+    """The samples of a run under its target rule: window fit if fitted, else the ratio law."""
+    return build_samples(curves) if curves.fitted is None else fit_samples(curves)
 
 
 def open_loop_curves(

@@ -1,12 +1,12 @@
 """From recorded runs to `RunCurves`: the measured curves and the same run simulated.
 
-The paper simulates each training run with the twin under the online ratio correction.
-That is the twin loop's job (`twin.loop`, issue 7); the contract expected from it is
+Simulating a training run is the twin loop's job (`twin.loop.training`):
 
-    twin.loop.simulate_for_training(run: RecordedRun) -> SimulatedRun
+    twin.loop.simulate_for_training(run) -> list[SimulatedRun]   # window fit (targets "fit")
+    twin.loop.simulate_with_ratio(run) -> list[SimulatedRun]     # the paper's way ("ratio")
 
-(the run replayed with the `ratio` method).  A `Simulator` is any callable
-RecordedRun -> SimulatedRun, so tests and other tools can plug in their own.
+A `Simulator` is any callable RecordedRun -> list[SimulatedRun] (one entry per simulated
+pass), so tests and other tools can plug in their own.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ class SimulatedRun:
     time_s (m,), T_C (m, 5): simulated T1..T5 at the solver steps (run time, s).
     nominal (windows, 4): Eq. 1 / Eq. 4 values per 60 s window (BoundaryValues order).
     used (windows, 4): the values the simulation ran with per window.
-    method: how `used` came about ("ratio", "open_loop").
+    method: how `used` came about ("fit", "ratio", "open_loop").
+    fitted (windows, 4): the window fit's values, the training targets (None: no fit).
     """
 
     time_s: np.ndarray
@@ -34,21 +35,32 @@ class SimulatedRun:
     nominal: np.ndarray
     used: np.ndarray
     method: str
+    fitted: np.ndarray | None = None
 
 
-Simulator = Callable[[object], SimulatedRun]
+Simulator = Callable[[object], list[SimulatedRun]]
+
+TARGET_RULES = ("fit", "ratio")
+"""How training targets are made: the window fit (default) or the paper's ratio law."""
 
 
-def default_simulator() -> Simulator:
-    """The twin loop's replay of a run with the online ratio correction (the paper's way)."""
-    from twin.loop import simulate_for_training
+def default_simulator(targets: str = "fit") -> Simulator:
+    """The twin loop's simulation of a training run for a target rule (see TARGET_RULES)."""
+    from twin.loop import training
 
-    return simulate_for_training
+    if targets == "fit":
+        return training.simulate_for_training
+    if targets == "ratio":
+        return training.simulate_with_ratio
+    raise ValueError(f"unknown target rule {targets!r}; expected one of {', '.join(TARGET_RULES)}")
 
 
-def run_curves(run: object, simulator: Simulator | None = None) -> RunCurves:
-    """RunCurves of a `twin.runs.RecordedRun`; samples flagged invalid become NaN."""
-    sim = (simulator or default_simulator())(run)
+def run_curves(run: object, simulator: Simulator | None = None) -> list[RunCurves]:
+    """RunCurves of a `twin.runs.RecordedRun`, one per simulated pass; invalid samples → NaN."""
+    return [_curves(run, sim) for sim in (simulator or default_simulator())(run)]
+
+
+def _curves(run: object, sim: SimulatedRun) -> RunCurves:
     measured = np.array(run.T_C, dtype=float, copy=True)
     valid = getattr(run, "valid_T", None)
     if valid is not None:
@@ -63,4 +75,5 @@ def run_curves(run: object, simulator: Simulator | None = None) -> RunCurves:
         simulated_C=np.asarray(sim.T_C, dtype=float),
         nominal=np.asarray(sim.nominal, dtype=float),
         used=np.asarray(sim.used, dtype=float),
+        fitted=None if sim.fitted is None else np.asarray(sim.fitted, dtype=float),
     )

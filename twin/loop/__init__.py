@@ -7,7 +7,8 @@ batch       many runs: local processes or dask, resume, summary.json
 outputs     atomic writers (CSV, JSON, VTU, PVD)
 snapshot    headless field pictures (pyvista)
 report      the self-contained report.html
-training    simulate_for_training: a run replayed with `ratio` (training samples)
+training    simulate_for_training: a run replayed with the window fit (training samples)
+windowfit   the offline window fit that makes the training targets
 """
 
 

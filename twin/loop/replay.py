@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.correction.features import BoundaryValues, WindowFeatures
+from twin.correction.features import BoundaryValues, TwinState, WindowFeatures
 from twin.correction.methods import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
@@ -224,6 +224,7 @@ def replay_method(
             nominal=nominal,
             previous=previous or nominal,
             previous_nominal=previous_nominal,
+            twin_state=TwinState(T, bc),
         )
         corr = corrector.correct(features)
         steps, deck = solver(bc, corr, T, start, k)

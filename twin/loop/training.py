@@ -1,8 +1,11 @@
-"""The twin's own simulation of a training run (issue 6's sample builder needs it).
+"""The twin's own simulations of a training run, for the networks' sample builder.
 
-The paper builds its training samples from each recorded run and "the same conditions
-simulated" by the twin with the online ratio correction; this is that simulation: the
-run replayed by the loop with the `ratio` method.
+`simulate_for_training` (the default): the run replayed with the offline window fit
+(`twin.loop.windowfit`), once on the fit itself and `DRIVEN_PASSES` times driven by values
+scattered around it; each pass carries the fitted values per window (the targets).
+
+`simulate_with_ratio` (the paper's way, `twin train --targets ratio`): the run replayed
+with the online ratio correction; the targets then come from Eq. 2/5/6 on fitted curves.
 """
 
 from __future__ import annotations
@@ -11,23 +14,39 @@ import numpy as np
 
 from twin.correction.methods import make_corrector
 from twin.correction.training_data import SimulatedRun
-from twin.loop.replay import replay_method
+from twin.loop.replay import MethodReplay, replay_method
 from twin.loop.runfiles import default_spindle
+from twin.loop.windowfit import WindowFit
+
+DRIVEN_PASSES = (0.05, 0.05)
+"""drive_spread of the extra passes per run (seeds 1, 2, …): see `WindowFit`."""
 
 
-def simulate_for_training(run) -> SimulatedRun:  # noqa: ANN001 - a twin.runs.RecordedRun
-    """Replay `run` with the ratio correction; T1..T5 per solver step and H/R per window.
+def simulate_for_training(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.runs.RecordedRun
+    """The run replayed with the window fit: one exact pass, then the driven passes."""
+    model = default_spindle()
+    out = []
+    for seed, spread in enumerate((0.0, *DRIVEN_PASSES)):
+        fit = WindowFit(run, model, drive_spread=spread, seed=seed)
+        result = replay_method(run, model, fit, keep_fields=False)
+        out.append(_simulated(run, result, np.array(fit.fitted)))
+    return out
 
-    The series starts at t = 0 with the uniform initial field the loop starts from.
-    """
+
+def simulate_with_ratio(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.runs.RecordedRun
+    """The run replayed with the online ratio correction (the paper's training simulation)."""
     result = replay_method(run, default_spindle(), make_corrector("ratio"), keep_fields=False)
-    nominal = np.array([list(w.nominal) for w in result.windows])
-    used = np.array([list(w.correction.values) for w in result.windows])
+    return [_simulated(run, result, None)]
+
+
+def _simulated(run, result: MethodReplay, fitted: np.ndarray | None) -> SimulatedRun:  # noqa: ANN001
+    # the series starts at t = 0 with the uniform initial field the loop starts from
     t0 = float(run.time_s[0])
     return SimulatedRun(
         time_s=np.r_[0.0, result.time_s] + t0,
         T_C=np.vstack([np.full((1, 5), result.T_initial_C), result.T_twin_C]),
-        nominal=nominal,
-        used=used,
-        method="ratio",
+        nominal=np.array([list(w.nominal) for w in result.windows]),
+        used=np.array([list(w.correction.values) for w in result.windows]),
+        method=result.method,
+        fitted=fitted,
     )

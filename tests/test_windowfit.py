@@ -1,0 +1,69 @@
+"""The offline window fit that makes the networks' training targets (twin.loop.windowfit).
+
+The recorded run is made by the spindle model itself with known factors on the nominal
+values (heat ×1.15 on both bearings, front contact resistance ×0.7), so the fit has a true
+answer to recover.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.test_replay import make_recorded_run
+from twin.correction.samples import fit_samples
+from twin.correction.training_data import run_curves
+from twin.loop.replay import replay_method
+from twin.loop.runfiles import default_spindle
+from twin.loop.training import DRIVEN_PASSES, simulate_for_training
+from twin.loop.windowfit import WindowFit
+from twin.runs import read_run
+
+TRUE_FACTORS = np.array([1.15, 1.15, 0.7, 1.0])
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    path = tmp_path_factory.mktemp("fit") / "run.csv"
+    return read_run(make_recorded_run(path, minutes=6, heat=1.15, resistance=0.7))
+
+
+def test_fit_recovers_the_true_factors(run):
+    model = default_spindle()
+    fit = WindowFit(run, model)
+    result = replay_method(run, model, fit, keep_fields=False)
+    factors = np.array(fit.fitted) / np.array([list(w.nominal) for w in result.windows])
+    # the heats are seen directly by T1/T3: recovered to a fraction of a percent from the
+    # second window on (the first starts from the noisy mean of the first samples)
+    assert factors[1:, :2] == pytest.approx(np.broadcast_to(TRUE_FACTORS[:2], (5, 2)), rel=0.01)
+    # the resistances only through the ring-to-sleeve drops (tenths of a kelvin)
+    assert factors[2:, 2:] == pytest.approx(np.broadcast_to(TRUE_FACTORS[2:], (4, 2)), rel=0.05)
+    # driven by its own fit, the twin stays on the measurement (noise 0.02 K)
+    measured = run.at(result.time_s).T_C
+    assert np.sqrt(np.mean((result.T_twin_C[15:] - measured[15:]) ** 2)) < 0.03
+
+
+def test_training_passes_are_seeded_and_targets_are_the_fit(run):
+    passes = simulate_for_training(run)
+    assert len(passes) == 1 + len(DRIVEN_PASSES)
+    exact, driven = passes[0], passes[1]
+    # the exact pass runs on its fit; a driven pass runs off it but still targets the fit
+    assert np.array_equal(exact.used, exact.fitted)
+    assert not np.allclose(driven.used, driven.fitted)
+    again = simulate_for_training(run)
+    assert all(np.array_equal(a.fitted, b.fitted) for a, b in zip(passes, again, strict=True))
+    samples = [fit_samples(c) for c in run_curves(run, simulate_for_training)]
+    assert len(samples[0]) == 6
+    np.testing.assert_array_equal(samples[1].targets["heat_front"], driven.fitted[:, 0])
+    # the inputs are what the loop shows the network at each window start
+    np.testing.assert_array_equal(samples[0].inputs["heat_front"][:, 4], 60.0 * np.arange(6))
+
+
+def test_fit_needs_the_twin_state(run):
+    from twin.correction.features import BoundaryValues, WindowFeatures
+
+    nominal = BoundaryValues(1.0, 1.0, 1.0, 1.0)
+    f = WindowFeatures(0, 0.0, 9000.0, 25.0, np.zeros(1), np.zeros((1, 5)), np.zeros(1),
+                       np.zeros((1, 5)), nominal, nominal)
+    with pytest.raises(ValueError, match="twin's state"):
+        WindowFit(run, default_spindle()).correct(f)

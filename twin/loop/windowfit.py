@@ -1,0 +1,126 @@
+"""The offline window fit: the boundary values that make the twin match a recorded window.
+
+Training targets for the BP networks.  For window k the twin starts from its own state
+(`WindowFeatures.twin_state`) and the fit chooses the four values (H_front, H_rear, R_front,
+R_rear) that bring its T1..T4 over the coming 15 steps closest to the *measured* T1..T4 of
+that window.  It looks ahead, so it is not a correction method: it runs only while training,
+on recorded runs, where the future of every window is known.  The network then learns to
+forecast, from data before the window, the value this fit finds.
+
+Why not the ratio law (Eq. 2, 3, 6) for targets: the total-rise ratio mixes the heat error
+of the whole history into one factor.  After a first window that overshoots (cold-oil
+nominal heat, thermocouple lag), it halves the heat of the next window; on the emulated
+runs it drove the contact resistance to 0.6× its true value, and networks trained on
+those targets lost deformation accuracy against the open loop.  The fit reads the heat
+error off the window itself.
+
+The fit: parameters θ are log factors on the nominal values, p = p_nominal · e^θ.  The
+window response is linear in the heat and mildly non-linear in the resistance, so two
+Gauss–Newton steps with forward-difference sensitivities (5 window solves each, 2.3 ms a
+window on the default mesh) converge.  A Gaussian prior θ ~ N(0, prior_spread²) against a
+residual noise of `noise_C` keeps an unidentifiable value (a rear drop of a few tenths
+of a kelvin) near its nominal:
+
+    minimise  Σ (T_twin(θ) − T_meas)² / noise_C²  +  Σ θ² / prior_spread²
+
+`drive_spread` > 0 advances the twin with values scattered around the fit (seeded log-normal,
+double spread on the resistances), while the target stays the fit from the state reached.
+The networks then see windows that start with the twin off the measurement and learn how
+to pull it back, which an exact fit trajectory (twin always on the measurement) never shows
+them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from twin.correction.features import WindowFeatures
+from twin.correction.methods import Correction
+from twin.loop.replay import STEP_S, STEPS_PER_WINDOW
+from twin.runs import RecordedRun
+from twin.spindle.model import SpindleModel
+
+FIT_SENSORS = (0, 1, 2, 3)
+"""T1..T4: the rings and sleeves of both bearings (T5, the housing, hardly sees them)."""
+DRIVE_SPREAD_WEIGHTS = np.array([1.0, 1.0, 2.0, 2.0])
+"""Drive scatter per value (H_front, H_rear, R_front, R_rear) in units of `drive_spread`."""
+
+
+@dataclass
+class WindowFit:
+    """Look-ahead least-squares fit of each window's values (see the module doc).
+
+    Use it as the corrector of `replay_method` on a recorded run; `fitted` collects the
+    fitted values per window (the targets), the replay's corrections the values driven.
+    """
+
+    run: RecordedRun
+    model: SpindleModel
+    noise_C: float = 0.05
+    """Assumed residual noise of a thermocouple sample, K."""
+    prior_spread: float = 0.25
+    """Standard deviation of the log-factor prior (0.25: a factor within ≈ ×/÷ 1.3)."""
+    iterations: int = 2
+    step: float = 0.05
+    """Forward-difference step on the log factor."""
+    drive_spread: float = 0.0
+    seed: int = 0
+    name: str = "fit"
+    fitted: list[np.ndarray] = field(default_factory=list)
+    _theta: np.ndarray = field(default_factory=lambda: np.zeros(4))
+    _rng: np.random.Generator | None = None
+
+    def correct(self, features: WindowFeatures) -> Correction:
+        f = features
+        if f.twin_state is None:
+            raise ValueError("the window fit needs the twin's state (run it through replay_method)")
+        if f.window == 0:
+            self.fitted.clear()
+            self._theta = np.zeros(4)
+            self._rng = np.random.default_rng(self.seed)
+        nominal = np.asarray(f.nominal, dtype=float)
+        theta = self._fit(f, nominal)
+        self._theta = theta
+        fitted = nominal * np.exp(theta)
+        self.fitted.append(fitted)
+        driven = fitted
+        if self.drive_spread > 0:
+            scatter = self._rng.normal(0.0, self.drive_spread, 4) * DRIVE_SPREAD_WEIGHTS
+            driven = fitted * np.exp(scatter)
+        return Correction.relative_to(driven, f.previous)
+
+    def _fit(self, f: WindowFeatures, nominal: np.ndarray) -> np.ndarray:
+        times = f.start_s + STEP_S * np.arange(1, STEPS_PER_WINDOW + 1)
+        measured = self.run.at(times)
+        target = np.where(measured.valid_T, measured.T_C, np.nan)[:, FIT_SENSORS]
+        seen = np.isfinite(target)
+        theta = self._theta.copy()  # warm start: the values change slowly window to window
+        if not seen.any():
+            return theta
+        weight = (self.noise_C / self.prior_spread) ** 2
+        for _ in range(self.iterations):
+            base = self._window(f, nominal * np.exp(theta))
+            residual = (base - target)[seen]
+            jacobian = np.empty((residual.size, 4))
+            for j in range(4):
+                probe = theta.copy()
+                probe[j] += self.step
+                jacobian[:, j] = (self._window(f, nominal * np.exp(probe)) - base)[seen] / self.step
+            normal = jacobian.T @ jacobian + weight * np.eye(4)
+            theta = theta + np.linalg.solve(normal, -jacobian.T @ residual - weight * theta)
+        return theta
+
+    def _window(self, f: WindowFeatures, values: np.ndarray) -> np.ndarray:
+        """T1..T4 of the twin over the window (15, 4) with these four values."""
+        T, bc = f.twin_state
+        loads = bc.to_thermal_loads(H_front=values[0], H_rear=values[1], R_front=values[2],
+                                    R_rear=values[3])
+        stepper = self.model.thermal.transient(loads, STEP_S)
+        probe = self.model.sensor_matrix[list(FIT_SENSORS)]
+        out = np.empty((STEPS_PER_WINDOW, len(FIT_SENSORS)))
+        for i in range(STEPS_PER_WINDOW):
+            T = stepper.step(T)
+            out[i] = probe @ T
+        return out
