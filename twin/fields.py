@@ -26,7 +26,9 @@ def field_arrays(model: SpindleModel, T: np.ndarray, T_initial_C: float | None =
     elastic = model.elastic
     u_abs = elastic.solve(T)
     stress = elastic.stresses(u_abs, T)
-    u = u_abs - elastic.solve(np.full_like(T, T_initial_C)) if T_initial_C is not None else u_abs
+    # the structure is linear in T − T_ref: the drift from a uniform T_initial is the
+    # solution for the excess T − T_initial (one back-substitution instead of two)
+    u = u_abs if T_initial_C is None else elastic.solve(T - T_initial_C + elastic.T_ref)
     nodes = mesh.node_map[:n_vertices]
     disp = np.zeros((n_vertices, 3))
     disp[:, 0] = 1e6 * u[0, :n_glued][nodes]

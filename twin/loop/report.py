@@ -43,7 +43,9 @@ def _png(fig) -> bytes:  # noqa: ANN001
     import matplotlib.pyplot as plt
 
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=80, bbox_inches="tight")
+    # fixed margins: a "tight" bounding box draws the figure twice (a third of a replay)
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.17, top=0.9, wspace=0.25)
+    fig.savefig(buf, format="png", dpi=80)
     plt.close(fig)
     return buf.getvalue()
 

@@ -199,11 +199,14 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
                        coolant_C: float | None = None,
                        T_bearings_C: float | tuple[float, float] | None = None,
                        T_sleeves_C: float | tuple[float, float] | None = None,
+                       film_ambient_C: float | None = None,
                        ) -> BoundaryConditions:
     """Nominal boundary conditions at an operating point.
 
     `model`: a SpindleModel or a SpindleSpec (only the spec is used; volumes come from
     the spec's rectangles, which the linear mesh reproduces exactly).
+    `film_ambient_C`: the ambient at which the natural-convection and radiation film
+    coefficients are evaluated (default: `ambient_C`, which is always the sink temperature).
     """
     spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
     check_operating_point(spec, speed_rpm, ambient_C, coolant_C)
@@ -226,7 +229,8 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
 
     convection = {}
     for name, conv in spec.convection.items():
-        h = film_coefficient(conv, spec, speed_rpm, ambient_C)
+        h = film_coefficient(conv, spec, speed_rpm,
+                             ambient_C if film_ambient_C is None else film_ambient_C)
         convection[name] = (h, coolant if conv.fluid == "coolant" else float(ambient_C))
 
     return BoundaryConditions(
