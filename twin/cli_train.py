@@ -79,6 +79,7 @@ def model_info(model: Path = typer.Argument(..., help="Correction model file."))
     m = load_model(model)
     meta = m.metadata
     typer.echo(f"{model}: {meta.get('config')} configuration, {meta.get('samples')} samples, "
-               f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}")
+               f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}, "
+               f"targets {meta.get('targets', 'ratio')}")
     for output, r2 in (meta.get("r2") or {}).items():
         typer.echo(f"  {output:18s} R² {r2.get('value')}  factor R² {r2.get('factor')}")
