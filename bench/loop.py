@@ -88,9 +88,14 @@ def run() -> dict:
         for i in range(8):
             shutil.copy(RUN, batch / f"run_{i}.csv")
         runs = [str(p) for p in sorted(batch.glob("*.csv"))]
-        for jobs in (1, 2):
-            wall, _ = _replay(runs, tmp / f"jobs{jobs}", "--jobs", str(jobs))
-            out[f"batch8_jobs{jobs}_s"] = wall
+        # interleaved, best of two: on a shared 2-core machine one sample of either can be
+        # off by 15 % (measured 10.6 and 12.3 s for the same --jobs 1 batch)
+        for _ in range(2):
+            for jobs in (1, 2):
+                shutil.rmtree(tmp / f"jobs{jobs}", ignore_errors=True)
+                wall, _ = _replay(runs, tmp / f"jobs{jobs}", "--jobs", str(jobs))
+                key = f"batch8_jobs{jobs}_s"
+                out[key] = min(out.get(key, float("inf")), wall)
         out["batch8_speedup_jobs2"] = out["batch8_jobs1_s"] / out["batch8_jobs2_s"]
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
