@@ -148,6 +148,18 @@ def sample_times(
     return np.unique(np.concatenate([regular, dense]))
 
 
+def _inputs_at(c: RunCurves, t0: np.ndarray, nominal: np.ndarray) -> dict[str, np.ndarray]:
+    """Network inputs at times t0 (causal: raw samples at or before, the twin's state)."""
+    return network_inputs(
+        speed_rpm=[last_at_or_before(c.time_s, c.speed_rpm, t)[0] for t in t0],
+        ambient_C=[last_at_or_before(c.time_s, c.ambient_C, t)[0] for t in t0],
+        run_time_s=t0 - c.time_s[0],
+        measured_C=np.array([last_at_or_before(c.time_s, c.measured_C, t) for t in t0]),
+        simulated_C=np.array([last_at_or_before(c.sim_time_s, c.simulated_C, t) for t in t0]),
+        nominal=nominal,
+    )
+
+
 def build_samples(
     curves: RunCurves,
     *,
@@ -167,14 +179,7 @@ def build_samples(
     nominal = c.per_window("nominal", window)
     used = c.per_window("used", window)
 
-    speed = np.array([last_at_or_before(c.time_s, c.speed_rpm, t)[0] for t in t0])
-    ambient = np.array([last_at_or_before(c.time_s, c.ambient_C, t)[0] for t in t0])
-    measured = np.array([last_at_or_before(c.time_s, c.measured_C, t) for t in t0])
-    simulated = np.array([last_at_or_before(c.sim_time_s, c.simulated_C, t) for t in t0])
-    inputs = network_inputs(
-        speed_rpm=speed, ambient_C=ambient, run_time_s=t0 - c.time_s[0],
-        measured_C=measured, simulated_C=simulated, nominal=nominal,
-    )
+    inputs = _inputs_at(c, t0, nominal)
 
     sim_speed = np.interp(c.sim_time_s, c.time_s, c.speed_rpm)
     fit_rms = {}
@@ -238,14 +243,7 @@ def fit_samples(curves: RunCurves, guards: RatioGuards = TARGET_GUARDS) -> Sampl
     start = float(c.time_s[0])
     t0 = start + c.window_s * windows
     nominal = c.per_window("nominal", windows)
-    inputs = network_inputs(
-        speed_rpm=[last_at_or_before(c.time_s, c.speed_rpm, t)[0] for t in t0],
-        ambient_C=[last_at_or_before(c.time_s, c.ambient_C, t)[0] for t in t0],
-        run_time_s=t0 - start,
-        measured_C=np.array([last_at_or_before(c.time_s, c.measured_C, t) for t in t0]),
-        simulated_C=np.array([last_at_or_before(c.sim_time_s, c.simulated_C, t) for t in t0]),
-        nominal=nominal,
-    )
+    inputs = _inputs_at(c, t0, nominal)
     targets = limit_to_nominal(fitted, nominal, guards)
     return SampleSet(
         inputs=inputs,

@@ -38,7 +38,7 @@ import numpy as np
 
 from twin.correction.features import WindowFeatures
 from twin.correction.methods import Correction
-from twin.loop.replay import STEP_S, STEPS_PER_WINDOW
+from twin.loop.replay import STEP_S, STEPS_PER_WINDOW, direct_window_solver
 from twin.runs import RecordedRun
 from twin.spindle.model import SpindleModel
 
@@ -115,12 +115,6 @@ class WindowFit:
     def _window(self, f: WindowFeatures, values: np.ndarray) -> np.ndarray:
         """T1..T4 of the twin over the window (15, 4) with these four values."""
         T, bc = f.twin_state
-        loads = bc.to_thermal_loads(H_front=values[0], H_rear=values[1], R_front=values[2],
-                                    R_rear=values[3])
-        stepper = self.model.thermal.transient(loads, STEP_S)
-        probe = self.model.sensor_matrix[list(FIT_SENSORS)]
-        out = np.empty((STEPS_PER_WINDOW, len(FIT_SENSORS)))
-        for i in range(STEPS_PER_WINDOW):
-            T = stepper.step(T)
-            out[i] = probe @ T
-        return out
+        steps, _ = direct_window_solver(self.model)(bc, Correction(*values), T, f.start_s,
+                                                    f.window)
+        return (self.model.sensor_matrix[list(FIT_SENSORS)] @ steps.T).T
