@@ -16,6 +16,8 @@ so a window deck that re-applies loads on the same components reuses every opera
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -103,25 +105,24 @@ class FemModel:
     # -------------------------------------------------------------- named sets
     def region_for(self, cells: np.ndarray) -> str:
         """A region name for exactly these cells (existing name if the set is known)."""
-        key = self._key(cells)
-        name = self._region_names.get(key)
-        if name is None:
-            name = f"_cells{len(self._region_names)}"
-            while name in self.mesh.regions:
-                name += "_"
-            self.mesh.add_region(name, cells)
-            self._region_names[key] = name
-        return name
+        return self._named(cells, self._region_names, "_cells", self.mesh.regions,
+                           self.mesh.add_region)
 
     def boundary_for(self, facets: np.ndarray) -> str:
-        key = self._key(facets)
-        name = self._boundary_names.get(key)
+        """A boundary name for exactly these facets (existing name if the set is known)."""
+        return self._named(facets, self._boundary_names, "_faces", self.mesh.boundaries,
+                           self.mesh.add_boundary)
+
+    def _named(self, indices: np.ndarray, names: dict[bytes, str], prefix: str,
+               taken: Mapping[str, object], add: Callable[[str, np.ndarray], object]) -> str:
+        key = self._key(indices)
+        name = names.get(key)
         if name is None:
-            name = f"_faces{len(self._boundary_names)}"
-            while name in self.mesh.boundaries:
+            name = f"{prefix}{len(names)}"
+            while name in taken:
                 name += "_"
-            self.mesh.add_boundary(name, facets)
-            self._boundary_names[key] = name
+            add(name, indices)
+            names[key] = name
         return name
 
     def cells_of_elements(self, element_mask: np.ndarray) -> np.ndarray:
