@@ -60,22 +60,15 @@ def build_mesh(spec: SpindleSpec, size_factor: float = 1.0) -> SpindleMesh:
 
     with pygmsh.occ.Geometry() as geom:
         gmsh.option.setNumber("General.Terminal", 0)
-        parts = [
-            geom.add_rectangle(
-                [p.r_inner_mm * MM, p.z_start_mm * MM, 0.0],
-                (p.r_outer_mm - p.r_inner_mm) * MM,
-                (p.z_end_mm - p.z_start_mm) * MM,
+        def rectangle(box):  # noqa: ANN001, ANN202 - a spec part or channel (r/z in mm)
+            return geom.add_rectangle(
+                [box.r_inner_mm * MM, box.z_start_mm * MM, 0.0],
+                (box.r_outer_mm - box.r_inner_mm) * MM,
+                (box.z_end_mm - box.z_start_mm) * MM,
             )
-            for p in spec.parts
-        ]
-        channels = [
-            geom.add_rectangle(
-                [c.r_inner_mm * MM, c.z_start_mm * MM, 0.0],
-                (c.r_outer_mm - c.r_inner_mm) * MM,
-                (c.z_end_mm - c.z_start_mm) * MM,
-            )
-            for c in spec.coolant_channels
-        ]
+
+        parts = [rectangle(p) for p in spec.parts]
+        channels = [rectangle(c) for c in spec.coolant_channels]
         occ = gmsh.model.occ
         occ.synchronize()
         part_tags = [(2, int(p._id)) for p in parts]
