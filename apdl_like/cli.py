@@ -14,8 +14,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli import report_errors
-from twin.errors import InputError
+from twin.errors import InputError, report_errors
 
 app = typer.Typer(
     name="apdl-like",

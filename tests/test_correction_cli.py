@@ -44,7 +44,6 @@ def runs(tmp_path, monkeypatch):
 
 
 def _invoke(args):
-    from twin import commands  # noqa: F401  (registers the commands)
     from twin.cli import app
 
     return CliRunner().invoke(app, args)

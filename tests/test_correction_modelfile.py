@@ -107,7 +107,6 @@ def test_wrong_hidden_size_missing_tensor_and_foreign_file(tmp_path):
 
 
 def test_cli_exit_2_on_a_damaged_model(tmp_path):
-    from twin import commands  # noqa: F401  (registers the commands)
     from twin.cli import app
 
     path = save_model(_model(), tmp_path / "m.safetensors")

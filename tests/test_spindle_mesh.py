@@ -99,7 +99,6 @@ def test_boundary_classification_spot_checks(spec, mesh):
 
 
 def test_twin_mesh_cli(tmp_path):
-    from twin import commands  # noqa: F401
     from twin.cli import app
 
     out = tmp_path / "coarse.msh"

@@ -76,7 +76,6 @@ def test_cold_start_hold_versus_feedback(model):
 
 
 def test_simulate_cli_writes_the_files(tmp_path):
-    from twin import commands  # noqa: F401
     from twin.cli import app
 
     out = tmp_path / "run"
@@ -107,7 +106,6 @@ def test_simulate_cli_writes_the_files(tmp_path):
 
 
 def test_simulate_cli_rejects_bad_speed(tmp_path):
-    from twin import commands  # noqa: F401
     from twin.cli import app
 
     for speed in ("-100", "20000"):

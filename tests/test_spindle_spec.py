@@ -110,7 +110,6 @@ def test_bad_spec_via_cli_exits_2(tmp_path, raw):
     text = DEFAULT_SPEC_PATH.read_text().replace("r_outer_mm = 55.0", "r_outer_mm = -55.0", 1)
     path = tmp_path / "neg.toml"
     path.write_text(text)
-    from twin import commands  # noqa: F401  (registers the commands)
     from twin.cli import app
 
     result = CliRunner().invoke(app, ["mesh", "--spec", str(path), "--out",

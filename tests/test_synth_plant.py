@@ -155,7 +155,6 @@ def test_speed_profile_steps_the_loads():
 
 
 def test_cli(tmp_path):
-    from twin import commands  # noqa: F401 - registers every command, as `twin` does
     from twin.cli import app
 
     runner = CliRunner()

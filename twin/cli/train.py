@@ -1,4 +1,4 @@
-"""`twin train`: train the correction networks on recorded runs; `twin model-info`."""
+"""`twin train`: train the correction networks on recorded runs."""
 
 from __future__ import annotations
 
@@ -6,10 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli import command
 
-
-@command("train")
 def train(
     runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
@@ -69,17 +66,3 @@ def train(
         for output, row in results[chosen.name].r2_table().items():
             typer.echo(f"{output:18s} R² {row['r2_value']:.4f} (factor {row['r2_factor']:.3f})")
         typer.echo(f"wrote {out}, {json_path.name}, {html_path.name}")
-
-
-@command("model-info")
-def model_info(model: Path = typer.Argument(..., help="Correction model file.")) -> None:
-    """Check a correction model file and print what it was trained on and how well."""
-    from twin.correction.modelfile import load_model
-
-    m = load_model(model)
-    meta = m.metadata
-    typer.echo(f"{model}: {meta.get('config')} configuration, {meta.get('samples')} samples, "
-               f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}, "
-               f"targets {meta.get('targets', 'ratio')}")
-    for output, r2 in (meta.get("r2") or {}).items():
-        typer.echo(f"  {output:18s} R² {r2.get('value')}  factor R² {r2.get('factor')}")

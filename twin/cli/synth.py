@@ -6,11 +6,9 @@ from pathlib import Path
 
 import typer
 
-from twin.cli import command
 from twin.errors import InputError
 
 
-@command("synth")
 def synth(
     out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
                              "RUN.parquet); the truth goes to RUN.truth.csv beside it."),

@@ -6,10 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli import command
 
-
-@command("simulate")
 def simulate_command(
     speed: float = typer.Option(..., "--speed", help="Spindle speed, rpm."),
     minutes: float = typer.Option(..., "--minutes", help="Duration, minutes."),
@@ -25,8 +22,10 @@ def simulate_command(
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
-    """Transient with 4 s steps and nominal boundary conditions; writes keypoints.csv,
-    fields.pvd + fields/*.vtu and summary.json to OUT."""
+    """Open-loop transient at a constant speed (4 s steps, nominal boundary conditions).
+
+    Writes keypoints.csv, fields.pvd + fields/*.vtu and summary.json to OUT.
+    """
     from twin.errors import InputError
     from twin.spindle import SpindleModel, simulate, write_simulation
     from twin.spindle.conditions import check_operating_point

@@ -6,10 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli import command
 
-
-@command("mesh")
 def mesh(
     out: Path = typer.Option(..., "--out", help="Mesh file to write (.msh, gmsh 2.2)."),
     spec: Path | None = typer.Option(

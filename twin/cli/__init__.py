@@ -1,0 +1,58 @@
+"""The `twin` console script: one module per command, wired here explicitly.
+
+As in meshio's `_cli/_main.py`, this module imports each command module and adds its
+function to the app; no command registers itself by being imported, and no command module
+imports this one.  The command modules keep their heavy imports (torch, gmsh, pyvista,
+matplotlib) inside their functions, so `twin --help` stays fast.  Every command runs under
+`report_errors`: bad input (`InputError`) exits with code 2 and a one-line message;
+anything else is an internal error, exit code 1.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from twin.cli.mesh import mesh
+from twin.cli.model_info import model_info
+from twin.cli.replay import replay
+from twin.cli.report import report
+from twin.cli.simulate import simulate_command
+from twin.cli.snapshot import snapshot
+from twin.cli.synth import synth
+from twin.cli.train import train
+from twin.errors import report_errors
+
+COMMANDS = (
+    ("replay", replay),
+    ("snapshot", snapshot),
+    ("report", report),
+    ("simulate", simulate_command),
+    ("synth", synth),
+    ("train", train),
+    ("model-info", model_info),
+    ("mesh", mesh),
+)
+"""(name, function) of every `twin` command, in the order `twin --help` lists them."""
+
+
+def build_app() -> typer.Typer:
+    """The `twin` app with every command of `COMMANDS` under the shared error handling."""
+    app = typer.Typer(
+        name="twin",
+        help="Digital twin of a motorized spindle: replay recorded runs, simulate, train, "
+        "report.",
+        no_args_is_help=True,
+        add_completion=False,
+        pretty_exceptions_enable=False,
+    )
+    for name, function in COMMANDS:
+        app.command(name)(report_errors(function))
+    return app
+
+
+app = build_app()
+
+
+def main() -> None:
+    app(prog_name="twin")
+

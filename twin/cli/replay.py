@@ -1,0 +1,98 @@
+"""`twin replay`: recorded runs through the twin, with fields, metrics and a report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from twin.cli.inputs import EXAMPLES_DIR, bundled_runs, checked_model, parse_methods
+from twin.errors import InputError
+
+
+def replay(
+    runs: list[Path] = typer.Argument(
+        None, help="recorded runs (CSV/Parquet); none: the bundled example runs"
+    ),
+    out: Path = typer.Option(..., "--out", help="output folder"),
+    model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
+    methods: str = typer.Option(
+        "open_loop,ratio,bpnn", "--methods", help="comma-separated: open_loop, ratio, bpnn"
+    ),
+    jobs: int = typer.Option(1, "--jobs", min=1, help="local worker processes"),
+    dask: str | None = typer.Option(
+        None, "--dask", help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
+    ),
+    snapshots: str = typer.Option("end", "--snapshots", help="none | end | every"),
+    resume: bool = typer.Option(False, "--resume", help="skip runs already finished"),
+    quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
+) -> None:
+    """Replay recorded runs through the twin and write fields, metrics and a report."""
+    from rich.console import Console
+
+    from twin.loop.batch import replay_batch
+    from twin.loop.report import build_report
+    from twin.loop.runfiles import SNAPSHOT_CHOICES
+
+    if snapshots not in SNAPSHOT_CHOICES:
+        raise InputError(
+            f"must be one of {', '.join(SNAPSHOT_CHOICES)}, got {snapshots!r}", column="--snapshots"
+        )
+    if dask and jobs > 1:
+        raise InputError("use either --jobs or --dask, not both", column="--dask")
+    method_list = parse_methods(methods)
+    paths = list(runs) if runs else bundled_runs()
+    if not paths:
+        raise InputError(
+            "no runs given and no bundled example runs found", file=str(EXAMPLES_DIR / "runs")
+        )
+    model_path = checked_model(method_list, model)
+    console = Console(stderr=True, quiet=quiet)
+    console.print(f"replaying {len(paths)} run(s) with {', '.join(method_list)} → {out}")
+
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.fields[status]}"),
+        TimeElapsedColumn(),
+        console=console,
+        disable=quiet,
+    ) as progress:
+        tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="") for p in paths}
+
+        def tell(name: str, status: str) -> None:
+            progress.update(tasks[name], completed=1, status=status[:80])
+
+        result = replay_batch(
+            paths,
+            out,
+            method_list,
+            model_path,
+            jobs=jobs,
+            dask_address=dask,
+            snapshots=snapshots,
+            resume=resume,
+            progress=tell,
+        )
+    build_report(out, rebuild_summary=False)
+    for failure in result.failed:
+        typer.echo(f"error: {failure['error']}", err=True)
+    if not quiet and result.accuracies:
+        console.print(_mean_line(out))
+        console.print(f"report: {Path(out) / 'report.html'}")
+    if result.exit_code:
+        raise typer.Exit(result.exit_code)
+
+
+def _mean_line(out: Path) -> str:
+    import json
+
+    summary = json.loads((Path(out) / "summary.json").read_text())
+    parts = []
+    for m, v in summary.get("mean", {}).items():
+        t = v.get("temperature_accuracy_pct")
+        d = v.get("deformation_accuracy_pct")
+        parts.append(f"{m}: T {t:.2f} %" + (f", deformation {d:.2f} %" if d is not None else ""))
+    return "mean accuracy — " + "; ".join(parts)

@@ -1,0 +1,57 @@
+"""`twin snapshot`: a headless picture of the twin's field at a time of a recorded run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from twin.cli.inputs import checked_model, parse_methods
+from twin.errors import InputError
+
+
+def snapshot(
+    run: Path = typer.Argument(..., help="recorded run (CSV/Parquet)"),
+    time_s: float = typer.Option(..., "--time", help="run time of the picture, s"),
+    out: Path = typer.Option(..., "--out", help="PNG file"),
+    field: str = typer.Option("temperature", "--field", help="temperature | displacement"),
+    method: str = typer.Option("bpnn", "--method", help="open_loop | ratio | bpnn"),
+    model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
+    section: bool = typer.Option(False, "--section", help="flat r–z section, not 3-D"),
+) -> None:
+    """Headless picture of the twin's field at a time of a recorded run."""
+    from twin.correction.methods import make_corrector
+    from twin.loop.replay import replay_method
+    from twin.loop.runfiles import default_spindle
+    from twin.loop.snapshot import FIELDS, render_snapshot
+    from twin.runs import read_run
+
+    if field not in FIELDS:
+        raise InputError(f"must be one of {', '.join(FIELDS)}, got {field!r}", column="--field")
+    (method_name,) = parse_methods(method)
+    model_path = checked_model([method_name], model)
+    if out.suffix.lower() != ".png":
+        raise InputError("the picture must be a .png file", file=str(out), column="--out")
+    recorded = read_run(run)
+    spindle = default_spindle()
+    try:
+        r = replay_method(
+            recorded,
+            spindle,
+            make_corrector(method_name, model_path),
+            keep_fields=False,
+            field_at_s=time_s,
+        )
+    except ValueError as exc:
+        raise InputError(str(exc), file=str(run), column="--time") from None
+    ((t, T),) = r.fields.items()
+    render_snapshot(
+        spindle,
+        T,
+        out,
+        field=field,
+        section=section,
+        T_initial_C=r.T_initial_C,
+        title=f"{recorded.name} · {method_name} · t = {t:.0f} s",
+    )
+    typer.echo(f"wrote {out}")
