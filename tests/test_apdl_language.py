@@ -183,6 +183,7 @@ def _only_apdl_errors(text: str) -> None:
         pass
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.text(alphabet=st.characters(codec="utf-8", exclude_categories=["Cs"]), max_size=300))
 def test_fuzz_arbitrary_text(text):

@@ -135,6 +135,7 @@ def test_window_deck_round_trip_on_the_spindle_mesh():
     assert read_window_deck(window_deck(ls, layout), Session.from_mesh(mesh, materials)) == ls
 
 
+@pytest.mark.slow
 # ----------------------------------------------------------------- CDB
 def test_export_cdb_reads_back_with_mapdl_archive(tmp_path):
     from mapdl_archive import Archive

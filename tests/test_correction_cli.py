@@ -49,6 +49,7 @@ def _invoke(args):
     return CliRunner().invoke(app, args)
 
 
+@pytest.mark.slow
 def test_train_writes_model_and_report(runs, tmp_path):
     out = tmp_path / "model" / "m.safetensors"
     before = [p.read_bytes() for p in runs]

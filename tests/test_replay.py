@@ -235,6 +235,7 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
     assert [a["run"] for a in result.accuracies] == ["hot_9000", "hot_12000"]
 
 
+@pytest.mark.slow
 def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
     from dask.distributed import Client, LocalCluster
 

@@ -5,47 +5,42 @@ import pytest
 
 from twin.errors import InputError
 from twin.fem import ThermalLoads
-from twin.spindle import SpindleModel, nominal_conditions
+from twin.spindle import nominal_conditions
 
 
-@pytest.fixture(scope="module")
-def model():
-    return SpindleModel.load()
-
-
-def test_model_parts(model):
-    assert model.sensor_matrix.shape == (5, model.n_dofs)
+def test_model_parts(spindle_model):
+    assert spindle_model.sensor_matrix.shape == (5, spindle_model.n_dofs)
     # interpolation weights of a point inside the mesh sum to one
-    assert np.allclose(np.asarray(model.sensor_matrix.sum(axis=1)).ravel(), 1.0)
-    assert model.probe_vectors.shape == (2, model.n_dofs)
-    T = np.full(model.n_dofs, 31.0)
-    assert np.allclose(model.sensor_matrix @ T, 31.0)
+    assert np.allclose(np.asarray(spindle_model.sensor_matrix.sum(axis=1)).ravel(), 1.0)
+    assert spindle_model.probe_vectors.shape == (2, spindle_model.n_dofs)
+    T = np.full(spindle_model.n_dofs, 31.0)
+    assert np.allclose(spindle_model.sensor_matrix @ T, 31.0)
 
 
-def test_uniform_warming_of_a_single_material_would_be_free_expansion(model):
+def test_uniform_warming_of_a_single_material_would_be_free_expansion(spindle_model):
     # sanity of the structural supports: the axial nose probe sees, for a uniform +10 K,
     # roughly α·ΔT times its distance from the mount (steel 12.2e-6; other materials
     # nearby differ by < 10 %): (450 − 380) mm · 12.2e-6 · 10 = 8.5 µm.
-    dz = model.probe_vectors[0] @ np.full(model.n_dofs, 10.0) * 1e6
+    dz = spindle_model.probe_vectors[0] @ np.full(spindle_model.n_dofs, 10.0) * 1e6
     assert dz == pytest.approx(8.5, rel=0.25)
 
 
-def test_nominal_conditions_content(model):
-    bc = nominal_conditions(model, 9000.0, 25.3)
+def test_nominal_conditions_content(spindle_model):
+    bc = nominal_conditions(spindle_model, 9000.0, 25.3)
     loads = bc.to_thermal_loads()
     assert isinstance(loads, ThermalLoads)
     assert set(loads.contact_resistance) == {"contact_front", "contact_rear"}
     for region in ("front_inner_ring", "front_rolling_band", "front_outer_ring"):
         assert loads.sources[region] == bc.H_front
-    assert set(loads.convection) == set(model.mesh.boundaries) - {"axis"}
+    assert set(loads.convection) == set(spindle_model.mesh.boundaries) - {"axis"}
     # heat in W: sources × volumes, checked against the FEM's own volumes
-    total = sum(q * model.thermal.volume(r) for r, q in loads.sources.items())
+    total = sum(q * spindle_model.thermal.volume(r) for r, q in loads.sources.items())
     assert total == pytest.approx(sum(bc.heat_W().values()), rel=1e-9)
     assert 1e-5 < bc.R_front < 1e-3 and 1e-5 < bc.R_rear < 1e-3
 
 
-def test_overrides_replace_exactly_the_four_values(model):
-    bc = nominal_conditions(model, 9000.0, 25.3)
+def test_overrides_replace_exactly_the_four_values(spindle_model):
+    bc = nominal_conditions(spindle_model, 9000.0, 25.3)
     base = bc.to_thermal_loads()
     over = bc.to_thermal_loads(H_front=2.0e6, R_rear=3e-4)
     assert over.sources["front_outer_ring"] == 2.0e6
@@ -59,22 +54,22 @@ def test_overrides_replace_exactly_the_four_values(model):
         bc.to_thermal_loads(H_rear=float("nan"))
 
 
-def test_bearing_temperature_feedback(model):
-    cold = nominal_conditions(model, 9000.0, 25.3)
-    warm = nominal_conditions(model, 9000.0, 25.3, T_bearings_C=40.0)
+def test_bearing_temperature_feedback(spindle_model):
+    cold = nominal_conditions(spindle_model, 9000.0, 25.3)
+    warm = nominal_conditions(spindle_model, 9000.0, 25.3, T_bearings_C=40.0)
     assert warm.H_front < cold.H_front  # the oil thins
-    tight = nominal_conditions(model, 9000.0, 25.3, T_bearings_C=40.0, T_sleeves_C=30.0)
-    loose = nominal_conditions(model, 9000.0, 25.3, T_bearings_C=30.0, T_sleeves_C=40.0)
+    tight = nominal_conditions(spindle_model, 9000.0, 25.3, T_bearings_C=40.0, T_sleeves_C=30.0)
+    loose = nominal_conditions(spindle_model, 9000.0, 25.3, T_bearings_C=30.0, T_sleeves_C=40.0)
     assert tight.R_front < warm.R_front < loose.R_front  # Eq. 5
 
 
 @pytest.mark.parametrize(("speed", "field"), [(-1.0, "speed_rpm"), (15001.0, "speed_rpm"),
                                               (float("nan"), "speed_rpm")])
-def test_impossible_operating_points(model, speed, field):
+def test_impossible_operating_points(spindle_model, speed, field):
     with pytest.raises(InputError, match=field):
-        nominal_conditions(model, speed, 25.0)
+        nominal_conditions(spindle_model, speed, 25.0)
 
 
-def test_bad_ambient(model):
+def test_bad_ambient(spindle_model):
     with pytest.raises(InputError, match="ambient_C"):
-        nominal_conditions(model, 1000.0, 500.0)
+        nominal_conditions(spindle_model, 1000.0, 500.0)

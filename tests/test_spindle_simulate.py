@@ -14,13 +14,8 @@ BEARING_OR_ROTOR = {"rotor", "front_inner_ring", "front_rolling_band", "front_ou
 
 
 @pytest.fixture(scope="module")
-def model():
-    return SpindleModel.load()
-
-
-@pytest.fixture(scope="module")
-def runs(model):
-    return {n: simulate(model, n, 30.0, 25.3) for n in (3000, 6000, 9000, 12000, 15000)}
+def runs(spindle_model):
+    return {n: simulate(spindle_model, n, 30.0, 25.3) for n in (3000, 6000, 9000, 12000, 15000)}
 
 
 def test_reference_operating_point_is_plausible(runs):
@@ -48,7 +43,7 @@ def test_temperatures_and_drift_grow_with_speed(runs):
     assert np.all(np.diff(tmax) > 0), tmax
 
 
-def test_energy_balance_closes_every_step(runs, model):
+def test_energy_balance_closes_every_step(runs, spindle_model):
     for r in runs.values():
         assert r.relative_residual.max() < 0.01
         # early on most heat is stored, later more leaves through the films
@@ -56,20 +51,20 @@ def test_energy_balance_closes_every_step(runs, model):
         assert r.heat_out_W[-1] > r.heat_out_W[0]
 
 
-def test_energy_balance_agrees_with_the_fem(model):
+def test_energy_balance_agrees_with_the_fem(spindle_model):
     # our per-step dot products vs twin.fem's energy_balance on the same step
-    r = simulate(model, 9000.0, 1.0, 25.3, field_every_s=4.0)
+    r = simulate(spindle_model, 9000.0, 1.0, 25.3, field_every_s=4.0)
     loads = r.conditions[0].to_thermal_loads()
     (_, T0), (_, T1) = r.fields[0], r.fields[1]
-    eb = model.thermal.energy_balance(T0, T1, loads, 4.0)
+    eb = spindle_model.thermal.energy_balance(T0, T1, loads, 4.0)
     assert r.heat_in_W[0] == pytest.approx(eb["heat_in_W"], rel=1e-9)
     assert r.heat_out_W[0] == pytest.approx(eb["heat_out_W"], rel=1e-6, abs=1e-9)
     assert r.stored_W[0] == pytest.approx(eb["stored_W"], rel=1e-9)
 
 
-def test_cold_start_hold_versus_feedback(model):
-    held = simulate(model, 9000.0, 10.0, 25.3, update_every_s=None)
-    fed = simulate(model, 9000.0, 10.0, 25.3)
+def test_cold_start_hold_versus_feedback(spindle_model):
+    held = simulate(spindle_model, 9000.0, 10.0, 25.3, update_every_s=None)
+    fed = simulate(spindle_model, 9000.0, 10.0, 25.3)
     assert len(held.conditions) == 1 and len(fed.conditions) == 10
     # warm oil → less bearing heat → cooler outer ring than with the cold-start heat
     assert fed.sensors_C[-1, 0] < held.sensors_C[-1, 0]
@@ -116,11 +111,11 @@ def test_simulate_cli_rejects_bad_speed(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_p2_elements_agree_with_the_default_p1_run(model):
+def test_p2_elements_agree_with_the_default_p1_run(spindle_model):
     # discretisation check: quadratic elements on the same mesh change the 10 min key
     # points by well under the sensors' accuracy
     p2 = SpindleModel.load(order=2)
-    a = simulate(model, 9000.0, 10.0, 25.3)
+    a = simulate(spindle_model, 9000.0, 10.0, 25.3)
     b = simulate(p2, 9000.0, 10.0, 25.3)
     assert np.abs(a.sensors_C[-1] - b.sensors_C[-1]).max() < 0.3
     assert b.disp_z_um[-1] == pytest.approx(a.disp_z_um[-1], rel=0.05)

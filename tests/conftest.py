@@ -1,0 +1,25 @@
+"""Shared fixtures: the bundled spindle spec and model are loaded once per test session.
+
+Loading the model reads the committed mesh and assembles every operator (about 0.5 s);
+tests only read from it, so one instance serves them all.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def spindle_spec():  # noqa: ANN201 - twin.spindle.SpindleSpec
+    """The bundled reference-spindle spec (validated)."""
+    from twin.spindle import load_spec
+
+    return load_spec()
+
+
+@pytest.fixture(scope="session")
+def spindle_model():  # noqa: ANN201 - twin.spindle.SpindleModel
+    """The reference spindle on the committed mesh, operators assembled."""
+    from twin.spindle import SpindleModel
+
+    return SpindleModel.load()
