@@ -3,8 +3,6 @@ with loss curves, the R² table (both configurations) and predicted-vs-target pl
 
 from __future__ import annotations
 
-import base64
-import html
 import io
 import json
 from pathlib import Path
@@ -15,6 +13,7 @@ import numpy as np
 from twin.atomic import write_bytes_atomic
 from twin.correction.features import OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.training import TrainingResult
+from twin.io.html_pages import png_data_uri, render_page
 
 
 def report_paths(model_path: str | Path) -> tuple[Path, Path]:
@@ -23,13 +22,13 @@ def report_paths(model_path: str | Path) -> tuple[Path, Path]:
     return p.with_name(p.name + ".report.json"), p.with_name(p.name + ".report.html")
 
 
-def _figure_png(fig: Any) -> str:
+def _figure_png(fig: Any) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode()
+    return buf.getvalue()
 
 
-def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, str]]:
+def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, bytes]]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -92,42 +91,17 @@ def write_report(
     }
     write_bytes_atomic(json_path, json.dumps(summary, indent=2, default=_jsonable).encode())
 
-    rows = []
-    for output in OUTPUTS:
-        cells = "".join(
-            f"<td>{res.outputs[output].r2_value:.5f}</td><td>{res.outputs[output].r2_factor:.4f}</td>"
-            f"<td>{res.outputs[output].history.epochs}</td>"
-            for res in results.values()
-        )
-        rows.append(f"<tr><th>{output}</th>{cells}</tr>")
-    head = "".join(
-        f"<th>{html.escape(n)}{' (saved)' if n == chosen else ''}: R² value</th>"
-        f"<th>R² factor</th><th>epochs</th>"
-        for n in results
-    )
-    images = "".join(
-        f"<h2>{html.escape(title)}</h2><img src='data:image/png;base64,{png}'>"
-        for title, png in _plots(results)
-    )
-    meta = results[chosen].model.metadata
-    page = f"""<!doctype html><html><head><meta charset="utf-8">
-<title>Correction model training report</title>
-<style>body{{font-family:sans-serif;margin:2em}} td,th{{padding:2px 8px;text-align:right}}
-table{{border-collapse:collapse}} tr:nth-child(even){{background:#f2f2f2}}
-img{{max-width:100%}}</style>
-</head><body>
-<h1>Correction model: {html.escape(Path(model_path).name)}</h1>
-<p>{meta.get("samples")} samples from {len(meta.get("training_runs", []))} runs; 80/20 random
-split, seed {meta.get("seed")}; Rprop, learning rate {meta.get("learning_rate")}, at most
-{meta.get("epochs_max")} epochs, goal MSE {meta.get("goal_mse")}.
-R² value: on the corrected value (the paper's figure, > 0.99 there); R² factor: on
-value/nominal, the part of the correction the nominal (speed-dependent) value does not
-already explain. The random split puts neighbouring windows of one run on both sides, so
-both are optimistic for unseen runs.</p>
-<table><tr><th>output</th>{head}</tr>{"".join(rows)}</table>
-<p>Training time: {", ".join(f"{n} {r.seconds:.1f} s" for n, r in results.items())}.</p>
-{images}
-</body></html>"""
+    configs = [{"name": n, "saved": n == chosen, "time": f"{n} {r.seconds:.1f} s"}
+               for n, r in results.items()]
+    rows = [{"output": output,
+             "cells": [cell for res in results.values() for cell in (
+                 f"{res.outputs[output].r2_value:.5f}", f"{res.outputs[output].r2_factor:.4f}",
+                 res.outputs[output].history.epochs)]}
+            for output in OUTPUTS]
+    images = [{"title": title, "src": png_data_uri(png)} for title, png in _plots(results)]
+    page = render_page("training_report.html.j2", model_name=Path(model_path).name,
+                       meta=results[chosen].model.metadata, configs=configs, rows=rows,
+                       images=images)
     write_bytes_atomic(html_path, page.encode())
     return json_path, html_path
 

@@ -10,9 +10,7 @@ can rebuild it at any time:
 
 from __future__ import annotations
 
-import base64
 import csv
-import html
 import io
 import json
 from pathlib import Path
@@ -20,6 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from twin.atomic import write_bytes_atomic, write_text_atomic
+from twin.contract import STEP_S, WINDOW_S
+from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.metrics import SENSORS, mean_metrics
 from twin.loop.outputs import write_json_atomic
 
@@ -48,10 +48,6 @@ def _png(fig) -> bytes:  # noqa: ANN001
     fig.savefig(buf, format="png", dpi=80)
     plt.close(fig)
     return buf.getvalue()
-
-
-def _img(b64: str, alt: str) -> str:
-    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{b64}"/>'
 
 
 def render_run_plots(run_dir: Path) -> list[Path]:
@@ -139,69 +135,37 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     ]
 
 
-def _plots(run_dir: Path) -> list[str]:
-    """The run's figures as <img> tags, drawn now if the replay did not leave them."""
+def _image(png: Path) -> dict[str, str]:
+    return {"alt": png.stem, "src": png_data_uri(png.read_bytes())}
+
+
+def _plots(run_dir: Path) -> list[dict[str, str]]:
+    """The run's figures (alt text, data URI), drawn now if the replay did not leave them."""
     paths = [run_dir / "plots" / name for name in PLOTS]
     if not all(p.is_file() for p in paths):
         paths = render_run_plots(run_dir)
-    return [_img(base64.b64encode(p.read_bytes()).decode("ascii"), p.stem) for p in paths]
+    return [_image(p) for p in paths]
 
 
 def _fmt(v: float | None, digits: int = 2) -> str:
     return "–" if v is None else f"{v:.{digits}f}"
 
 
-def _table(summary: dict) -> str:
-    runs = summary.get("runs", [])
-    methods = list(dict.fromkeys(m for r in runs for m in r["methods"]))
-    head = "<tr><th rowspan=2>run</th><th rowspan=2>speed [rpm]</th><th rowspan=2>ambient [°C]</th>"
-    head += "".join(f"<th colspan=3>{html.escape(m)}</th>" for m in methods) + "</tr><tr>"
-    head += (
-        "".join("<th>T acc [%]</th><th>rise acc [%]</th><th>deform acc [%]</th>" for _ in methods)
-        + "</tr>"
-    )
-    body = []
-    for r in runs:
-        cells = [html.escape(r["run"]), f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}"]
-        for m in methods:
-            a = r["methods"].get(m, {})
-            cells += [
-                _fmt(a.get("temperature_accuracy_pct")),
-                _fmt(a.get("temperature_rise_accuracy_pct")),
-                _fmt(a.get("deformation_accuracy_pct")),
-            ]
-        body.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    mean = summary.get("mean", {})
-    cells = ["<b>average</b>", "", ""]
-    for m in methods:
-        a = mean.get(m, {})
-        cells += [
-            _fmt(a.get("temperature_accuracy_pct")),
-            _fmt(a.get("temperature_rise_accuracy_pct")),
-            _fmt(a.get("deformation_accuracy_pct")),
-        ]
-    body.append("<tr class=avg>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    return f"<table>{head}{''.join(body)}</table>"
+def _accuracy_cells(metrics: dict) -> list[str]:
+    return [_fmt(metrics.get(key)) for key in
+            ("temperature_accuracy_pct", "temperature_rise_accuracy_pct",
+             "deformation_accuracy_pct")]
 
 
-def _quality(run_dir: Path) -> str:
+def _findings(run_dir: Path) -> list[str] | None:
+    """The run's data-quality findings as JSON lines; None without a quality.json."""
     try:
         findings = json.loads((run_dir / "quality.json").read_text())
     except (OSError, ValueError):
-        return "<p>no data-quality file</p>"
+        return None
     items = findings if isinstance(findings, list) else findings.get("findings", findings)
-    if not items:
-        return "<p>data quality: no findings</p>"
-    lis = []
-    for f in items if isinstance(items, list) else [items]:
-        lis.append("<li>" + html.escape(json.dumps(f, ensure_ascii=False)) + "</li>")
-    return (
-        "<details><summary>data-quality findings ("
-        + str(len(lis))
-        + ")</summary><ul>"
-        + "".join(lis)
-        + "</ul></details>"
-    )
+    return [json.dumps(f, ensure_ascii=False) for f in
+            (items if isinstance(items, list) else [items] if items else [])]
 
 
 def collect_summary(out_root: Path) -> dict:
@@ -229,38 +193,33 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
         write_json_atomic(out_root / "summary.json", summary)
     else:
         summary = json.loads((out_root / "summary.json").read_text())
-    parts = [
-        "<!doctype html><html><head><meta charset='utf-8'>",
-        "<title>spindle twin replay report</title>",
-        "<style>body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:"
-        "collapse}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
-        "tr.avg{background:#eef}img{max-width:100%}h2{margin-top:2em}.err{color:#b00}</style>",
-        "</head><body><h1>spindle twin — replay report</h1>",
-        "<p>Accuracy over every 4 s solver step after the first 60 s window. Temperature "
-        "accuracy: 100·(1 − mean |T_twin − T_meas| / |T_meas|) in °C (the reference paper's "
-        "measure); rise accuracy: 100·(1 − Σ|error| / Σ|rise|); deformation accuracy: axial "
-        "nose drift, 100·(1 − Σ|δ error| / Σ|δ|).</p>",
-        _table(summary),
-    ]
-    for f in summary.get("failed", []):
-        parts.append(
-            f"<p class=err>failed: {html.escape(f.get('run', '?'))}: "
-            f"{html.escape(f.get('error', ''))}</p>"
-        )
-    for r in summary.get("runs", []):
+    runs = summary.get("runs", [])
+    methods = list(dict.fromkeys(m for r in runs for m in r["methods"]))
+    mean = summary.get("mean", {})
+    page_runs = []
+    for r in runs:
         run_dir = out_root / r["run"]
-        parts.append(f"<h2>{html.escape(r['run'])}</h2>")
-        parts.append(
-            f"<p>{r['speed_rpm']:.0f} rpm, ambient {r['ambient_C']:.2f} °C, "
-            f"{r['duration_s'] / 60:.1f} min</p>"
-        )
-        if (run_dir / "keypoints.csv").is_file():
-            parts += _plots(run_dir)
-        parts.append(_quality(run_dir))
-        for png in sorted((run_dir / "snapshots").glob("*.png"))[-2:]:
-            b64 = base64.b64encode(png.read_bytes()).decode("ascii")
-            parts.append(_img(b64, png.name))
-    parts.append("</body></html>")
+        snapshots = sorted((run_dir / "snapshots").glob("*.png"))[-2:]
+        page_runs.append({
+            "name": r["run"],
+            "caption": f"{r['speed_rpm']:.0f} rpm, ambient {r['ambient_C']:.2f} °C, "
+                       f"{r['duration_s'] / 60:.1f} min",
+            "plots": _plots(run_dir) if (run_dir / "keypoints.csv").is_file() else [],
+            "findings": _findings(run_dir),
+            "snapshots": [{"alt": p.name, "src": png_data_uri(p.read_bytes())}
+                          for p in snapshots],
+        })
+    page = render_page(
+        "replay_report.html.j2",
+        step_s=STEP_S, window_s=WINDOW_S, methods=methods,
+        rows=[[r["run"], f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
+               *(c for m in methods for c in _accuracy_cells(r["methods"].get(m, {})))]
+              for r in runs],
+        average=["", "", *(c for m in methods for c in _accuracy_cells(mean.get(m, {})))],
+        failed=[{"run": f.get("run", "?"), "error": f.get("error", "")}
+                for f in summary.get("failed", [])],
+        runs=page_runs,
+    )
     path = out_root / "report.html"
-    write_text_atomic(path, "\n".join(parts))
+    write_text_atomic(path, page)
     return path

@@ -1,0 +1,9 @@
+"""Writers: every file the twin writes goes through this package.
+
+atomic       the one atomic writer (temporary file beside the target, then os.replace)
+             and its text, JSON and CSV forms
+html_pages   HTML pages from the jinja2 templates in `templates/` (package data)
+
+Imports are per module (`from twin.io.atomic import write_json`): this package imports
+nothing itself, so a writer never pulls in the plotting or FEM stack it does not need.
+"""
