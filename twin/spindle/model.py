@@ -3,7 +3,8 @@
 `SpindleModel.load(spec_path=None, size_factor=1.0, order=1)` builds everything once:
 the mesh comes from the committed `meshes/reference_spindle.msh` for the bundled spec at
 size factor 1, otherwise it is generated with gmsh into a cache directory
-(`$TWIN_CACHE_DIR`, default `~/.cache/spindle-twin/meshes`) keyed by the spec's content and
+(`$TWIN_CACHE_DIR/meshes`, default the platform's user cache folder, e.g.
+`~/.cache/spindle-twin/meshes` on Linux) keyed by the spec's content and
 the size factor.
 
 Structure: u_r = 0 on the axis and u_z = 0 on the mounting-flange face ("mount"); the
@@ -45,8 +46,11 @@ def fem_material(spec: SpindleSpec, region: str) -> Material:
 
 
 def cache_dir() -> Path:
+    """Generated meshes: `$TWIN_CACHE_DIR/meshes`, else the platform's user cache folder."""
+    import platformdirs
+
     root = os.environ.get("TWIN_CACHE_DIR")
-    base = Path(root) if root else Path.home() / ".cache" / "spindle-twin"
+    base = Path(root) if root else platformdirs.user_cache_path("spindle-twin")
     return base / "meshes"
 
 
