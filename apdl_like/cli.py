@@ -42,7 +42,7 @@ def run(
         raise ApdlError("deck not found", file=str(deck))
     session = Session(base_dir=deck.parent)
     session.run_file(deck)
-    written = write_outputs(session, out)
+    written = write_outputs(session.state, out)
     if not quiet:
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
                    f"{len(written)} files to {out}")

@@ -9,13 +9,14 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from apdl_like.commands import REGISTRY, Call
+from apdl_like.call import Call
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import compile_expression, is_parameter_name
 from apdl_like.parser import Program, Statement, read_deck
+from apdl_like.registry import REGISTRY
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 MAX_LOOP_ITERATIONS = 100_000
 MAX_STATEMENTS = 2_000_000
@@ -31,7 +32,7 @@ class _Exit(Exception):
         self.do_index, self.cycle = do_index, cycle
 
 
-def _value(session: Session, st: Statement, i: int, what: str) -> float:
+def _value(session: SessionState, st: Statement, i: int, what: str) -> float:
     text = st.fields[i - 1] if i <= len(st.fields) else ""
     if not text:
         raise st.error(f"field {i} ({what}) is required")
@@ -59,7 +60,7 @@ def _compare(a: float, op: str, b: float) -> bool:
     return abs(a) > abs(b)  # ABGT
 
 
-def _condition(session: Session, st: Statement) -> tuple[bool, str]:
+def _condition(session: SessionState, st: Statement) -> tuple[bool, str]:
     """Evaluate `*IF/*ELSEIF,V1,OP1,V2[,AND|OR|XOR,V3,OP2,V4]` -> (truth, action)."""
     f = [x.upper() for x in st.fields]
 
@@ -84,7 +85,7 @@ def _condition(session: Session, st: Statement) -> tuple[bool, str]:
     return truth, action
 
 
-def _assign(session: Session, st: Statement) -> None:
+def _assign(session: SessionState, st: Statement) -> None:
     name, expr = st.fields
     if not is_parameter_name(name):
         raise st.error(f"{name!r} is not a valid parameter name (≤ 32 characters, letter first, "
@@ -100,7 +101,7 @@ def _assign(session: Session, st: Statement) -> None:
         raise st.error(exc.reason) from None
 
 
-def execute(session: Session, program: Program, depth: int = 0) -> None:
+def execute(session: SessionState, program: Program, depth: int = 0) -> None:
     """Run `program`; nested `/INPUT` files run recursively with their own file:line."""
     stmts = program.statements
     n = len(stmts)
@@ -108,8 +109,8 @@ def execute(session: Session, program: Program, depth: int = 0) -> None:
     i = 0
     while i < n:
         st = stmts[i]
-        session.statements_run += 1
-        if session.statements_run > MAX_STATEMENTS:
+        session.budget.statements_run += 1
+        if session.budget.statements_run > MAX_STATEMENTS:
             raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
         name = st.name
         try:
@@ -168,7 +169,7 @@ def _owner_if(program: Program, i: int) -> int:
     raise program.statements[i].error("branch without its *IF")  # pragma: no cover
 
 
-def _take_branch(session: Session, program: Program, i: int, truth: bool) -> int:
+def _take_branch(session: SessionState, program: Program, i: int, truth: bool) -> int:
     if truth:
         return i + 1
     for j in program.if_branches[i]:
@@ -181,7 +182,7 @@ def _take_branch(session: Session, program: Program, i: int, truth: bool) -> int
     return program.block_end[i] + 1
 
 
-def _start_loop(session: Session, program: Program, st: Statement, i: int,
+def _start_loop(session: SessionState, program: Program, st: Statement, i: int,
                 loops: dict[int, list[float]]) -> int:
     par = st.fields[0].upper() if st.fields else ""
     if not is_parameter_name(par):
@@ -202,7 +203,7 @@ def _start_loop(session: Session, program: Program, st: Statement, i: int,
     return i + 1
 
 
-def _next_iteration(session: Session, program: Program, end: int,
+def _next_iteration(session: SessionState, program: Program, end: int,
                     loops: dict[int, list[float]]) -> int:
     do_index = next(j for j, e in program.block_end.items() if e == end)
     state = loops.get(do_index)
@@ -217,13 +218,13 @@ def _next_iteration(session: Session, program: Program, end: int,
     return do_index + 1
 
 
-def _count_iteration(session: Session, st: Statement) -> None:
-    session.loop_iterations += 1
-    if session.loop_iterations > MAX_LOOP_ITERATIONS:
+def _count_iteration(session: SessionState, st: Statement) -> None:
+    session.budget.loop_iterations += 1
+    if session.budget.loop_iterations > MAX_LOOP_ITERATIONS:
         raise st.error(f"more than {MAX_LOOP_ITERATIONS} loop iterations (runaway *DO?)")
 
 
-def _input(session: Session, st: Statement, depth: int) -> None:
+def _input(session: SessionState, st: Statement, depth: int) -> None:
     if depth + 1 > MAX_INPUT_DEPTH:
         raise st.error(f"/INPUT nested deeper than {MAX_INPUT_DEPTH} files")
     fname = st.fields[0] if st.fields else ""
@@ -243,7 +244,7 @@ def _input(session: Session, st: Statement, depth: int) -> None:
     execute(session, read_deck(target, shown), depth + 1)
 
 
-def _dispatch(session: Session, st: Statement) -> None:
+def _dispatch(session: SessionState, st: Statement) -> None:
     spec = REGISTRY.get(st.name)
     if spec is None:
         raise st.error(f"unknown or unsupported command {st.name}")

@@ -26,7 +26,7 @@ import numpy as np
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
 def canonical_resistance(r: float) -> float:
@@ -96,9 +96,10 @@ def _groups(record: np.ndarray) -> list[np.ndarray]:
     return np.split(order, splits)
 
 
-def record_solve(session: Session) -> dict:
-    """What a SOLVE would solve, by mesh names (used with `session.solve_enabled = False`)."""
-    from apdl_like.solve import TCC_LOCATION, fem_model
+def record_solve(session: SessionState) -> dict:
+    """What a SOLVE would solve, by mesh names (SOLVE with `record_only` set)."""
+    from apdl_like.solve import fem_model
+    from apdl_like.state import TCC_LOCATION
 
     fem = fem_model(session)
     db = session.db
@@ -113,7 +114,7 @@ def record_solve(session: Session) -> dict:
         conv[fem.boundary_for(fem.face_facets[idx])] = (float(faces.conv_h[idx[0]]),
                                                         float(faces.conv_bulk[idx[0]]))
     contact = {}
-    for name, real in session.contact_real_sets.items():
+    for name, real in session.db.contact_real_sets.items():
         tcc = db.real_sets.get(real, {}).get(TCC_LOCATION)
         if tcc is not None:
             contact[name] = 1.0 / tcc
@@ -123,20 +124,8 @@ def record_solve(session: Session) -> dict:
             "convection": conv, "contact": contact}
 
 
-def read_window_deck(text: str, session: Session, file: str = "<window deck>") -> LoadSet:
-    """Run a window deck without solving and return the load set it applies.
-
-    The session (normally a dedicated one from `Session.from_mesh`) keeps the applied loads.
-    """
-    session.solve_enabled = False
-    before = len(session.recorded_solves)
-    try:
-        session.run_text(text, file)
-    finally:
-        session.solve_enabled = True
-    if len(session.recorded_solves) != before + 1:
-        raise ApdlError("a window deck must SOLVE exactly once", file=file)
-    rec = session.recorded_solves[-1]
+def load_set_from_record(rec: dict, file: str) -> LoadSet:
+    """The window's load set from what its one SOLVE recorded (`record_solve`)."""
     params = rec["params"]
     for name in ("WINDOW", "T_START"):
         if name not in params:

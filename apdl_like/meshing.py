@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 MAX_NEW_ELEMENTS = 200_000
 
@@ -63,7 +63,7 @@ def _triangulate(polygons: list[np.ndarray], size: float) -> tuple[np.ndarray, n
     return xy, tri
 
 
-def mesh_areas(s: Session, area_numbers: list[int]) -> None:
+def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
     db = s.db
     et = db.element_types.get(db.active_type)
     if et is None:

@@ -337,6 +337,10 @@ class Database:
     areas: dict[int, list[int]] = field(default_factory=dict)
     meshed_areas: set[int] = field(default_factory=set)
     esize: float | None = None
+    title: str = ""
+    last_real: tuple[int, int] | None = None  # (set, next location) for RMORE
+    # contact interface (of an AxiMesh session) -> its real-constant set (TCC at 14)
+    contact_real_sets: dict[str, int] = field(default_factory=dict)
     load_records: int = 0  # a counter: every load command gets its own record id
 
     def next_record(self) -> int:

@@ -17,7 +17,7 @@ import numpy as np
 from twin.atomic import atomic_target
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
 def _atomic(path: Path, write: Callable[[Path], None]) -> None:
@@ -25,7 +25,7 @@ def _atomic(path: Path, write: Callable[[Path], None]) -> None:
         write(tmp)
 
 
-def _cells(session: Session) -> list[tuple[str, np.ndarray]]:
+def _cells(session: SessionState) -> list[tuple[str, np.ndarray]]:
     db = session.db
     el = db.elements
     idx = db.nodes.index(el.nodes.ravel()).reshape(el.nodes.shape)
@@ -49,11 +49,11 @@ def _cells(session: Session) -> list[tuple[str, np.ndarray]]:
     return blocks
 
 
-def write_result_vtu(session: Session, result_index: int, path: Path) -> None:
+def write_result_vtu(session: SessionState, result_index: int, path: Path) -> None:
     import meshio
 
-    res = session.results[result_index]
-    fem = session.fem
+    res = session.solution.results[result_index]
+    fem = session.fem.model
     assert fem is not None
     points = np.column_stack([session.db.nodes.xy, np.zeros(len(session.db.nodes.ids))])
     data = {"TEMP": fem.thermal_nodal(res.temperature)}
@@ -70,7 +70,7 @@ def write_result_vtu(session: Session, result_index: int, path: Path) -> None:
     _atomic(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
 
 
-def write_outputs(session: Session, out_dir: str | Path) -> list[Path]:
+def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     """params.json, result_NNN.vtu (one per solved load step) and log.txt under `out_dir`."""
     out = Path(out_dir)
     written = []
@@ -78,7 +78,7 @@ def write_outputs(session: Session, out_dir: str | Path) -> list[Path]:
     _atomic(params, lambda tmp: tmp.write_text(
         json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n"))
     written.append(params)
-    for i, res in enumerate(session.results):
+    for i, res in enumerate(session.solution.results):
         path = out / f"result_{res.load_step:03d}.vtu"
         write_result_vtu(session, i, path)
         written.append(path)

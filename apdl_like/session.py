@@ -1,6 +1,9 @@
 """`Session`: one APDL database plus the FEM state, kept alive between decks.
 
-A session runs decks (`run_file`, `run_text`) against one database.  Mesh, materials and the
+A session runs decks (`run_file`, `run_text`) against one `SessionState` (database,
+parameters, FEM cache, solution, run budget; see `apdl_like.state` for who writes what).
+The twin's loop calls `advance(T, start_s, deck)`: one window deck from a given
+temperature state, returning the temperature of every substep.  Mesh, materials and the
 assembled operators stay in memory, so a window deck that only changes loads and time
 re-uses them.  For the twin, `Session.from_mesh` loads an `AxiMesh` directly:
 
@@ -23,64 +26,47 @@ from pathlib import Path
 
 import numpy as np
 
-import apdl_like.commands.begin  # noqa: F401  (registers commands)
-import apdl_like.commands.blocks  # noqa: F401
-import apdl_like.commands.loads  # noqa: F401
-import apdl_like.commands.post1  # noqa: F401
-import apdl_like.commands.prep7  # noqa: F401
-import apdl_like.commands.selection  # noqa: F401
-import apdl_like.commands.solution  # noqa: F401
 from apdl_like.errors import ApdlError
-from apdl_like.fem_bridge import FemModel, nearest_node
+from apdl_like.fem_bridge import FemModel
 from apdl_like.interpreter import execute
-from apdl_like.model import Component, Database, ElementType
+from apdl_like.loadset import LoadSet, load_set_from_record
+from apdl_like.model import Component, ElementType
 from apdl_like.model import Material as MpTable
 from apdl_like.parser import Program, parse_deck, read_deck
-from apdl_like.solve import TCC_LOCATION, StepResult
+from apdl_like.solve import adopt_thermal_problem
+from apdl_like.state import SessionState, StepResult
 from apdl_like.writer import DeckLayout, component_name
 from twin.fem import AxiMesh, Material, ThermalProblem
 
 
 class Session:
-    """A persistent APDL-like session (database, parameters, FEM caches, results)."""
+    """A persistent APDL-like session: runs decks against one `SessionState`."""
 
     def __init__(self, base_dir: str | Path | None = None) -> None:
-        self.db = Database()
-        self.params: dict[str, float] = {}
-        self.processor = "BEGIN"
-        self.title = ""
-        self.log: list[str] = []
-        self.base_dir = Path(base_dir) if base_dir is not None else None
-        self.results: list[StepResult] = []
-        self.post_index = -1  # result set shown in /POST1 (SET)
-        # FEM state
-        self.fem: FemModel | None = None
-        self.fem_key: tuple | None = None
-        self.external_mesh = False
-        self.thermal = None
-        self.thermal_key: tuple | None = None
-        self.elastic = None
-        self.elastic_key: tuple | None = None
-        self.state: np.ndarray | None = None  # thermal dofs at `time`
-        self.time = 0.0
-        self.fresh_start = True
-        self.previous_loads: dict | None = None
-        self.body_temperature: np.ndarray | None = None  # LDREAD, thermal dofs
-        self.substep_times: list[float] = []
-        self.substep_temperatures: list[np.ndarray] = []
-        self.contact_real_sets: dict[str, int] = {}
-        self.layout: DeckLayout | None = None
-        self.last_real: tuple[int, int] | None = None  # (set, next location) for RMORE
-        self.solve_enabled = True
-        self.recorded_solves: list[dict] = []  # with solve_enabled False: what SOLVE saw
-        # run bookkeeping
-        self.statements_run = 0
-        self.loop_iterations = 0
-        self.unsolved: tuple[str, int, str] | None = None  # first load after the last SOLVE
-        self.model_functions = {
-            "NX": self._nx, "NY": self._ny, "NZ": self._nz, "NODE": self._node,
-            "TEMP": self._temp, "UX": self._ux, "UY": self._uy,
-        }
+        self.state = SessionState(base_dir=Path(base_dir) if base_dir is not None else None)
+        self.layout: DeckLayout | None = None  # the deck names of an AxiMesh's sets
+
+    # read-only views the callers use most
+    @property
+    def db(self):  # noqa: ANN201 - apdl_like.model.Database
+        return self.state.db
+
+    @property
+    def params(self) -> dict[str, float]:
+        return self.state.params
+
+    @property
+    def results(self) -> list[StepResult]:
+        return self.state.solution.results
+
+    @property
+    def log(self) -> list[str]:
+        return self.state.log
+
+    @property
+    def thermal(self) -> ThermalProblem | None:
+        """The cached ThermalProblem (None before the first thermal SOLVE)."""
+        return self.state.fem.thermal
 
     # ------------------------------------------------------------ the twin
     @classmethod
@@ -99,10 +85,8 @@ class Session:
         thermal  an already assembled ThermalProblem of this mesh, materials and order to
                  adopt instead of assembling another one
         """
-        from apdl_like.fem_bridge import FemModel
-
         s = cls(base_dir)
-        db = s.db
+        db = s.state.db
         n = mesh.thermal.p.shape[1]
         db.nodes.set_arrays(np.arange(1, n + 1), mesh.thermal.p.T)
         names = sorted(materials)
@@ -127,125 +111,82 @@ class Session:
         for name, facets in mesh.boundaries.items():
             db.components[layout.boundaries[name]] = Component(
                 "NODE", np.unique(mesh.thermal.facets[:, facets]) + 1)
-        s.contact_real_sets = dict(layout.interfaces)
+        db.contact_real_sets = dict(layout.interfaces)
         for name, iface in mesh.interfaces.items():
             for side, facets in (("A", iface.facets_a), ("B", iface.facets_b)):
                 cname = component_name(name)[:30] + f"_{side}"
                 db.components[cname] = Component(
                     "NODE", np.unique(mesh.thermal.facets[:, facets]) + 1)
-            db.real_sets[s.contact_real_sets[name]] = {}
+            db.real_sets[db.contact_real_sets[name]] = {}
         db.settings.tunif = float(T_initial_C)
         db.settings.tref = float(T_ref_C)
         fem = FemModel(mesh, np.arange(n), np.arange(mesh.n_cells), order, db.nodes.ids)
         db.faces.rekey(fem.face_keys)
-        s.fem, s.fem_key, s.external_mesh = fem, (db.nodes.version, db.elements.version), True
+        cache = s.state.fem
+        cache.model, cache.model_key = fem, (db.nodes.version, db.elements.version)
+        cache.external_mesh = True
         if thermal is not None:
-            from apdl_like.solve import adopt_thermal_problem
-
-            adopt_thermal_problem(s, thermal)
+            adopt_thermal_problem(s.state, thermal)
         return s
 
     def set_state(self, temperature: np.ndarray, time_s: float) -> None:
         """Carry a temperature state (thermal dofs, °C) in at `time_s` (e.g. a resumed run)."""
-        self.state = np.asarray(temperature, float).copy()
-        self.time = float(time_s)
-        self.fresh_start = False
+        sol = self.state.solution
+        sol.temperature = np.asarray(temperature, float).copy()
+        sol.time = float(time_s)
+        sol.fresh_start = False
+
+    def advance(self, T: np.ndarray, start_s: float, deck: str,
+                file: str = "<window deck>") -> np.ndarray:
+        """Run one window deck from temperature `T` (thermal dofs, °C) at `start_s`.
+
+        Returns the temperature after every substep of the deck's load step, shape
+        (n_substeps, n_dofs).  At `start_s` = 0 the deck is a new analysis (ANTYPE,TRANS),
+        which starts from TUNIF: `T` must then be uniform and becomes TUNIF.
+        """
+        T = np.asarray(T, float)
+        if start_s == 0.0:
+            if T.size and np.any(T != T[0]):
+                raise ValueError("a window at t = 0 starts from a uniform temperature (TUNIF)")
+            self.state.db.settings.tunif = float(T[0])
+        else:
+            self.set_state(T, start_s)
+        self.run_text(deck, file)
+        return np.asarray(self.state.solution.substep_temperatures)
+
+    def read_window_deck(self, text: str, file: str = "<window deck>") -> LoadSet:
+        """Run a window deck without solving and return the load set it applies.
+
+        The session (normally a dedicated one from `Session.from_mesh`) keeps the loads.
+        """
+        state = self.state
+        state.record_only = True
+        before = len(state.recorded_solves)
+        try:
+            self.run_text(text, file)
+        finally:
+            state.record_only = False
+        if len(state.recorded_solves) != before + 1:
+            raise ApdlError("a window deck must SOLVE exactly once", file=file)
+        return load_set_from_record(state.recorded_solves[-1], file)
 
     # ----------------------------------------------------------------- runs
     def run_file(self, path: str | Path) -> None:
         path = Path(path)
-        if self.base_dir is None:
-            self.base_dir = path.parent
+        if self.state.base_dir is None:
+            self.state.base_dir = path.parent
         self.run_program(read_deck(path, str(path)))
 
     def run_text(self, text: str, file: str = "<deck>") -> None:
         self.run_program(parse_deck(text, file))
 
     def run_program(self, program: Program) -> None:
-        self.statements_run = 0
-        self.loop_iterations = 0
-        self.unsolved = None
-        execute(self, program)
-        if self.unsolved is not None:
-            file, line, cmd = self.unsolved
+        budget = self.state.budget
+        budget.statements_run = 0
+        budget.loop_iterations = 0
+        budget.unsolved = None
+        execute(self.state, program)
+        if budget.unsolved is not None:
+            file, line, cmd = budget.unsolved
             raise ApdlError("loads or solution settings given here are never solved "
                             "(the deck ends without SOLVE)", file=file, line=line, command=cmd)
-
-    def note_load(self, call) -> None:  # noqa: ANN001 - a commands.Call
-        if self.unsolved is None:
-            st = call.statement
-            self.unsolved = (st.file, st.line, st.name)
-
-    def say(self, text: str) -> None:
-        self.log.append(text)
-
-    # ------------------------------------------------------ model functions
-    def _node_index(self, n: float) -> int:
-        i = int(self.db.nodes.index(int(round(n)))[0]) if abs(n) < 2**31 else -1
-        if i < 0:
-            raise ApdlError(f"node {n:g} does not exist")
-        return i
-
-    def _nx(self, n: float) -> float:
-        return float(self.db.nodes.xy[self._node_index(n), 0])
-
-    def _ny(self, n: float) -> float:
-        return float(self.db.nodes.xy[self._node_index(n), 1])
-
-    def _nz(self, n: float) -> float:
-        self._node_index(n)
-        return 0.0
-
-    def _node(self, x: float, y: float, z: float = 0.0) -> float:
-        db = self.db
-        i = nearest_node(db.nodes.xy, db.nodes.selected, np.array([x, y]))
-        return 0.0 if i < 0 else float(db.nodes.ids[i])
-
-    def result(self) -> StepResult:
-        if not self.results:
-            raise ApdlError("no results yet (SOLVE first)")
-        return self.results[self.post_index]
-
-    def nodal_result(self, item: str, n: float) -> float:
-        """TEMP, UX, UY, SX, SY, SZ, SXY, SEQV at node n from the current result set."""
-        i = self._node_index(n)
-        res = self.result()
-        fem = self.fem
-        assert fem is not None
-        if item == "TEMP":
-            d = fem.thermal_dof[i]
-            value = res.temperature[d] if d >= 0 else np.nan
-        elif res.displacement is None:
-            raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
-        else:
-            d = fem.glued_dof[i]
-            if item in ("UX", "UY"):
-                value = res.displacement[0 if item == "UX" else 1, d] if d >= 0 else np.nan
-            else:
-                key = {"SX": "rr", "SY": "zz", "SZ": "tt", "SXY": "rz", "SEQV": "von_mises"}[item]
-                value = res.stress[key][d] if d >= 0 else np.nan
-        if np.isnan(value):
-            raise ApdlError(f"node {n:g} is not attached to an element (no {item})")
-        return float(value)
-
-    def _temp(self, n: float) -> float:
-        return self.nodal_result("TEMP", n)
-
-    def _ux(self, n: float) -> float:
-        return self.nodal_result("UX", n)
-
-    def _uy(self, n: float) -> float:
-        return self.nodal_result("UY", n)
-
-    # -------------------------------------------------------------- outputs
-    def scalar_parameters(self) -> dict[str, float]:
-        return {k.upper(): float(v) for k, v in sorted(self.params.items())}
-
-    def contact_conductance(self) -> dict[str, float]:
-        """Current TCC (W/m²K) per contact interface that has one."""
-        out = {}
-        for name, real in self.contact_real_sets.items():
-            tcc = self.db.real_sets.get(real, {}).get(TCC_LOCATION)
-            if tcc is not None:
-                out[name] = tcc
-        return out

@@ -14,49 +14,36 @@ always stepped.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
+from apdl_like.state import TCC_LOCATION, StepResult
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
-
-TCC_LOCATION = 14  # real-constant position of TCC (thermal contact conductance) on CONTA17x
+    from apdl_like.state import SessionState
 _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants positive values
 
 
-@dataclass
-class StepResult:
-    """One solved load step (its last substep)."""
-
-    load_step: int
-    time: float
-    analysis: str  # "thermal" | "structural"
-    temperature: np.ndarray  # thermal dofs, °C (structural: the body temperature used)
-    displacement: np.ndarray | None = None  # (2, n glued scalar dofs), m
-    stress: dict[str, np.ndarray] = field(default_factory=dict)  # glued scalar dofs, Pa
-
-
-def fem_model(session: Session) -> FemModel:
+def fem_model(session: SessionState) -> FemModel:
     """The FEM view of the current mesh, rebuilt only when nodes or elements changed."""
     db = session.db
     db.nodes.flush()
     db.elements.flush()
     key = (db.nodes.version, db.elements.version)
-    if session.fem is not None and session.fem_key == key:
-        return session.fem
-    if session.fem is not None and session.external_mesh:
+    cache = session.fem
+    if cache.model is not None and cache.model_key == key:
+        return cache.model
+    if cache.model is not None and cache.external_mesh:
         raise ApdlError("the mesh of this session came from an AxiMesh with contact interfaces "
                         "and cannot be changed by N/E commands")
-    session.fem = build_model(db)
-    session.fem_key = key
-    db.faces.rekey(session.fem.face_keys)
-    return session.fem
+    cache.model = build_model(db)
+    cache.model_key = key
+    db.faces.rekey(cache.model.face_keys)
+    return cache.model
 
 
 def _require(props: dict[str, float], label: str, mat: int, why: str) -> float:
@@ -65,7 +52,7 @@ def _require(props: dict[str, float], label: str, mat: int, why: str) -> float:
     return props[label]
 
 
-def _materials(session: Session, fem: FemModel, kind: str) -> dict[str, Material]:
+def _materials(session: SessionState, fem: FemModel, kind: str) -> dict[str, Material]:
     db = session.db
     mats = {}
     cell_mat = db.elements.mat[fem.cell_element]
@@ -101,16 +88,17 @@ def _material_key(mats: dict[str, Material]) -> tuple:
     return tuple(sorted((n, m.k, m.rho, m.c, m.E, m.nu, m.alpha) for n, m in mats.items()))
 
 
-def thermal_problem(session: Session, fem: FemModel) -> ThermalProblem:
+def thermal_problem(session: SessionState, fem: FemModel) -> ThermalProblem:
     mats = _materials(session, fem, "thermal")
     key = (id(fem), _material_key(mats), fem.order)
-    if session.thermal_key != key:
-        session.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
-        session.thermal_key = key
-    return session.thermal  # type: ignore[return-value]
+    cache = session.fem
+    if cache.thermal_key != key:
+        cache.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
+        cache.thermal_key = key
+    return cache.thermal  # type: ignore[return-value]
 
 
-def adopt_thermal_problem(session: Session, problem: ThermalProblem) -> None:
+def adopt_thermal_problem(session: SessionState, problem: ThermalProblem) -> None:
     """Use an assembled ThermalProblem (same mesh, materials and order) as the cached one."""
     fem = fem_model(session)
     if problem.mesh is not fem.mesh or problem.order != fem.order:
@@ -119,11 +107,11 @@ def adopt_thermal_problem(session: Session, problem: ThermalProblem) -> None:
     by_constants = sorted((m.k, m.rho_c) for m in mats.values())
     if by_constants != sorted((m.k, m.rho_c) for m in problem.materials.values()):
         raise ValueError("the ThermalProblem has other materials than the session")
-    session.thermal = problem
-    session.thermal_key = (id(fem), _material_key(mats), fem.order)
+    session.fem.thermal = problem
+    session.fem.thermal_key = (id(fem), _material_key(mats), fem.order)
 
 
-def _check_axisymmetric(session: Session, physics: str) -> None:
+def _check_axisymmetric(session: SessionState, physics: str) -> None:
     db = session.db
     types = {int(t) for t in np.unique(db.elements.type)}
     for t in types:
@@ -153,12 +141,12 @@ def _groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[np.ndar
     return [has[s] for s in np.split(order, splits)]
 
 
-def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> ThermalLoads:
+def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -> ThermalLoads:
     """The database's thermal loads as twin.fem ThermalLoads (ramped to `fraction`)."""
     db = session.db
     prev = None
     if fraction < 1.0:
-        prev = session.previous_loads or _first_step_loads(session)
+        prev = session.solution.previous_loads or _first_step_loads(session)
     tunif = db.settings.tunif
     el = db.elements.arrays
     cell_hgen = el["hgen"][fem.cell_element]
@@ -203,7 +191,7 @@ def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> The
         values = d0 + fraction * (values - d0)
     contact = {}
     for name in fem.mesh.interfaces:
-        real = session.contact_real_sets.get(name)
+        real = session.db.contact_real_sets.get(name)
         tcc = db.real_sets.get(real, {}).get(TCC_LOCATION) if real is not None else None
         if tcc is not None:
             if not tcc > 0.0:
@@ -214,46 +202,47 @@ def thermal_loads(session: Session, fem: FemModel, fraction: float = 1.0) -> The
                         fixed_dofs=(fem.thermal_dof[fixed], values) if fixed.size else None)
 
 
-def _first_step_loads(session: Session) -> dict:
+def _first_step_loads(session: SessionState) -> dict:
     """Ramps of the first load step start from no load (NaN: zero, or TUNIF)."""
     db = session.db
     n_faces = db.faces.keys.size
     return {"hgen": np.full(len(db.elements.ids), np.nan),
             "d_temp": np.full(len(db.nodes.ids), np.nan),
             "faces": {k: np.full(n_faces, np.nan) for k in ("conv_h", "conv_bulk", "hflux")},
-            "key": session.fem_key}
+            "key": session.fem.model_key}
 
 
-def _snapshot(session: Session) -> dict:
+def _snapshot(session: SessionState) -> dict:
     db = session.db
     f = db.faces
     return {"hgen": db.elements.arrays["hgen"].copy(),
             "d_temp": db.nodes.arrays["d_temp"].copy(),
             "faces": {"conv_h": f.conv_h.copy(), "conv_bulk": f.conv_bulk.copy(),
                       "hflux": f.hflux.copy()},
-            "key": session.fem_key}
+            "key": session.fem.model_key}
 
 
-def initial_temperature(session: Session, fem: FemModel, n_dofs: int) -> np.ndarray:
+def initial_temperature(session: SessionState, fem: FemModel, n_dofs: int) -> np.ndarray:
     base = np.full(n_dofs, session.db.settings.tunif)
     return fem.nodal_to_thermal(session.db.nodes.arrays["ic_temp"], base)
 
 
-def solve_thermal(session: Session) -> StepResult:
+def solve_thermal(session: SessionState) -> StepResult:
     fem = fem_model(session)
     _check_axisymmetric(session, "thermal")
     problem = thermal_problem(session, fem)
     s = session.db.settings
-    if session.previous_loads is not None and session.previous_loads["key"] != session.fem_key:
-        session.previous_loads = None
-    if session.fresh_start or session.state is None or session.state.size != problem.n_dofs:
-        session.state = initial_temperature(session, fem, problem.n_dofs)
-        session.time = 0.0
-        session.fresh_start = False
+    sol = session.solution
+    if sol.previous_loads is not None and sol.previous_loads["key"] != session.fem.model_key:
+        sol.previous_loads = None
+    if sol.fresh_start or sol.temperature is None or sol.temperature.size != problem.n_dofs:
+        sol.temperature = initial_temperature(session, fem, problem.n_dofs)
+        sol.time = 0.0
+        sol.fresh_start = False
     ramped = s.kbc == 0 and s.antype == "TRANS"
     steps_T, steps_t = [], []
     if s.antype == "STATIC" or s.timint is False:
-        end = s.time if s.time is not None else session.time + 1.0
+        end = s.time if s.time is not None else sol.time + 1.0
         loads = thermal_loads(session, fem)
         try:
             T = problem.steady(loads)
@@ -263,15 +252,15 @@ def solve_thermal(session: Session) -> StepResult:
     else:
         if s.time is None:
             raise ApdlError("a transient load step needs its end time (TIME)")
-        span = s.time - session.time
+        span = s.time - sol.time
         if not span > 0.0:
-            raise ApdlError(f"TIME {s.time!r} is not after the current time {session.time!r}")
+            raise ApdlError(f"TIME {s.time!r} is not after the current time {sol.time!r}")
         if s.deltim is not None:
             n = max(1, int(np.ceil(span / s.deltim - 1e-9)))
         else:
             n = s.nsubst or 1
         dt = span / n
-        T = session.state
+        T = sol.temperature
         stepper = None
         for k in range(1, n + 1):
             if stepper is None or ramped:
@@ -279,16 +268,16 @@ def solve_thermal(session: Session) -> StepResult:
                 stepper = problem.transient(loads, dt)
             T = stepper.step(T)
             steps_T.append(T)
-            steps_t.append(session.time + k * dt if k < n else s.time)
-    session.state = steps_T[-1]
-    session.time = steps_t[-1]
-    session.substep_times = steps_t
-    session.substep_temperatures = steps_T
-    session.previous_loads = _snapshot(session)
-    return StepResult(len(session.results) + 1, session.time, "thermal", session.state)
+            steps_t.append(sol.time + k * dt if k < n else s.time)
+    sol.temperature = steps_T[-1]
+    sol.time = steps_t[-1]
+    sol.substep_times = steps_t
+    sol.substep_temperatures = steps_T
+    sol.previous_loads = _snapshot(session)
+    return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature)
 
 
-def _constraints(session: Session, fem: FemModel) -> dict[str, str]:
+def _constraints(session: SessionState, fem: FemModel) -> dict[str, str]:
     nodes = session.db.nodes.arrays
     for label in ("d_ux", "d_uy"):
         v = nodes[label]
@@ -318,7 +307,7 @@ def _constraints(session: Session, fem: FemModel) -> dict[str, str]:
     return out
 
 
-def solve_structural(session: Session) -> StepResult:
+def solve_structural(session: SessionState) -> StepResult:
     fem = fem_model(session)
     _check_axisymmetric(session, "structural")
     s = session.db.settings
@@ -327,19 +316,21 @@ def solve_structural(session: Session) -> StepResult:
     mats = _materials(session, fem, "structural")
     constraints = _constraints(session, fem)
     key = (id(fem), _material_key(mats), tuple(sorted(constraints.items())), s.tref, fem.order)
-    if session.elastic_key != key:
+    cache = session.fem
+    if cache.elastic_key != key:
         try:
-            session.elastic = ElasticProblem(fem.mesh, mats, constraints, T_ref=s.tref,
+            cache.elastic = ElasticProblem(fem.mesh, mats, constraints, T_ref=s.tref,
                                              order=fem.order)
         except RuntimeError as exc:  # singular stiffness (a mechanism)
             raise ApdlError(f"the structure is not held (singular stiffness: {exc})") from None
-        session.elastic_key = key
-    elastic = session.elastic
+        cache.elastic_key = key
+    elastic = cache.elastic
     n_t = elastic.temperature_basis.N
-    base = session.body_temperature if session.body_temperature is not None and \
-        session.body_temperature.size == n_t else np.full(n_t, s.tunif)
+    sol = session.solution
+    base = sol.body_temperature if sol.body_temperature is not None and \
+        sol.body_temperature.size == n_t else np.full(n_t, s.tunif)
     T = fem.nodal_to_thermal(session.db.nodes.arrays["bf_temp"], base)
     u = elastic.solve(T)
     stress = elastic.stresses(u, T)
-    session.time = s.time if s.time is not None else session.time + 1.0
-    return StepResult(len(session.results) + 1, session.time, "structural", T, u, stress)
+    sol.time = s.time if s.time is not None else sol.time + 1.0
+    return StepResult(len(sol.results) + 1, sol.time, "structural", T, u, stress)

@@ -51,7 +51,7 @@ def run(windows: int = 9) -> dict:
         t0 = time.perf_counter()
         parse_deck(text, "w.inp")
         parse_ms.append(1e3 * (time.perf_counter() - t0))
-        T_start = session.state.copy()
+        T_start = session.state.solution.temperature.copy()
         t0 = time.perf_counter()
         session.run_text(text, f"window_{k:03d}.inp")
         deck_ms.append(1e3 * (time.perf_counter() - t0))
@@ -63,7 +63,7 @@ def run(windows: int = 9) -> dict:
         for _ in range(ls.n_steps):
             T = stepper.step(T)
         solve_ms.append(1e3 * (time.perf_counter() - t0))
-        assert np.allclose(T, session.state, rtol=1e-10, atol=1e-10)
+        assert np.allclose(T, session.state.solution.temperature, rtol=1e-10, atol=1e-10)
     deck, solve = statistics.median(deck_ms), statistics.median(solve_ms)
     return {
         "mesh_nodes": int(mesh.thermal.p.shape[1]),

@@ -183,7 +183,7 @@ def test_transient_uniform_heating_stepped():
     expected = 20.0 + 5e6 * 12.0 / (7800 * 460)
     assert s.params["T_A"] == pytest.approx(expected, rel=1e-10)
     assert s.params["T_B"] == pytest.approx(expected, rel=1e-10)
-    assert len(s.substep_temperatures) == 8
+    assert len(s.state.solution.substep_temperatures) == 8
 
 
 def test_transient_uniform_heating_ramped():

@@ -6,46 +6,35 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.commands import ANY, Call, command
+from apdl_like.call import ANY, Call, CommandSpec, ignored
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
 def _enter(processor: str):  # noqa: ANN202
-    def enter(s: Session, c: Call) -> None:
+    def enter(s: SessionState, c: Call) -> None:
         s.processor = processor
 
     return enter
 
 
-command("/PREP7", ANY, 0)(_enter("PREP7"))
-command("/SOLU", ANY, 0)(_enter("SOLU"))
-command("/POST1", ANY, 0)(_enter("POST1"))
-command("FINISH", ANY, 0)(_enter("BEGIN"))
-
-
-@command("/COM", ANY, 1)
-def com(s: Session, c: Call) -> None:
+def com(s: SessionState, c: Call) -> None:
     s.say(c.raw(1))
 
 
-@command("/TITLE", ANY, 1)
-def title(s: Session, c: Call) -> None:
-    s.title = c.raw(1)
+def title(s: SessionState, c: Call) -> None:
+    s.db.title = c.raw(1)
 
 
-command("/STITLE", ANY, 1)(lambda s, c: None)
 # output controls that archives and MAPDL decks carry; they change nothing here
-for _name in ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VERIFY", "/OUTPUT",
-              "/NERR", "/SHOW", "/CONFIG", "/FILNAME", "/CLEAR"):
-    command(_name, ANY, 10)(lambda s, c: None)
+OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VERIFY",
+                   "/OUTPUT", "/NERR", "/SHOW", "/CONFIG", "/FILNAME", "/CLEAR")
 
 
-@command("*SET", ANY, 11)
-def star_set(s: Session, c: Call) -> None:
+def star_set(s: SessionState, c: Call) -> None:
     name = c.raw(1).upper()
     if not is_parameter_name(name):
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
@@ -62,8 +51,7 @@ def star_set(s: Session, c: Call) -> None:
 _STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
 
 
-@command("*GET", ANY, 8)
-def star_get(s: Session, c: Call) -> None:
+def star_get(s: SessionState, c: Call) -> None:
     """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM ...)."""
     name = c.raw(1).upper()
     if not is_parameter_name(name):
@@ -99,7 +87,7 @@ def star_get(s: Session, c: Call) -> None:
         elif item == "LOC":
             if sub not in ("X", "Y", "Z"):
                 raise ApdlError(f"field 5: LOC takes X, Y or Z, got {sub or '(empty)'!r}")
-            i = s._node_index(n)
+            i = s.node_index(n)
             value = 0.0 if sub == "Z" else float(db.nodes.xy[i, 0 if sub == "X" else 1])
         else:
             raise ApdlError(f"field 4: NODE item must be TEMP, U, S, LOC or NUM, got "
@@ -107,3 +95,17 @@ def star_get(s: Session, c: Call) -> None:
     if not np.isfinite(value):
         raise ApdlError("the requested value is not a finite number")
     s.params[name] = float(value)
+
+
+COMMANDS = (
+    CommandSpec("/COM", ANY, 1, com),
+    CommandSpec("/TITLE", ANY, 1, title),
+    CommandSpec("*SET", ANY, 11, star_set),
+    CommandSpec("*GET", ANY, 8, star_get),
+    CommandSpec("/PREP7", ANY, 0, _enter("PREP7")),
+    CommandSpec("/SOLU", ANY, 0, _enter("SOLU")),
+    CommandSpec("/POST1", ANY, 0, _enter("POST1")),
+    CommandSpec("FINISH", ANY, 0, _enter("BEGIN")),
+    CommandSpec("/STITLE", ANY, 1, ignored),
+    *(CommandSpec(name, ANY, 10, ignored) for name in OUTPUT_CONTROLS),
+)

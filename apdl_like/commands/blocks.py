@@ -6,18 +6,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from apdl_like.call import PREP7, Call, CommandSpec
 from apdl_like.cdb import parse_cmblock, parse_eblock, parse_nblock
-from apdl_like.commands import PREP7, Call, command
 from apdl_like.commands.prep7 import MAX_ENTITY_NUMBER
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
-@command("NBLOCK", PREP7, 6)
-def nblock(s: Session, c: Call) -> None:
+def nblock(s: SessionState, c: Call) -> None:
     ids, xyz = parse_nblock(c.statement.block)
     if ids.size and (ids.min() < 1 or ids.max() > MAX_ENTITY_NUMBER):
         raise ApdlError("NBLOCK node number out of range")
@@ -28,8 +27,7 @@ def nblock(s: Session, c: Call) -> None:
     s.db.nodes.flush()
 
 
-@command("EBLOCK", PREP7, 6)
-def eblock(s: Session, c: Call) -> None:
+def eblock(s: SessionState, c: Call) -> None:
     db = s.db
     rows = parse_eblock(c.statement.block)
     for num, etype, mat, real, nodes in rows:
@@ -49,8 +47,7 @@ def eblock(s: Session, c: Call) -> None:
     db.elements.flush()
 
 
-@command("CMBLOCK", PREP7 | {"BEGIN", "SOLU"}, 4)
-def cmblock(s: Session, c: Call) -> None:
+def cmblock(s: SessionState, c: Call) -> None:
     name = c.raw(1).upper()
     if not name or not name[0].isalpha() or len(name) > 32:
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid component name")
@@ -58,3 +55,10 @@ def cmblock(s: Session, c: Call) -> None:
     if entity not in ("NODE", "ELEM"):
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity!r}")
     s.db.components[name] = Component(entity, parse_cmblock(c.statement.block))
+
+
+COMMANDS = (
+    CommandSpec("NBLOCK", PREP7, 6, nblock),
+    CommandSpec("EBLOCK", PREP7, 6, eblock),
+    CommandSpec("CMBLOCK", PREP7 | {"BEGIN", "SOLU"}, 4, cmblock),
+)

@@ -11,17 +11,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.commands import LOADS, Call, command
+from apdl_like.call import LOADS, Call, CommandSpec
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import pair_keys
 from apdl_like.solve import fem_model
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
-def node_targets(s: Session, c: Call, i: int = 1, end_field: int | None = None) -> np.ndarray:
+def node_targets(s: SessionState, c: Call, i: int = 1, end_field: int | None = None) -> np.ndarray:
     """Node indices named by field i: ALL (selected), a component, or a number [NEND, NINC]."""
     nodes = s.db.nodes
     text = c.label(i)
@@ -55,7 +55,7 @@ def node_targets(s: Session, c: Call, i: int = 1, end_field: int | None = None) 
     return idx
 
 
-def element_targets(s: Session, c: Call, i: int = 1) -> np.ndarray:
+def element_targets(s: SessionState, c: Call, i: int = 1) -> np.ndarray:
     el = s.db.elements
     text = c.label(i)
     if not text:
@@ -82,8 +82,7 @@ def element_targets(s: Session, c: Call, i: int = 1) -> np.ndarray:
 _D_LABELS = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",), "ALL": ("d_ux", "d_uy")}
 
 
-@command("D", LOADS, 11)
-def d(s: Session, c: Call) -> None:
+def d(s: SessionState, c: Call) -> None:
     labels = [c.label(2)] + [c.label(i) for i in range(7, 12) if c.given(i)]
     for lab in labels:
         if lab not in _D_LABELS:
@@ -99,8 +98,7 @@ def d(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-@command("DDELE", LOADS, 5)
-def ddele(s: Session, c: Call) -> None:
+def ddele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     keys = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",),
             "ALL": ("d_temp", "d_ux", "d_uy")}.get(lab)
@@ -111,14 +109,14 @@ def ddele(s: Session, c: Call) -> None:
         s.db.nodes.arrays[key][idx] = np.nan
 
 
-def _faces_on_nodes(s: Session, idx: np.ndarray) -> np.ndarray:
+def _faces_on_nodes(s: SessionState, idx: np.ndarray) -> np.ndarray:
     fem = fem_model(s)
     mask = np.zeros(len(s.db.nodes.ids), bool)
     mask[idx] = True
     return np.nonzero(mask[fem.face_nodes[0]] & mask[fem.face_nodes[1]])[0]
 
 
-def _set_face_load(s: Session, faces: np.ndarray, lab: str, v1: float | None,
+def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | None,
                    v2: float | None) -> None:
     f = s.db.faces
     rec = s.db.next_record()
@@ -135,8 +133,7 @@ def _set_face_load(s: Session, faces: np.ndarray, lab: str, v1: float | None,
         f.hflux_record[faces] = rec
 
 
-@command("SF", LOADS, 4)
-def sf(s: Session, c: Call) -> None:
+def sf(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab not in ("CONV", "HFLUX"):
         raise ApdlError(f"field 2: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
@@ -149,8 +146,7 @@ def sf(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-@command("SFDELE", LOADS, 2)
-def sfdele(s: Session, c: Call) -> None:
+def sfdele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     if lab not in ("CONV", "HFLUX", "ALL"):
         raise ApdlError(f"field 2 must be CONV, HFLUX or ALL, got {lab!r}")
@@ -162,7 +158,7 @@ def sfdele(s: Session, c: Call) -> None:
         f.hflux[faces], f.hflux_record[faces] = np.nan, -1
 
 
-def _element_faces(s: Session, elems: np.ndarray, lkey: int) -> np.ndarray:
+def _element_faces(s: SessionState, elems: np.ndarray, lkey: int) -> np.ndarray:
     db = s.db
     fem = fem_model(s)
     nodes = db.elements.nodes[elems]
@@ -186,8 +182,7 @@ def _element_faces(s: Session, elems: np.ndarray, lkey: int) -> np.ndarray:
     return faces
 
 
-@command("SFE", LOADS, 8)
-def sfe(s: Session, c: Call) -> None:
+def sfe(s: SessionState, c: Call) -> None:
     lkey = c.int(2, 1, what="LKEY")
     if lkey not in (1, 2, 3, 4):
         raise ApdlError(f"field 2 (LKEY) must be 1..4, got {lkey}")
@@ -210,14 +205,13 @@ def sfe(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-def _set_hgen(s: Session, elems: np.ndarray, value: float | None) -> None:
+def _set_hgen(s: SessionState, elems: np.ndarray, value: float | None) -> None:
     arrays = s.db.elements.arrays
     arrays["hgen"][elems] = np.nan if value is None else value
     arrays["hgen_record"][elems] = -1 if value is None else s.db.next_record()
 
 
-@command("BF", LOADS, 6)
-def bf(s: Session, c: Call) -> None:
+def bf(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab == "TEMP":
         value = c.num(3, what="VAL1")
@@ -235,8 +229,7 @@ def bf(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-@command("BFE", LOADS, 7)
-def bfe(s: Session, c: Call) -> None:
+def bfe(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab != "HGEN":
         raise ApdlError(f"field 2: element body load must be HGEN, got {lab or '(empty)'!r}")
@@ -251,16 +244,14 @@ def bfe(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-@command("BFEDELE", LOADS, 2)
-def bfedele(s: Session, c: Call) -> None:
+def bfedele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     if lab not in ("HGEN", "ALL"):
         raise ApdlError(f"field 2 must be HGEN or ALL, got {lab!r}")
     _set_hgen(s, element_targets(s, c, 1), None)
 
 
-@command("IC", LOADS, 5)
-def ic(s: Session, c: Call) -> None:
+def ic(s: SessionState, c: Call) -> None:
     lab = c.label(2, "TEMP")
     if lab != "TEMP":
         raise ApdlError(f"field 2: initial condition must be TEMP, got {lab!r}")
@@ -268,18 +259,31 @@ def ic(s: Session, c: Call) -> None:
     s.db.nodes.arrays["ic_temp"][node_targets(s, c, 1)] = value
 
 
-@command("TUNIF", LOADS, 1)
-def tunif(s: Session, c: Call) -> None:
+def tunif(s: SessionState, c: Call) -> None:
     s.db.settings.tunif = c.num(1, 0.0, what="TEMP")
 
 
-@command("BFUNIF", LOADS, 2)
-def bfunif(s: Session, c: Call) -> None:
+def bfunif(s: SessionState, c: Call) -> None:
     if c.label(1) != "TEMP":
         raise ApdlError(f"field 1: BFUNIF supports TEMP only, got {c.label(1) or '(empty)'!r}")
     s.db.settings.tunif = c.num(2, 0.0, what="VALUE")
 
 
-@command("TREF", LOADS, 1)
-def tref(s: Session, c: Call) -> None:
+def tref(s: SessionState, c: Call) -> None:
     s.db.settings.tref = c.num(1, 0.0, what="TREF")
+
+
+COMMANDS = (
+    CommandSpec("D", LOADS, 11, d),
+    CommandSpec("DDELE", LOADS, 5, ddele),
+    CommandSpec("SF", LOADS, 4, sf),
+    CommandSpec("SFDELE", LOADS, 2, sfdele),
+    CommandSpec("SFE", LOADS, 8, sfe),
+    CommandSpec("BF", LOADS, 6, bf),
+    CommandSpec("BFE", LOADS, 7, bfe),
+    CommandSpec("BFEDELE", LOADS, 2, bfedele),
+    CommandSpec("IC", LOADS, 5, ic),
+    CommandSpec("TUNIF", LOADS, 1, tunif),
+    CommandSpec("BFUNIF", LOADS, 2, bfunif),
+    CommandSpec("TREF", LOADS, 1, tref),
+)

@@ -6,27 +6,26 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.commands import POST, Call, command
+from apdl_like.call import POST, Call, CommandSpec
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 
-@command("SET", POST, 5)
-def set_(s: Session, c: Call) -> None:
-    if not s.results:
+def set_(s: SessionState, c: Call) -> None:
+    if not s.solution.results:
         raise ApdlError("there are no results (SOLVE first)")
     what = c.label(1, "LAST")
     if what in ("LAST", ""):
-        s.post_index = len(s.results) - 1
+        s.solution.post_index = len(s.solution.results) - 1
     elif what == "FIRST":
-        s.post_index = 0
+        s.solution.post_index = 0
     else:
         step = c.int(1, what="LSTEP")
-        if not 1 <= step <= len(s.results):
-            raise ApdlError(f"load step {step} does not exist (1..{len(s.results)})")
-        s.post_index = step - 1
+        if not 1 <= step <= len(s.solution.results):
+            raise ApdlError(f"load step {step} does not exist (1..{len(s.solution.results)})")
+        s.solution.post_index = step - 1
 
 
 _ITEMS = {
@@ -38,15 +37,14 @@ _ITEMS = {
 }
 
 
-@command("PRNSOL", POST, 2)
-def prnsol(s: Session, c: Call) -> None:
+def prnsol(s: SessionState, c: Call) -> None:
     key = (c.label(1, "TEMP"), c.label(2))
     items = _ITEMS.get(key)
     if items is None:
         raise ApdlError(f"PRNSOL supports TEMP, U,X|Y|COMP and S,X|Y|Z|XY|COMP|EQV, got "
                         f"{','.join(k for k in key if k)!r}")
     res = s.result()
-    fem = s.fem
+    fem = s.fem.model
     assert fem is not None
     nodes = s.db.nodes
     sel = np.nonzero(nodes.selected)[0]
@@ -68,3 +66,9 @@ def prnsol(s: Session, c: Call) -> None:
         if all(np.isnan(v) for v in values):
             continue
         s.say(f"{int(nodes.ids[i]):8d} " + "".join(f"{v:16.6E}" for v in values))
+
+
+COMMANDS = (
+    CommandSpec("SET", POST, 5, set_),
+    CommandSpec("PRNSOL", POST, 2, prnsol),
+)

@@ -6,12 +6,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.commands import PREP7, Call, command
+from apdl_like.call import PREP7, Call, CommandSpec, ignored
 from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 MAX_ENTITY_NUMBER = 2**31 - 1
 MP_LABELS = ("KXX", "DENS", "C", "EX", "PRXY", "NUXY", "ALPX")
@@ -43,8 +43,7 @@ def _element_name(c: Call) -> str:
     raise ApdlError(f"element {text} is not supported (PLANE55, PLANE77, PLANE182, PLANE183)")
 
 
-@command("ET", PREP7, 8)
-def et(s: Session, c: Call) -> None:
+def et(s: SessionState, c: Call) -> None:
     itype = _entity_number(c, 1, "ITYPE")
     name = _element_name(c)
     if name in CONTACT_TYPES:
@@ -58,8 +57,7 @@ def et(s: Session, c: Call) -> None:
     s.db.element_types[itype] = ElementType(name, keyopt)
 
 
-@command("KEYOPT", PREP7, 3)
-def keyopt(s: Session, c: Call) -> None:
+def keyopt(s: SessionState, c: Call) -> None:
     itype = _entity_number(c, 1, "ITYPE")
     knum = c.int(2, what="KNUM")
     if not 1 <= knum <= 18:
@@ -71,8 +69,7 @@ def keyopt(s: Session, c: Call) -> None:
     et_.keyopt[knum] = value
 
 
-@command("ETCHG", PREP7, 1)
-def etchg(s: Session, c: Call) -> None:
+def etchg(s: SessionState, c: Call) -> None:
     how = c.label(1)
     if how not in ("TTS", "STT"):
         raise ApdlError(f"field 1 must be TTS (thermal to structural) or STT, got {how!r}")
@@ -84,19 +81,15 @@ def etchg(s: Session, c: Call) -> None:
 
 
 def _attribute(name: str):  # noqa: ANN202
-    def set_attribute(s: Session, c: Call) -> None:
+    def set_attribute(s: SessionState, c: Call) -> None:
         setattr(s.db, f"active_{name}", _entity_number(c, 1, name.upper()))
 
     return set_attribute
 
 
-command("TYPE", PREP7, 1)(_attribute("type"))
-command("MAT", PREP7, 1)(_attribute("mat"))
-command("REAL", PREP7, 1)(_attribute("real"))
 
 
-@command("MP", PREP7, 7)
-def mp(s: Session, c: Call) -> None:
+def mp(s: SessionState, c: Call) -> None:
     label = c.label(1)
     if label not in MP_LABELS:
         raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
@@ -112,32 +105,30 @@ def mp(s: Session, c: Call) -> None:
     s.db.materials.setdefault(mat, Material()).props[label] = value
 
 
-def _real_values(s: Session, nset: int, start: int, c: Call, first_field: int, count: int) -> None:
+def _real_values(s: SessionState, nset: int, start: int, c: Call, first_field: int,
+                 count: int) -> None:
     values = s.db.real_sets.setdefault(nset, {})
     for k in range(count):
         if c.given(first_field + k):
             values[start + k] = c.num(first_field + k, what=f"R{start + k}")
 
 
-@command("R", PREP7, 7)
-def r(s: Session, c: Call) -> None:
+def r(s: SessionState, c: Call) -> None:
     nset = _entity_number(c, 1, "NSET")
     s.db.real_sets[nset] = {}
     _real_values(s, nset, 1, c, 2, 6)
-    s.last_real = (nset, 7)
+    s.db.last_real = (nset, 7)
 
 
-@command("RMORE", PREP7, 6)
-def rmore(s: Session, c: Call) -> None:
-    if s.last_real is None:
+def rmore(s: SessionState, c: Call) -> None:
+    if s.db.last_real is None:
         raise ApdlError("RMORE needs a preceding R command")
-    nset, start = s.last_real
+    nset, start = s.db.last_real
     _real_values(s, nset, start, c, 1, 6)
-    s.last_real = (nset, start + 6)
+    s.db.last_real = (nset, start + 6)
 
 
-@command("RMODIF", PREP7, 8)
-def rmodif(s: Session, c: Call) -> None:
+def rmodif(s: SessionState, c: Call) -> None:
     nset = _entity_number(c, 1, "NSET")
     stloc = c.int(2, what="STLOC")
     if not 1 <= stloc <= 100:
@@ -148,8 +139,7 @@ def rmodif(s: Session, c: Call) -> None:
     s.note_load(c)
 
 
-@command("N", PREP7, 7)
-def n(s: Session, c: Call) -> None:
+def n(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     if c.given(1):
         num = _entity_number(c, 1, "NODE")
@@ -166,8 +156,7 @@ def n(s: Session, c: Call) -> None:
 _NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (8,), "PLANE183": (8,)}
 
 
-@command("E", PREP7, 8)
-def e(s: Session, c: Call) -> None:
+def e(s: SessionState, c: Call) -> None:
     db = s.db
     et_ = db.element_types.get(db.active_type)
     if et_ is None:
@@ -193,8 +182,7 @@ def e(s: Session, c: Call) -> None:
     el.add(number, db.active_type, db.active_mat, db.active_real, tuple(nums))
 
 
-@command("K", PREP7, 4)
-def k(s: Session, c: Call) -> None:
+def k(s: SessionState, c: Call) -> None:
     kps = s.db.keypoints
     num = _entity_number(c, 1, "NPT") if c.given(1) else max(kps, default=0) + 1
     if c.given(4) and c.num(4) != 0.0:
@@ -202,8 +190,7 @@ def k(s: Session, c: Call) -> None:
     kps[num] = (c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
 
 
-@command("A", PREP7, 18)
-def a(s: Session, c: Call) -> None:
+def a(s: SessionState, c: Call) -> None:
     pts = [_entity_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
     if len(pts) < 3:
         raise ApdlError("an area needs at least 3 keypoints")
@@ -213,8 +200,7 @@ def a(s: Session, c: Call) -> None:
     s.db.areas[max(s.db.areas, default=0) + 1] = pts
 
 
-@command("RECTNG", PREP7, 4)
-def rectng(s: Session, c: Call) -> None:
+def rectng(s: SessionState, c: Call) -> None:
     x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
     y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
     if x1 == x2 or y1 == y2:
@@ -227,20 +213,17 @@ def rectng(s: Session, c: Call) -> None:
     s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
 
 
-@command("ESIZE", PREP7, 2)
-def esize(s: Session, c: Call) -> None:
+def esize(s: SessionState, c: Call) -> None:
     size = c.num(1, what="SIZE")
     if not size > 0.0:
         raise ApdlError(f"field 1 (SIZE) must be positive, got {size!r}")
     s.db.esize = size
 
 
-command("MSHAPE", PREP7, 2)(lambda s, c: None)  # AMESH makes triangles whatever is asked
-command("MSHKEY", PREP7, 1)(lambda s, c: None)
+# AMESH makes triangles whatever is asked
 
 
-@command("AMESH", PREP7, 3)
-def amesh(s: Session, c: Call) -> None:
+def amesh(s: SessionState, c: Call) -> None:
     from apdl_like.meshing import mesh_areas
 
     areas = s.db.areas
@@ -263,8 +246,7 @@ def amesh(s: Session, c: Call) -> None:
     s.db.meshed_areas.update(chosen)
 
 
-@command("EMODIF", PREP7, 3)
-def emodif(s: Session, c: Call) -> None:
+def emodif(s: SessionState, c: Call) -> None:
     """EMODIF,IEL|ALL,MAT|TYPE|REAL,value: change an attribute of elements."""
     from apdl_like.commands.loads import element_targets
 
@@ -277,3 +259,27 @@ def emodif(s: Session, c: Call) -> None:
     idx = element_targets(s, c, 1)
     getattr(s.db.elements, what.lower())[idx] = value
     s.db.elements.version += 1
+
+
+COMMANDS = (
+    CommandSpec("ET", PREP7, 8, et),
+    CommandSpec("KEYOPT", PREP7, 3, keyopt),
+    CommandSpec("ETCHG", PREP7, 1, etchg),
+    CommandSpec("MP", PREP7, 7, mp),
+    CommandSpec("R", PREP7, 7, r),
+    CommandSpec("RMORE", PREP7, 6, rmore),
+    CommandSpec("RMODIF", PREP7, 8, rmodif),
+    CommandSpec("N", PREP7, 7, n),
+    CommandSpec("E", PREP7, 8, e),
+    CommandSpec("K", PREP7, 4, k),
+    CommandSpec("A", PREP7, 18, a),
+    CommandSpec("RECTNG", PREP7, 4, rectng),
+    CommandSpec("ESIZE", PREP7, 2, esize),
+    CommandSpec("AMESH", PREP7, 3, amesh),
+    CommandSpec("EMODIF", PREP7, 3, emodif),
+    CommandSpec("TYPE", PREP7, 1, _attribute("type")),
+    CommandSpec("MAT", PREP7, 1, _attribute("mat")),
+    CommandSpec("REAL", PREP7, 1, _attribute("real")),
+    CommandSpec("MSHAPE", PREP7, 2, ignored),
+    CommandSpec("MSHKEY", PREP7, 1, ignored),
+)

@@ -6,13 +6,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.commands import MODEL, Call, command
+from apdl_like.call import MODEL, Call, CommandSpec
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 from apdl_like.selection import combine, in_range, number_range
 
 if TYPE_CHECKING:
-    from apdl_like.session import Session
+    from apdl_like.state import SessionState
 
 _ANY_OR_BEGIN = MODEL | {"BEGIN"}
 
@@ -32,8 +32,7 @@ def _range(c: Call) -> tuple[float, float, float]:
     return vmin, vmax, vinc
 
 
-@command("NSEL", _ANY_OR_BEGIN, 7)
-def nsel(s: Session, c: Call) -> None:
+def nsel(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     mode = _mode(c)
     current = nodes.selected
@@ -56,8 +55,7 @@ def nsel(s: Session, c: Call) -> None:
     nodes.selected = combine(mode, current, picked)
 
 
-@command("ESEL", _ANY_OR_BEGIN, 7)
-def esel(s: Session, c: Call) -> None:
+def esel(s: SessionState, c: Call) -> None:
     el = s.db.elements
     mode = _mode(c)
     current = el.selected
@@ -82,7 +80,7 @@ def esel(s: Session, c: Call) -> None:
     el.selected = combine(mode, current, picked)
 
 
-def _centroids(s: Session) -> np.ndarray:
+def _centroids(s: SessionState) -> np.ndarray:
     el = s.db.elements
     corner = el.nodes[:, :4]
     idx = s.db.nodes.index(corner.ravel()).reshape(corner.shape)
@@ -95,15 +93,14 @@ def _centroids(s: Session) -> np.ndarray:
     return (xy * w[..., None]).sum(axis=1) / np.maximum(w.sum(axis=1), 1.0)[:, None]
 
 
-def _element_node_indices(s: Session, element_mask: np.ndarray) -> np.ndarray:
+def _element_node_indices(s: SessionState, element_mask: np.ndarray) -> np.ndarray:
     nums = s.db.elements.nodes[element_mask]
     nums = nums[nums > 0]
     idx = s.db.nodes.index(np.unique(nums))
     return idx[idx >= 0]
 
 
-@command("NSLE", _ANY_OR_BEGIN, 3)
-def nsle(s: Session, c: Call) -> None:
+def nsle(s: SessionState, c: Call) -> None:
     mode = _mode(c)
     nodes = s.db.nodes
     picked = np.zeros(len(nodes.ids), bool)
@@ -111,8 +108,7 @@ def nsle(s: Session, c: Call) -> None:
     nodes.selected = combine(mode, nodes.selected, picked)
 
 
-@command("ESLN", _ANY_OR_BEGIN, 3)
-def esln(s: Session, c: Call) -> None:
+def esln(s: SessionState, c: Call) -> None:
     mode = _mode(c)
     key = c.int(2, 0, what="EKEY")
     el, nodes = s.db.elements, s.db.nodes
@@ -125,8 +121,7 @@ def esln(s: Session, c: Call) -> None:
     el.selected = combine(mode, el.selected, picked)
 
 
-@command("ALLSEL", _ANY_OR_BEGIN, 2)
-def allsel(s: Session, c: Call) -> None:
+def allsel(s: SessionState, c: Call) -> None:
     s.db.nodes.selected = np.ones(len(s.db.nodes), bool)
     s.db.elements.selected = np.ones(len(s.db.elements), bool)
 
@@ -139,8 +134,7 @@ def _component_name(c: Call, i: int) -> str:
     return name
 
 
-@command("CM", _ANY_OR_BEGIN, 3)
-def cm(s: Session, c: Call) -> None:
+def cm(s: SessionState, c: Call) -> None:
     name = _component_name(c, 1)
     entity = c.label(2)
     if entity == "NODE":
@@ -152,14 +146,13 @@ def cm(s: Session, c: Call) -> None:
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
 
 
-@command("CMDELE", _ANY_OR_BEGIN, 1)
-def cmdele(s: Session, c: Call) -> None:
+def cmdele(s: SessionState, c: Call) -> None:
     name = _component_name(c, 1)
     if s.db.components.pop(name, None) is None:
         raise ApdlError(f"component {name} does not exist")
 
 
-def component(s: Session, name: str) -> Component:
+def component(s: SessionState, name: str) -> Component:
     comp = s.db.components.get(name.upper())
     if comp is None:
         known = ", ".join(sorted(s.db.components)) or "none"
@@ -167,7 +160,7 @@ def component(s: Session, name: str) -> Component:
     return comp
 
 
-def component_mask(s: Session, comp: Component) -> np.ndarray:
+def component_mask(s: SessionState, comp: Component) -> np.ndarray:
     table = s.db.nodes if comp.entity == "NODE" else s.db.elements
     table.flush()
     mask = np.zeros(len(table.ids), bool)
@@ -176,8 +169,7 @@ def component_mask(s: Session, comp: Component) -> np.ndarray:
     return mask
 
 
-@command("CMSEL", _ANY_OR_BEGIN, 3)
-def cmsel(s: Session, c: Call) -> None:
+def cmsel(s: SessionState, c: Call) -> None:
     mode = c.label(1, "S")
     if mode in ("ALL", "NONE"):
         for comp in s.db.components.values():
@@ -191,3 +183,15 @@ def cmsel(s: Session, c: Call) -> None:
     comp = component(s, _component_name(c, 2))
     table = s.db.nodes if comp.entity == "NODE" else s.db.elements
     table.selected = combine(mode, table.selected, component_mask(s, comp))
+
+
+COMMANDS = (
+    CommandSpec("NSEL", _ANY_OR_BEGIN, 7, nsel),
+    CommandSpec("ESEL", _ANY_OR_BEGIN, 7, esel),
+    CommandSpec("NSLE", _ANY_OR_BEGIN, 3, nsle),
+    CommandSpec("ESLN", _ANY_OR_BEGIN, 3, esln),
+    CommandSpec("ALLSEL", _ANY_OR_BEGIN, 2, allsel),
+    CommandSpec("CM", _ANY_OR_BEGIN, 3, cm),
+    CommandSpec("CMDELE", _ANY_OR_BEGIN, 1, cmdele),
+    CommandSpec("CMSEL", _ANY_OR_BEGIN, 3, cmsel),
+)

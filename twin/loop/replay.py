@@ -132,14 +132,7 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
             contact_resistance=loads.contact_resistance,
         )
         deck = window_deck(load_set, session.layout)
-        if start_s == 0.0:
-            # the first deck is a new analysis (ANTYPE,TRANS): it starts from TUNIF, which
-            # is the run's uniform initial field
-            session.db.settings.tunif = float(T[0])
-        else:
-            session.set_state(T, start_s)
-        session.run_text(deck, file=f"window_{window:03d}.inp")
-        return np.asarray(session.substep_temperatures), deck
+        return session.advance(T, start_s, deck, file=f"window_{window:03d}.inp"), deck
 
     return solve
 

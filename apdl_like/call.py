@@ -1,0 +1,90 @@
+"""What a command is: its spec (name, processors, field count, handler) and its call.
+
+Handlers are plain functions `handler(state, call)` on the session's `SessionState`; `call`
+gives typed access to the fields with APDL's 1-based numbering (field 1 is the first after
+the command name).  The table of all commands is built by `apdl_like.registry`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from apdl_like.errors import ApdlError
+from apdl_like.expressions import compile_expression
+from apdl_like.parser import Statement
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+ANY = frozenset({"BEGIN", "PREP7", "SOLU", "POST1"})
+PREP7 = frozenset({"PREP7"})
+SOLU = frozenset({"SOLU"})
+LOADS = frozenset({"PREP7", "SOLU"})
+POST = frozenset({"POST1"})
+MODEL = frozenset({"PREP7", "SOLU", "POST1"})
+
+Handler = Callable[["SessionState", "Call"], None]
+
+
+@dataclass(frozen=True)
+class CommandSpec:
+    """One APDL command: its name, where it may run, how many fields, what runs it."""
+
+    name: str
+    processors: frozenset[str]
+    max_fields: int
+    handler: Handler
+
+
+def ignored(s: SessionState, c: Call) -> None:
+    """Handler of commands that are accepted and change nothing here (output controls)."""
+
+
+class Call:
+    """The fields of one command, evaluated on demand."""
+
+    __slots__ = ("statement", "state")
+
+    def __init__(self, statement: Statement, state: SessionState) -> None:
+        self.statement = statement
+        self.state = state
+
+    @property
+    def name(self) -> str:
+        return self.statement.name
+
+    def raw(self, i: int) -> str:
+        f = self.statement.fields
+        return f[i - 1] if 0 < i <= len(f) else ""
+
+    def given(self, i: int) -> bool:
+        return self.raw(i) != ""
+
+    def label(self, i: int, default: str = "") -> str:
+        text = self.raw(i)
+        return text.upper() if text else default
+
+    def num(self, i: int, default: float | None = None, what: str = "") -> float:
+        text = self.raw(i)
+        if not text:
+            if default is None:
+                raise ApdlError(f"field {i}{f' ({what})' if what else ''} is required")
+            return default
+        try:
+            return compile_expression(text)(self.state.params, self.state.model_functions)
+        except ApdlError as exc:
+            raise ApdlError(f"field {i}{f' ({what})' if what else ''}: {exc.reason}") from None
+
+    def int(self, i: int, default: int | None = None, what: str = "") -> int:
+        value = self.num(i, None if default is None else float(default), what)
+        if not math.isfinite(value) or abs(value - round(value)) > 1e-9 * max(1.0, abs(value)) \
+                or abs(value) >= 2**31:
+            label = f" ({what})" if what else ""
+            raise ApdlError(f"field {i}{label} must be an integer, got {value!r}")
+        return int(round(value))
+
+    def count(self) -> int:
+        return len(self.statement.fields)

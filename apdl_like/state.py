@@ -1,0 +1,195 @@
+"""`SessionState`: what one APDL-like session holds, as small objects with one owner each.
+
+    db        the APDL database (nodes, elements, materials, loads, settings): written by
+              the /PREP7 and load commands (`apdl_like.commands`)
+    params    scalar parameters: assignments, *SET, *GET, *DO
+    fem       `FemCache`, the FEM view of the mesh and the assembled problems: written by
+              `apdl_like.solve` only
+    solution  `Solution`, the temperature state, time and solved load steps: written by
+              `apdl_like.solve` (SOLVE), ANTYPE (new analysis or restart) and
+              `Session.set_state` / `Session.advance`
+    budget    `RunBudget`, the per-run counters that keep a deck finite: written by
+              `apdl_like.interpreter`; reset by `Session.run_program`
+    processor, log, base_dir, record_only, recorded_solves
+              the deck context: processor commands, /COM and messages, /INPUT folder, and
+              the solve-recording mode of `apdl_like.loadset.read_window_deck`
+
+Command handlers take a `SessionState`; nothing here imports the commands or the session.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from apdl_like.errors import ApdlError
+from apdl_like.fem_bridge import FemModel, nearest_node
+from apdl_like.model import Database
+
+if TYPE_CHECKING:
+    from twin.fem import ElasticProblem, ThermalProblem
+
+TCC_LOCATION = 14  # real-constant position of TCC (thermal contact conductance) on CONTA17x
+
+
+@dataclass
+class StepResult:
+    """One solved load step (its last substep)."""
+
+    load_step: int
+    time: float
+    analysis: str  # "thermal" | "structural"
+    temperature: np.ndarray  # thermal dofs, °C (structural: the body temperature used)
+    displacement: np.ndarray | None = None  # (2, n glued scalar dofs), m
+    stress: dict[str, np.ndarray] = field(default_factory=dict)  # glued scalar dofs, Pa
+
+
+@dataclass
+class FemCache:
+    """The FEM view of the mesh and the problems assembled on it (owner: apdl_like.solve).
+
+    Each entry is rebuilt only when its key (mesh version, materials, constraints) changes.
+    """
+
+    model: FemModel | None = None
+    model_key: tuple | None = None
+    external_mesh: bool = False  # the mesh came from an AxiMesh: N/E may not change it
+    thermal: ThermalProblem | None = None
+    thermal_key: tuple | None = None
+    elastic: ElasticProblem | None = None
+    elastic_key: tuple | None = None
+
+
+@dataclass
+class Solution:
+    """Temperature state, time and solved load steps (owner: apdl_like.solve)."""
+
+    temperature: np.ndarray | None = None  # thermal dofs at `time`, °C
+    time: float = 0.0  # s
+    fresh_start: bool = True  # the next thermal SOLVE starts from TUNIF/IC (ANTYPE, NEW)
+    previous_loads: dict | None = None  # loads of the last load step (start of KBC,0 ramps)
+    body_temperature: np.ndarray | None = None  # LDREAD, thermal dofs, °C
+    substep_times: list[float] = field(default_factory=list)  # of the last load step, s
+    substep_temperatures: list[np.ndarray] = field(default_factory=list)
+    results: list[StepResult] = field(default_factory=list)
+    post_index: int = -1  # result set shown in /POST1 (SET)
+
+
+@dataclass
+class RunBudget:
+    """Per-run counters that keep a deck finite, and the first load not yet solved."""
+
+    statements_run: int = 0
+    loop_iterations: int = 0
+    unsolved: tuple[str, int, str] | None = None  # (file, line, command) after the last SOLVE
+
+
+@dataclass
+class SessionState:
+    """Everything a deck reads and writes (see the module docstring for the owners)."""
+
+    db: Database = field(default_factory=Database)
+    params: dict[str, float] = field(default_factory=dict)
+    fem: FemCache = field(default_factory=FemCache)
+    solution: Solution = field(default_factory=Solution)
+    budget: RunBudget = field(default_factory=RunBudget)
+    processor: str = "BEGIN"
+    log: list[str] = field(default_factory=list)
+    base_dir: Path | None = None
+    record_only: bool = False  # SOLVE records what it would solve instead of solving
+    recorded_solves: list[dict] = field(default_factory=list)
+    model_functions: dict[str, Any] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.model_functions = {
+            "NX": self._nx, "NY": self._ny, "NZ": self._nz, "NODE": self._node,
+            "TEMP": self._temp, "UX": self._ux, "UY": self._uy,
+        }
+
+    # ------------------------------------------------------------- messages
+    def say(self, text: str) -> None:
+        self.log.append(text)
+
+    def note_load(self, call) -> None:  # noqa: ANN001 - an apdl_like.call.Call
+        """Remember the first load after the last SOLVE (a deck must not end there)."""
+        if self.budget.unsolved is None:
+            st = call.statement
+            self.budget.unsolved = (st.file, st.line, st.name)
+
+    # ------------------------------------------------------ model functions
+    def node_index(self, n: float) -> int:
+        """Position of node number `n` in the node table (ApdlError if it does not exist)."""
+        i = int(self.db.nodes.index(int(round(n)))[0]) if abs(n) < 2**31 else -1
+        if i < 0:
+            raise ApdlError(f"node {n:g} does not exist")
+        return i
+
+    def _nx(self, n: float) -> float:
+        return float(self.db.nodes.xy[self.node_index(n), 0])
+
+    def _ny(self, n: float) -> float:
+        return float(self.db.nodes.xy[self.node_index(n), 1])
+
+    def _nz(self, n: float) -> float:
+        self.node_index(n)
+        return 0.0
+
+    def _node(self, x: float, y: float, z: float = 0.0) -> float:
+        db = self.db
+        i = nearest_node(db.nodes.xy, db.nodes.selected, np.array([x, y]))
+        return 0.0 if i < 0 else float(db.nodes.ids[i])
+
+    def _temp(self, n: float) -> float:
+        return self.nodal_result("TEMP", n)
+
+    def _ux(self, n: float) -> float:
+        return self.nodal_result("UX", n)
+
+    def _uy(self, n: float) -> float:
+        return self.nodal_result("UY", n)
+
+    # -------------------------------------------------------------- results
+    def result(self) -> StepResult:
+        """The result set shown in /POST1 (the last one unless SET chose another)."""
+        results = self.solution.results
+        if not results:
+            raise ApdlError("no results yet (SOLVE first)")
+        return results[self.solution.post_index]
+
+    def nodal_result(self, item: str, n: float) -> float:
+        """TEMP, UX, UY, SX, SY, SZ, SXY, SEQV at node n from the current result set."""
+        i = self.node_index(n)
+        res = self.result()
+        fem = self.fem.model
+        assert fem is not None
+        if item == "TEMP":
+            d = fem.thermal_dof[i]
+            value = res.temperature[d] if d >= 0 else np.nan
+        elif res.displacement is None:
+            raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
+        else:
+            d = fem.glued_dof[i]
+            if item in ("UX", "UY"):
+                value = res.displacement[0 if item == "UX" else 1, d] if d >= 0 else np.nan
+            else:
+                key = {"SX": "rr", "SY": "zz", "SZ": "tt", "SXY": "rz", "SEQV": "von_mises"}[item]
+                value = res.stress[key][d] if d >= 0 else np.nan
+        if np.isnan(value):
+            raise ApdlError(f"node {n:g} is not attached to an element (no {item})")
+        return float(value)
+
+    # -------------------------------------------------------------- outputs
+    def scalar_parameters(self) -> dict[str, float]:
+        return {k.upper(): float(v) for k, v in sorted(self.params.items())}
+
+    def contact_conductance(self) -> dict[str, float]:
+        """Current TCC (W/m²K) per contact interface that has one."""
+        out = {}
+        for name, real in self.db.contact_real_sets.items():
+            tcc = self.db.real_sets.get(real, {}).get(TCC_LOCATION)
+            if tcc is not None:
+                out[name] = tcc
+        return out
