@@ -39,12 +39,11 @@ def make_recorded_run(
         loads = bc.to_thermal_loads(
             H_front=heat * bc.H_front, H_rear=heat * bc.H_rear, R_front=resistance * bc.R_front
         )
-        stepper = model.thermal.transient(loads, 4.0)
-        for _ in range(15):
-            T = stepper.step(T)
+        for T_step in model.thermal.transient(loads, 4.0).march(T, 15):
             times.append(times[-1] + 4.0)
-            temps.append(model.sensor_matrix @ T)
-            drift.append(1e6 * model.probe_vectors[0] @ (T - T0))
+            temps.append(model.sensor_matrix @ T_step)
+            drift.append(1e6 * model.probe_vectors[0] @ (T_step - T0))
+        T = T_step
     rng = np.random.default_rng(seed)
     t = np.array(times)
     temps = np.array(temps) + 0.02 * rng.standard_normal((t.size, 5))

@@ -4,14 +4,22 @@ mesh        AxiMesh: (r, z) triangles with named regions, boundaries, split inte
 materials   Material: isotropic constants, validated
 forms       the weak forms (2πr-weighted), plain scikit-fem forms
 combine     PatternCombination: K(θ) = Σ θ_i K_i on one sparsity pattern
-thermal     ThermalProblem, ThermalLoads, ThermalStepper, energy balance, probes
+elements    P1/P2 Lagrange triangles
+linalg      symmetric factorization, Dirichlet elimination, low-rank (Woodbury) updates
+probes      point-evaluation matrices
+loads       ThermalLoads: one validated load set
+balance     HeatBalance: the discrete heat balance of a step
+thermal     ThermalProblem: operators by region/boundary/interface, steady and transient
+stepper     ThermalStepper: θ-method steps, `march(T, n)` yields each step's temperature
 structural  ElasticProblem: factorized once, thermal load operator, stresses, probes
 """
 
+from twin.fem.loads import ThermalLoads
 from twin.fem.materials import Material
 from twin.fem.mesh import AxiMesh, Interface
+from twin.fem.stepper import ThermalStepper
 from twin.fem.structural import ElasticProblem, von_mises
-from twin.fem.thermal import ThermalLoads, ThermalProblem, ThermalStepper
+from twin.fem.thermal import ThermalProblem
 
 __all__ = [
     "AxiMesh",

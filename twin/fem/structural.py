@@ -19,10 +19,12 @@ import numpy as np
 import scipy.sparse.linalg as spla
 from skfem import Basis, ElementVector, asm
 
-from twin.fem import forms
+from twin.fem.elements import element_for
+from twin.fem.forms import capacity, elasticity, thermal_strain_load, unit_load_weighted
+from twin.fem.linalg import factorize_symmetric
 from twin.fem.materials import Material
 from twin.fem.mesh import AxiMesh
-from twin.fem.thermal import element_for, factorize_symmetric, probe_matrix
+from twin.fem.probes import probe_matrix
 
 COMPONENTS = {"r": 0, "z": 1}
 
@@ -61,10 +63,10 @@ class ElasticProblem:
         }
         self._lam, self._mu = as_qp["lam"], as_qp["mu"]
         self._alpha = as_qp["beta"] / (3.0 * self._lam + 2.0 * self._mu)
-        self.K = asm(forms.elasticity, self.basis, lam=as_qp["lam"], mu=as_qp["mu"])
+        self.K = asm(elasticity, self.basis, lam=as_qp["lam"], mu=as_qp["mu"])
         # G: temperature (trial, thermal mesh) → displacement load (test, glued mesh)
         self.G = asm(
-            forms.thermal_strain_load, self.temperature_basis, self.basis, beta=as_qp["beta"]
+            thermal_strain_load, self.temperature_basis, self.basis, beta=as_qp["beta"]
         ).tocsr()
 
         fixed = []
@@ -155,10 +157,10 @@ class ElasticProblem:
             "rz": self._mu * g_rz,
         }
         if self._stress_mass is None:
-            M = asm(forms.capacity, self.scalar_basis).tocsc()
+            M = asm(capacity, self.scalar_basis).tocsc()
             self._stress_mass = spla.splu(M)
         out = {
-            k: self._stress_mass.solve(asm(forms.unit_load_weighted, self.scalar_basis, s=v))
+            k: self._stress_mass.solve(asm(unit_load_weighted, self.scalar_basis, s=v))
             for k, v in qp.items()
         }
         out["von_mises"] = von_mises(out["rr"], out["zz"], out["tt"], out["rz"])

@@ -15,76 +15,24 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
-from skfem import Basis, ElementTriP1, ElementTriP2, FacetBasis, asm
+from skfem import Basis, FacetBasis, asm
 
-from twin.fem import forms
+from twin.fem.balance import HeatBalance
 from twin.fem.combine import PatternCombination
+from twin.fem.elements import element_for
+from twin.fem.forms import capacity, conduction, unit_load, unit_load_weighted
+from twin.fem.linalg import DirichletSolver, LowRankUpdate, WoodburySolver
+from twin.fem.loads import ThermalLoads, field_values
 from twin.fem.materials import Material
 from twin.fem.mesh import AxiMesh
-
-ELEMENTS = {1: ElementTriP1, 2: ElementTriP2}
-
-
-def element_for(order: int):  # noqa: ANN201 - skfem element instance
-    try:
-        return ELEMENTS[order]()
-    except KeyError:
-        raise ValueError(f"element order must be 1 (P1) or 2 (P2), got {order!r}") from None
-
-
-def _finite(value: float, what: str) -> float:
-    if callable(value):  # a field f(r, z): checked where it is evaluated
-        return 0.0
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{what} must be finite, got {value!r}")
-    return value
-
-
-@dataclass
-class ThermalLoads:
-    """One set of thermal loads (held constant over a window of time steps).
-
-    sources             region → volumetric heat W/m³
-    convection          boundary → (h W/(m²K), T∞ °C)
-    flux                boundary → heat flux into the body W/m²
-    (source densities, fluxes, bulk and fixed temperatures may also be fields given as
-    functions f(r, z) of numpy arrays, like APDL tabular loads)
-    contact_resistance  interface → R m²K/W (interfaces not listed are perfectly bonded
-                        at a negligible R; see ThermalProblem.PERFECT_CONTACT_R)
-    fixed_temperature   boundary → T °C
-    fixed_dofs          optional (dof indices, values °C) for point constraints
-    """
-
-    sources: dict[str, float] = field(default_factory=dict)
-    convection: dict[str, tuple[float, float]] = field(default_factory=dict)
-    flux: dict[str, float] = field(default_factory=dict)
-    contact_resistance: dict[str, float] = field(default_factory=dict)
-    fixed_temperature: dict[str, float] = field(default_factory=dict)
-    fixed_dofs: tuple[np.ndarray, np.ndarray] | None = None
-
-    def __post_init__(self) -> None:
-        for name, q in self.sources.items():
-            _finite(q, f"heat source of region {name!r}")
-        for name, hc in self.convection.items():
-            h, t_inf = hc
-            if not (_finite(h, f"film coefficient of boundary {name!r}") >= 0.0):
-                raise ValueError(f"film coefficient of boundary {name!r} must be ≥ 0, got {h!r}")
-            _finite(t_inf, f"bulk temperature of boundary {name!r}")
-        for name, q in self.flux.items():
-            _finite(q, f"heat flux of boundary {name!r}")
-        for name, r in self.contact_resistance.items():
-            if not (_finite(r, f"contact resistance of interface {name!r}") > 0.0):
-                raise ValueError(f"contact resistance of interface {name!r} must be > 0, got {r!r}")
-        for name, t in self.fixed_temperature.items():
-            _finite(t, f"fixed temperature of boundary {name!r}")
+from twin.fem.probes import probe_matrix
+from twin.fem.stepper import ThermalStepper
 
 
 class ThermalProblem:
@@ -109,9 +57,9 @@ class ThermalProblem:
 
         # one pattern for every operator: all cells plus the interface couplings (built
         # from the mass matrix: its entries are all positive, so none cancels to zero)
-        pattern = asm(forms.capacity, self.basis)
-        self._interface_factors: dict[str, tuple[sp.csc_matrix, np.ndarray]] = {}
-        self._base_factorizations: dict[tuple, _BaseFactorization] = {}
+        pattern = asm(capacity, self.basis)
+        self._interface_jumps: dict[str, sp.csc_matrix] = {}
+        self._interface_mass: dict[str, np.ndarray] = {}
         iface_ops = {}
         for name, iface in mesh.interfaces.items():
             iface_ops[name] = self._interface_operator(name, iface.facets_a, iface.facets_b)
@@ -126,8 +74,8 @@ class ThermalProblem:
             sub = Basis(
                 mesh.thermal, self.element, elements=mesh.region(region), intorder=self.intorder
             )
-            self.ops.add(f"conduction:{region}", asm(forms.conduction, sub))
-            self.ops.add(f"capacity:{region}", asm(forms.capacity, sub))
+            self.ops.add(f"conduction:{region}", asm(conduction, sub))
+            self.ops.add(f"capacity:{region}", asm(capacity, sub))
             k_data += mat.k * self.ops.data({f"conduction:{region}": 1.0})
             c_data += mat.rho_c * self.ops.data({f"capacity:{region}": 1.0})
         self.conduction_data = k_data
@@ -136,6 +84,15 @@ class ThermalProblem:
         self._source_vectors: dict[str, np.ndarray] = {}
         self._region_bases: dict[str, Basis] = {}
         self._facet_loads: dict[str, np.ndarray] = {}
+        self.capacity_vector = self.ops.csr(c_data) @ np.ones(self.n_dofs)
+        """C·1, J/K per dof: the heat a dof stores per K."""
+        # the contact terms are low rank, K_i = U_i M_i U_iᵀ: a window with new contact
+        # resistances updates a factorization instead of making a new one
+        self.contact_update = (
+            LowRankUpdate(sp.hstack([self._interface_jumps[n] for n in mesh.interfaces]))
+            if mesh.interfaces
+            else None
+        )
 
     # ------------------------------------------------------------ operators
     def _check_materials(self) -> None:
@@ -152,7 +109,7 @@ class ThermalProblem:
     def _interface_operator(self, name: str, fa: np.ndarray, fb: np.ndarray) -> sp.csr_matrix:
         """Unit conductance J^T M_a J, with J the jump T_a − T_b on side-a dofs."""
         fbasis = FacetBasis(self.mesh.thermal, self.element, facets=fa, intorder=self.intorder)
-        m_a = asm(forms.capacity, fbasis)
+        m_a = asm(capacity, fbasis)
         dofs_a = self.basis.get_dofs(facets=fa).flatten()
         dofs_b = self.basis.get_dofs(facets=fb).flatten()
         xy = self.basis.doflocs
@@ -170,10 +127,8 @@ class ThermalProblem:
         )
         # low-rank form K_i = U M U^T (U: n × m jump columns, M: facet mass on side a),
         # used to update a factorization when only this interface's resistance changes
-        self._interface_factors[name] = (
-            sp.csc_matrix(jump.T)[:, dofs_a],
-            m_a[dofs_a][:, dofs_a].toarray(),
-        )
+        self._interface_jumps[name] = sp.csc_matrix(jump.T)[:, dofs_a]
+        self._interface_mass[name] = m_a[dofs_a][:, dofs_a].toarray()
         return (jump.T @ m_a @ jump).tocsr()
 
     def facet_basis(self, boundary: str) -> FacetBasis:
@@ -190,8 +145,8 @@ class ThermalProblem:
         key = f"film:{boundary}"
         if key not in self.ops:
             fb = self.facet_basis(boundary)
-            self.ops.add(key, asm(forms.capacity, fb))
-            self._facet_loads[boundary] = asm(forms.unit_load, fb)
+            self.ops.add(key, asm(capacity, fb))
+            self._facet_loads[boundary] = asm(unit_load, fb)
         return key
 
     def facet_load(self, boundary: str) -> np.ndarray:
@@ -209,7 +164,7 @@ class ThermalProblem:
                 intorder=self.intorder,
             )
             self._region_bases[region] = sub
-            self._source_vectors[region] = asm(forms.unit_load, sub)
+            self._source_vectors[region] = asm(unit_load, sub)
         return self._source_vectors[region]
 
     def volume(self, region: str) -> float:
@@ -222,7 +177,7 @@ class ThermalProblem:
         for boundary, t in loads.fixed_temperature.items():
             d = self.basis.get_dofs(facets=self.mesh.boundary(boundary)).flatten()
             dofs.append(d)
-            values.append(_field_values(t, self.basis.doflocs[:, d], f"boundary {boundary!r}"))
+            values.append(field_values(t, self.basis.doflocs[:, d], f"boundary {boundary!r}"))
         if loads.fixed_dofs is not None:
             d = np.asarray(loads.fixed_dofs[0], dtype=np.int64)
             if d.size and (d.min() < 0 or d.max() >= self.n_dofs):
@@ -240,7 +195,7 @@ class ThermalProblem:
         if not callable(value):
             return float(value) * unit
         x = basis.global_coordinates().value
-        return asm(forms.unit_load_weighted, basis, s=_field_values(value, x, what))
+        return asm(unit_load_weighted, basis, s=field_values(value, x, what))
 
     def load_parts(self, loads: ThermalLoads) -> tuple[dict[str, float], dict[str, np.ndarray]]:
         """Film/interface coefficients and the load vectors (W) by kind.
@@ -285,7 +240,7 @@ class ThermalProblem:
         dofs, values = self.fixed(loads)
         if dofs.size == 0 and not any(h > 0 for h, _ in loads.convection.values()):
             raise ValueError("steady problem needs a fixed temperature or a convective boundary")
-        return _LinearSolve(self.ops.csr(k_data), dofs, values).solve(f)
+        return DirichletSolver(self.ops.csr(k_data), dofs, values).solve(f)
 
     def transient(self, loads: ThermalLoads, dt: float, theta: float = 1.0) -> ThermalStepper:
         """A stepper for fixed Δt (s): θ = 1 backward Euler, θ = 0.5 Crank–Nicolson."""
@@ -293,7 +248,89 @@ class ThermalProblem:
             raise ValueError(f"time step must be positive, got {dt!r}")
         if not (0.5 <= theta <= 1.0):
             raise ValueError(f"theta must lie in [0.5, 1], got {theta!r}")
-        return ThermalStepper(self, loads, float(dt), float(theta))
+        dt, theta = float(dt), float(theta)
+        coeff, parts = self.load_parts(loads)
+        k_data = self.conduction_data + self.ops.data(coeff)
+        c_data = self.capacity_data / dt
+        dofs, values = self.fixed(loads)
+        return ThermalStepper(
+            self._step_solver(coeff, c_data, k_data, (dofs, values), dt, theta),
+            self.ops.csr(c_data - (1.0 - theta) * k_data),
+            sum(parts.values()),
+            dt,
+            theta,
+            balance=partial(self._heat_balance, coeff, parts, dofs, dt, theta),
+        )
+
+    def _step_solver(
+        self,
+        coeff: dict[str, float],
+        c_data: np.ndarray,
+        k_data: np.ndarray,
+        fixed: tuple[np.ndarray, np.ndarray],
+        dt: float,
+        theta: float,
+    ) -> DirichletSolver | WoodburySolver:
+        """C/Δt + θK factorized (c_data = C/Δt, k_data = K on the shared pattern).
+
+        Without fixed temperatures, C/Δt + θK less its contact terms is factorized once per
+        distinct set of film coefficients (they change with speed only), and the contact
+        terms of each load set enter through the low-rank update.  That base leaves the
+        contacts out entirely (rather than taking the first resistances seen), so results
+        never depend on which windows or runs came before: a batch gives the same numbers
+        in one process or many.
+        """
+        dofs, values = fixed
+        if dofs.size or self.contact_update is None:
+            return DirichletSolver(self.ops.csr(c_data + theta * k_data), dofs, values)
+        films = {k: v for k, v in coeff.items() if k.startswith("film:")}
+
+        def base() -> DirichletSolver:
+            k_base = self.conduction_data + self.ops.data(films)
+            return DirichletSolver(self.ops.csr(c_data + theta * k_base), dofs, values)
+
+        W = sla.block_diag(
+            *[
+                theta * coeff[f"interface:{n}"] * self._interface_mass[n]
+                for n in self.mesh.interfaces
+            ]
+        )
+        key = (dt, theta, tuple(sorted(films.items())))
+        return self.contact_update.solver(key, base, W)
+
+    def heat_balance(self, loads: ThermalLoads, dt: float, theta: float = 1.0) -> HeatBalance:
+        """The heat balance of a θ-step of Δt (s) under `loads` (see `twin.fem.balance`)."""
+        coeff, parts = self.load_parts(loads)
+        return self._heat_balance(coeff, parts, self.fixed(loads)[0], float(dt), float(theta))
+
+    def _heat_balance(
+        self,
+        coeff: dict[str, float],
+        parts: dict[str, np.ndarray],
+        dofs: np.ndarray,
+        dt: float,
+        theta: float,
+    ) -> HeatBalance:
+        films = {k: c for k, c in coeff.items() if k.startswith("film:")}
+        fixed = {}
+        if dofs.size:
+            K = self.ops.csr(self.conduction_data + self.ops.data(coeff))
+            C = self.ops.csr(self.capacity_data)
+            fixed = {
+                "fixed_capacity": np.asarray(C[dofs].sum(axis=0)).ravel(),
+                "fixed_conductance": np.asarray(K[dofs].sum(axis=0)).ravel(),
+                "fixed_load_W": float(sum(parts.values())[dofs].sum()),
+            }
+        return HeatBalance(
+            dt=dt,
+            theta=theta,
+            capacity=self.capacity_vector,
+            sources_W=float(parts["sources"].sum()),
+            flux_W=float(parts["flux"].sum()),
+            film=self.ops.matrix(films) @ np.ones(self.n_dofs),
+            film_load_W=float(parts["convection"].sum()),
+            **fixed,
+        )
 
     def energy_balance(
         self,
@@ -303,37 +340,14 @@ class ThermalProblem:
         dt: float,
         theta: float = 1.0,
     ) -> dict[str, float]:
-        """Discrete heat balance of one step, W.
+        """Discrete heat balance of one step T_old → T_new (°C), W.
 
         stored = sources + flux + fixed_in − convection_out; `residual_W` is what is left,
         round-off for an exact linear solve.  `heat_in_W` = sources + flux,
         `heat_out_W` = convection out + heat drawn by fixed temperatures.
+        In a loop, `ThermalStepper.energy_balance` reuses the prepared terms.
         """
-        coeff, parts = self.load_parts(loads)
-        T_theta = theta * T_new + (1.0 - theta) * T_old
-        C = self.ops.csr(self.capacity_data)
-        stored = float((C @ (T_new - T_old)).sum() / dt)
-        sources = float(parts["sources"].sum())
-        flux = float(parts["flux"].sum())
-        films = {k: c for k, c in coeff.items() if k.startswith("film:")}
-        convection_out = float((self.ops.matrix(films) @ T_theta).sum() - parts["convection"].sum())
-        dofs, _ = self.fixed(loads)
-        fixed_in = 0.0
-        if dofs.size:
-            K = self.ops.csr(self.conduction_data + self.ops.data(coeff))
-            residual = C @ (T_new - T_old) / dt + K @ T_theta - sum(parts.values())
-            fixed_in = float(residual[dofs].sum())
-        residual_w = sources + flux + fixed_in - convection_out - stored
-        return {
-            "sources_W": float(sources),
-            "flux_W": float(flux),
-            "convection_out_W": convection_out,
-            "fixed_in_W": fixed_in,
-            "stored_W": stored,
-            "heat_in_W": float(sources + flux),
-            "heat_out_W": convection_out - fixed_in,
-            "residual_W": residual_w,
-        }
+        return self.heat_balance(loads, dt, theta)(T_old, T_new)
 
     def probe(self, points_rz: np.ndarray) -> sp.csr_matrix:
         """Interpolation matrix P (n_points × n_dofs): T(points) = P @ T."""
@@ -341,147 +355,3 @@ class ThermalProblem:
         if pts.shape[0] != 2:
             pts = pts.T
         return probe_matrix(self.basis, pts)
-
-
-def probe_matrix(basis: Basis, points: np.ndarray) -> sp.csr_matrix:
-    """Point-evaluation matrix of a scalar basis at points (2, n); error outside the mesh."""
-    try:
-        cells = basis.mesh.element_finder()(points[0], points[1])
-    except ValueError as exc:
-        raise ValueError(f"probe point outside the mesh: {exc}") from None
-    p = basis.mesh.p
-    t = basis.mesh.t[:, cells]
-    # the finder may return the closest cell for points outside: check barycentrics
-    a, b, c = p[:, t[0]], p[:, t[1]], p[:, t[2]]
-    det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
-    l1 = ((points[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (points[1] - a[1])) / det
-    l2 = ((b[0] - a[0]) * (points[1] - a[1]) - (points[0] - a[0]) * (b[1] - a[1])) / det
-    tol = -1e-9
-    outside = (l1 < tol) | (l2 < tol) | (1.0 - l1 - l2 < tol)
-    if np.any(outside):
-        bad = points[:, np.where(outside)[0][0]]
-        raise ValueError(f"probe point (r={bad[0]:.6g}, z={bad[1]:.6g}) m is outside the mesh")
-    return sp.csr_matrix(basis.probes(points))
-
-
-def _field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
-    """A constant or a field f(r, z) evaluated at points (2, ...), checked finite."""
-    if callable(value):
-        out = np.asarray(value(points[0], points[1]), dtype=float)
-        out = np.broadcast_to(out, points.shape[1:]).astype(float)
-    else:
-        out = np.full(points.shape[1:], float(value))
-    if not np.all(np.isfinite(out)):
-        raise ValueError(f"{what}: load field is not finite")
-    return out
-
-
-def factorize_symmetric(A: sp.csc_matrix) -> spla.SuperLU:
-    """SuperLU of a symmetric positive-definite FE matrix.
-
-    Minimum-degree ordering on Aᵀ+A with diagonal pivots keeps the symmetric structure:
-    about half the fill and time of SuperLU's default (COLAMD, partial pivoting) here.
-    """
-    return spla.splu(
-        A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
-    )
-
-
-class _LinearSolve:
-    """Factorized SPD-pattern system with prescribed dofs eliminated."""
-
-    def __init__(self, A: sp.csr_matrix, dofs: np.ndarray, values: np.ndarray) -> None:
-        n = A.shape[0]
-        self.dofs, self.values = dofs, values
-        if dofs.size:
-            free = np.ones(n, dtype=bool)
-            free[dofs] = False
-            self.free = np.where(free)[0]
-            A_free = A[self.free][:, self.free]
-            self.coupling = A[self.free][:, dofs]
-        else:
-            self.free = None
-            A_free = A
-        # A is symmetric: its CSR arrays read as CSC describe the same matrix
-        A_csc = sp.csc_matrix((A_free.data, A_free.indices, A_free.indptr), shape=A_free.shape)
-        self.lu = factorize_symmetric(A_csc)
-        self.n = n
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        if self.free is None:
-            return self.lu.solve(rhs)
-        x = np.empty(self.n)
-        x[self.dofs] = self.values
-        x[self.free] = self.lu.solve(rhs[self.free] - self.coupling @ self.values)
-        return x
-
-
-class _BaseFactorization:
-    """The step matrix without contact coupling, factorized, and its interface response.
-
-    The contact terms are low rank: A = A_base + U W Uᵀ with U the interface jump columns
-    (a few dozen) and W = blockdiag(θ·(1/R_i)·M_i).  Woodbury then gives
-        A⁻¹ b = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A_base⁻¹ b,  Z = A_base⁻¹ U,
-    so a window with new contact resistances needs no sparse factorization at all.  The
-    base leaves the contacts out entirely (rather than taking the first resistances seen),
-    so results never depend on which windows or runs came before: a batch gives the same
-    numbers in one process or many.
-    """
-
-    def __init__(self, solver: _LinearSolve, U: sp.csc_matrix):
-        self.solver = solver
-        self.U = U
-        self.Z = solver.lu.solve(U.toarray()) if U.shape[1] else np.zeros((U.shape[0], 0))
-        self.UtZ = U.T @ self.Z
-
-
-class ThermalStepper:
-    """θ-method time stepping with a fixed Δt and fixed loads.
-
-    Without fixed temperatures, the step matrix C/Δt + θK less its contact terms is
-    factorized once per distinct set of film coefficients (they change with speed only),
-    and the contact terms of each window enter through a low-rank (Woodbury) update.
-    """
-
-    def __init__(self, problem: ThermalProblem, loads: ThermalLoads, dt: float, theta: float):
-        self.problem, self.loads, self.dt, self.theta = problem, loads, dt, theta
-        coeff, parts = problem.load_parts(loads)
-        self.f = sum(parts.values())
-        k_data = problem.conduction_data + problem.ops.data(coeff)
-        c_data = problem.capacity_data / dt
-        ops = problem.ops
-        self._explicit = ops.csr(c_data - (1.0 - theta) * k_data)
-        self._update = None
-        dofs, values = problem.fixed(loads)
-        if dofs.size or not problem.mesh.interfaces:
-            self._solver = _LinearSolve(ops.csr(c_data + theta * k_data), dofs, values)
-            return
-        films = {k: v for k, v in coeff.items() if k.startswith("film:")}
-        key = (dt, theta, tuple(sorted(films.items())))
-        base = problem._base_factorizations.get(key)
-        if base is None:
-            if len(problem._base_factorizations) >= 8:  # bound memory: drop the oldest
-                problem._base_factorizations.pop(next(iter(problem._base_factorizations)))
-            U = sp.hstack([problem._interface_factors[n][0] for n in problem.mesh.interfaces])
-            k_base = problem.conduction_data + ops.data(films)
-            solver = _LinearSolve(ops.csr(c_data + theta * k_base), dofs, values)
-            base = _BaseFactorization(solver, sp.csc_matrix(U))
-            problem._base_factorizations[key] = base
-        self._solver = base.solver
-        W = sla.block_diag(
-            *[
-                theta * coeff[f"interface:{n}"] * problem._interface_factors[n][1]
-                for n in problem.mesh.interfaces
-            ]
-        )
-        capacitance = np.eye(W.shape[0]) + W @ base.UtZ
-        self._update = (base, W, sla.lu_factor(capacitance))
-
-    def step(self, T: np.ndarray) -> np.ndarray:
-        """Advance one Δt from nodal temperature T (°C)."""
-        y = self._solver.solve(self._explicit @ T + self.f)
-        if self._update is None:
-            return y
-
-        base, W, lu = self._update
-        return y - base.Z @ sla.lu_solve(lu, W @ (base.U.T @ y))

@@ -84,11 +84,7 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
             R_rear=corr.R_rear_m2K_W,
         )
         stepper = model.thermal.transient(loads, STEP_S)
-        out = np.empty((STEPS_PER_WINDOW, T.size))
-        for i in range(STEPS_PER_WINDOW):
-            T = stepper.step(T)
-            out[i] = T
-        return out, None
+        return np.array(list(stepper.march(T, STEPS_PER_WINDOW))), None
 
     return solve
 

@@ -96,7 +96,6 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
     S, W = model.sensor_matrix, model.probe_vectors[0]
     T0 = np.full(model.n_dofs, float(tables.ambient_C(0.0)))
     T = T0.copy()
-    cap = model.capacity_vector / dt
     sensors = np.empty((n + 1, S.shape[0]))
     disp = np.zeros(n + 1)
     sensors[0] = S @ T
@@ -130,15 +129,9 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
         for k, v in row.items():
             loads_log[k][a:b] = v
         stepper = thermal.transient(loads, dt=dt, theta=1.0)
-        q_in = sum(q * thermal.source_vector(r).sum() for r, q in loads.sources.items())
-        films = [(h, t_inf, thermal.facet_load(bd)) for bd, (h, t_inf) in loads.convection.items()]
-        film_vec = sum(h * f for h, _, f in films)
-        film_const = sum(h * t_inf * f.sum() for h, t_inf, f in films)
-        for k in range(a, b):
-            T_new = stepper.step(T)
-            out = float(film_vec @ T_new) - film_const
-            heat_in[k] = q_in
-            residual[k] = q_in - out - float(cap @ (T_new - T))
+        for k, T_new in enumerate(stepper.march(T, b - a), start=a):
+            eb = stepper.energy_balance(T, T_new)
+            heat_in[k], residual[k] = eb["heat_in_W"], eb["residual_W"]
             T = T_new
             sensors[k + 1] = S @ T
             disp[k + 1] = W @ (T - T0)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +95,6 @@ class SpindleModel:
     sensor_matrix: sp.csr_matrix
     probe_vectors: np.ndarray
     order: int = 1
-    _capacity: np.ndarray | None = field(default=None, repr=False)
 
     sensor_names = SENSOR_NAMES
     probe_names = PROBE_NAMES
@@ -139,14 +138,6 @@ class SpindleModel:
     @property
     def n_dofs(self) -> int:
         return self.thermal.n_dofs
-
-    @property
-    def capacity_vector(self) -> np.ndarray:
-        """C·1 (J/K per dof): stored power of a step is capacity_vector @ ΔT / Δt."""
-        if self._capacity is None:
-            ops = self.thermal.ops
-            self._capacity = ops.csr(self.thermal.capacity_data) @ np.ones(self.n_dofs)
-        return self._capacity
 
     def region_volume_m3(self, region: str) -> float:
         return self.thermal.volume(region)

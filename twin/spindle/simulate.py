@@ -97,7 +97,6 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     T = T0.copy()
     S = model.sensor_matrix
     W = model.probe_vectors
-    cap = model.capacity_vector / dt
 
     n = n_steps
     sensors = np.empty((n + 1, S.shape[0]))
@@ -123,16 +122,9 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
             conditions.append(bc)
             loads = bc.to_thermal_loads()
             stepper = thermal.transient(loads, dt=dt, theta=1.0)
-            heat_in = sum(q * thermal.source_vector(r).sum() for r, q in loads.sources.items())
-            films = [(h, t_inf, thermal.facet_load(b))
-                     for b, (h, t_inf) in loads.convection.items()]
-            film_vec = sum(h * f for h, _, f in films)
-            film_const = sum(h * t_inf * f.sum() for h, t_inf, f in films)
-        for _ in range(min(steps_per_window, n - k)):
-            T_new = stepper.step(T)
-            out = float(film_vec @ T_new) - film_const
-            stored = float(cap @ (T_new - T))
-            energy[:, k] = (heat_in, out, stored, heat_in - out - stored)
+        for T_new in stepper.march(T, min(steps_per_window, n - k)):
+            eb = stepper.energy_balance(T, T_new)
+            energy[:, k] = (eb["heat_in_W"], eb["heat_out_W"], eb["stored_W"], eb["residual_W"])
             T = T_new
             k += 1
             sensors[k] = S @ T

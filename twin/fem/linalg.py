@@ -1,0 +1,115 @@
+"""Sparse direct solves of the symmetric FE systems, and their low-rank updates.
+
+factorize_symmetric  SuperLU with a symmetric ordering (SPD FE matrices)
+DirichletSolver      a factorized system with prescribed dofs eliminated
+LowRankUpdate        solves of (A₀ + U W Uᵀ) x = b by Woodbury, with A₀ factorized once
+                     per key and kept in the object's own bounded cache
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+
+def factorize_symmetric(A: sp.csc_matrix) -> spla.SuperLU:
+    """SuperLU of a symmetric positive-definite FE matrix.
+
+    Minimum-degree ordering on Aᵀ+A with diagonal pivots keeps the symmetric structure:
+    about half the fill and time of SuperLU's default (COLAMD, partial pivoting) here.
+    """
+    return spla.splu(
+        A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+    )
+
+
+class DirichletSolver:
+    """A symmetric system A x = b, factorized once, with x[dofs] = values prescribed.
+
+    Like scikit-fem's `condense` + `solve`, but the factorization of A[free, free] and the
+    coupling A[free, dofs] are kept, so each further right-hand side costs one
+    back-substitution (condense would slice and factorize again every time).
+    """
+
+    def __init__(self, A: sp.csr_matrix, dofs: np.ndarray, values: np.ndarray) -> None:
+        n = A.shape[0]
+        self.dofs, self.values = dofs, values
+        if dofs.size:
+            free = np.ones(n, dtype=bool)
+            free[dofs] = False
+            self.free = np.where(free)[0]
+            A_free = A[self.free][:, self.free]
+            self.coupling = A[self.free][:, dofs]
+        else:
+            self.free = None
+            A_free = A
+        # A is symmetric: its CSR arrays read as CSC describe the same matrix
+        A_csc = sp.csc_matrix((A_free.data, A_free.indices, A_free.indptr), shape=A_free.shape)
+        self.lu = factorize_symmetric(A_csc)
+        self.n = n
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        if self.free is None:
+            return self.lu.solve(rhs)
+        x = np.empty(self.n)
+        x[self.dofs] = self.values
+        x[self.free] = self.lu.solve(rhs[self.free] - self.coupling @ self.values)
+        return x
+
+
+class _Base:
+    """A₀ factorized and its response to the update columns: Z = A₀⁻¹ U, Uᵀ Z."""
+
+    def __init__(self, solver: DirichletSolver, U: sp.csc_matrix) -> None:
+        self.solver = solver
+        self.Z = solver.lu.solve(U.toarray()) if U.shape[1] else np.zeros((U.shape[0], 0))
+        self.UtZ = U.T @ self.Z
+
+
+class WoodburySolver:
+    """Solves (A₀ + U W Uᵀ) x = b with A₀ factorized:
+
+        x = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A₀⁻¹ b,  Z = A₀⁻¹ U.
+    """
+
+    def __init__(self, base: _Base, U: sp.csc_matrix, W: np.ndarray) -> None:
+        self._base, self._U, self._W = base, U, W
+        self._lu = sla.lu_factor(np.eye(W.shape[0]) + W @ base.UtZ)
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        y = self._base.solver.solve(rhs)
+        base = self._base
+        return y - base.Z @ sla.lu_solve(self._lu, self._W @ (self._U.T @ y))
+
+
+class LowRankUpdate:
+    """Solvers of A₀ + U W Uᵀ for fixed update columns U (n × m, m small).
+
+    The factorized A₀ of each key is cached (at most `max_bases`, the oldest dropped), so
+    a new W (m × m) costs one small dense factorization and no sparse one.  A₀ must not
+    depend on W: then results never depend on which W came first.
+    """
+
+    def __init__(self, U: sp.csc_matrix, max_bases: int = 8) -> None:
+        self.U = sp.csc_matrix(U)
+        self.max_bases = max_bases
+        self._bases: dict[Hashable, _Base] = {}
+
+    def __len__(self) -> int:
+        """Number of factorized A₀ held."""
+        return len(self._bases)
+
+    def solver(
+        self, key: Hashable, base: Callable[[], DirichletSolver], W: np.ndarray
+    ) -> WoodburySolver:
+        """The solver of A₀(key) + U W Uᵀ; `base()` factorizes A₀ on a cache miss."""
+        cached = self._bases.get(key)
+        if cached is None:
+            if len(self._bases) >= self.max_bases:  # bound memory: drop the oldest
+                self._bases.pop(next(iter(self._bases)))
+            cached = self._bases[key] = _Base(base(), self.U)
+        return WoodburySolver(cached, self.U, W)

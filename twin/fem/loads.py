@@ -1,0 +1,68 @@
+"""Thermal load sets: what a window (or a load step) applies, validated on construction."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _finite(value: float, what: str) -> float:
+    if callable(value):  # a field f(r, z): checked where it is evaluated
+        return 0.0
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{what} must be finite, got {value!r}")
+    return value
+
+
+@dataclass
+class ThermalLoads:
+    """One set of thermal loads (held constant over a window of time steps).
+
+    sources             region → volumetric heat W/m³
+    convection          boundary → (h W/(m²K), T∞ °C)
+    flux                boundary → heat flux into the body W/m²
+    (source densities, fluxes, bulk and fixed temperatures may also be fields given as
+    functions f(r, z) of numpy arrays, like APDL tabular loads)
+    contact_resistance  interface → R m²K/W (interfaces not listed are perfectly bonded
+                        at a negligible R; see ThermalProblem.PERFECT_CONTACT_R)
+    fixed_temperature   boundary → T °C
+    fixed_dofs          optional (dof indices, values °C) for point constraints
+    """
+
+    sources: dict[str, float] = field(default_factory=dict)
+    convection: dict[str, tuple[float, float]] = field(default_factory=dict)
+    flux: dict[str, float] = field(default_factory=dict)
+    contact_resistance: dict[str, float] = field(default_factory=dict)
+    fixed_temperature: dict[str, float] = field(default_factory=dict)
+    fixed_dofs: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __post_init__(self) -> None:
+        for name, q in self.sources.items():
+            _finite(q, f"heat source of region {name!r}")
+        for name, hc in self.convection.items():
+            h, t_inf = hc
+            if not (_finite(h, f"film coefficient of boundary {name!r}") >= 0.0):
+                raise ValueError(f"film coefficient of boundary {name!r} must be ≥ 0, got {h!r}")
+            _finite(t_inf, f"bulk temperature of boundary {name!r}")
+        for name, q in self.flux.items():
+            _finite(q, f"heat flux of boundary {name!r}")
+        for name, r in self.contact_resistance.items():
+            if not (_finite(r, f"contact resistance of interface {name!r}") > 0.0):
+                raise ValueError(f"contact resistance of interface {name!r} must be > 0, got {r!r}")
+        for name, t in self.fixed_temperature.items():
+            _finite(t, f"fixed temperature of boundary {name!r}")
+
+
+def field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
+    """A constant or a field f(r, z) evaluated at points (2, ...), checked finite."""
+    if callable(value):
+        out = np.asarray(value(points[0], points[1]), dtype=float)
+        out = np.broadcast_to(out, points.shape[1:]).astype(float)
+    else:
+        out = np.full(points.shape[1:], float(value))
+    if not np.all(np.isfinite(out)):
+        raise ValueError(f"{what}: load field is not finite")
+    return out
