@@ -32,8 +32,8 @@ def snapshot(
     model_path = checked_model([method_name], model)
     if out.suffix.lower() != ".png":
         raise InputError("the picture must be a .png file", file=str(out), column="--out")
-    recorded = read_run(run)
     spindle = default_spindle()
+    recorded = read_run(run, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
     try:
         r = replay_method(
             recorded,

@@ -38,13 +38,15 @@ def train(
     from twin.correction.training_data import TARGET_RULES, default_simulator, run_curves
     from twin.errors import InputError
     from twin.runs import read_run
+    from twin.spindle.spec import load_spec
 
     if targets not in TARGET_RULES:
         raise InputError(f"--targets must be one of {', '.join(TARGET_RULES)}, not {targets!r}")
     simulator = default_simulator(targets)
+    limit_rpm = load_spec(None).spindle.max_speed_rpm  # the networks train on that spindle
     sets = []
     for path in runs:
-        run = read_run(path)
+        run = read_run(path, max_speed_rpm=limit_rpm)
         if not quiet:
             typer.echo(f"simulating {path.name} …", err=True)
         sets.extend(samples_for(curves) for curves in run_curves(run, simulator))

@@ -5,11 +5,21 @@ has no correction yet), against the measurement at the same time, skipping sampl
 data-quality check excluded (NaN in the measured arrays).
 
 - temperature accuracy (the reference paper's style, °C):
-      100 · (1 − mean_i,k |T_twin − T_meas| / |T_meas|)
+      100 · (1 − mean_i,k |T_twin − T_meas| / max(|T_meas|, T_floor)),  T_floor = 20 °C
 - temperature-rise accuracy (stricter):
       100 · (1 − Σ|T_twin − T_meas| / Σ|T_meas − T_meas(0)|)
 - deformation accuracy, axial nose drift:
       100 · (1 − Σ|δ_twin − δ_meas| / Σ|δ_meas|)
+
+Why the floor: the paper divides by the measured temperature in °C, a ratio whose zero
+is where water freezes, not where the error stops mattering.  Its runs sit at workshop
+temperatures (20–40 °C), where the ratio is well defined; near 0 °C it blows up (a
+measured 0.0 °C gave −inf) and it depends on the scale's origin (the same run shifted
+down 22 K scored 55.8 % instead of 99.5 %).  Dividing by at least `T_FLOOR_C`, a workshop
+temperature, keeps the paper's value unchanged wherever every measured temperature is at
+or above 20 °C (all bundled runs, the paper's runs) and gives any colder run the error
+relative to that temperature: finite for any valid run, and a run shifted to below
+20 °C scores as if it sat at 20 °C instead of collapsing towards −∞.
 """
 
 from __future__ import annotations
@@ -19,6 +29,8 @@ import math
 import numpy as np
 
 SENSORS = ("T1", "T2", "T3", "T4", "T5")
+T_FLOOR_C = 20.0
+"""Smallest denominator of the temperature accuracy (°C): a workshop temperature."""
 
 
 def _nan_to_none(value: float) -> float | None:
@@ -47,7 +59,8 @@ def accuracy_metrics(
     n = int(ok.sum())
     if n == 0:
         raise ValueError("no valid temperature samples after the first window")
-    temp_acc = 100.0 * (1.0 - float(np.sum(np.where(ok, err / np.abs(tm), 0.0))) / n)
+    scale = np.maximum(np.abs(np.where(ok, tm, T_FLOOR_C)), T_FLOOR_C)
+    temp_acc = 100.0 * (1.0 - float(np.sum(err / scale)) / n)
     rise = np.where(ok, np.abs(tm - np.asarray(T_meas0_C, float)[None, :]), 0.0)
     rise_acc = 100.0 * (1.0 - err.sum() / rise.sum()) if rise.sum() > 0 else math.nan
     rmse = {}

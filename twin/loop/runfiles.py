@@ -84,8 +84,8 @@ def replay_run_to_dir(
 
     if snapshots not in SNAPSHOT_CHOICES:
         raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
-    run = read_run(run_path)
     model = spindle if spindle is not None else default_spindle()
+    run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
     out_dir = Path(out_root) / run_name(run_path)
     token = resume_token(run_path, methods, model_path)
     (out_dir / DONE_FILE).unlink(missing_ok=True)

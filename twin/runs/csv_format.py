@@ -9,45 +9,21 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Mapping
-from pathlib import Path
+from collections.abc import Iterator, Mapping
 
 import numpy as np
 
 from twin.atomic import atomic_target
 from twin.errors import InputError
-from twin.runs.schema import ALL_COLUMNS
-from twin.runs.table import RawTable
-
-_MISSING = {"", "nan", "na", "n/a", "null", "none"}
-
-
-def _parse_number(cell: str, file: str, line: int, column: str) -> float:
-    text = cell.strip()
-    if text.lower() in _MISSING:
-        return math.nan
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(f"cannot read {cell!r} as a number", file=file, row=line,
-                         column=column) from None
-    if math.isinf(value):
-        raise InputError(f"{cell!r} is not a finite number", file=file, row=line, column=column)
-    return value
+from twin.paths import read_input_text
+from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
+from twin.runs.table import RawTable, parse_cell
 
 
 def read_csv_table(path: str | os.PathLike[str]) -> RawTable:
     """Read a CSV recorded run into a `RawTable` (no validation beyond parsing)."""
     file = str(path)
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read file: {exc.strerror or exc}", file=file) from None
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise InputError("not UTF-8 text", file=file, row=line) from None
+    text = read_input_text(path)
 
     # Split on '\n' only: editors number lines that way (str.splitlines would also
     # break on form feeds and Unicode separators).
@@ -68,7 +44,7 @@ def read_csv_table(path: str | os.PathLike[str]) -> RawTable:
                     metadata[key.strip()] = value.strip()
             continue
         if header is None:
-            header = [name.strip() for name in next(csv.reader([line]))]
+            header = [name.strip() for name in next(_records([line], file, [number]))]
             header_line = number
             continue
         data_lines.append(line)
@@ -84,24 +60,45 @@ def read_csv_table(path: str | os.PathLike[str]) -> RawTable:
                              column=name)
     if not data_lines:
         raise InputError("no data rows after the header", file=file, row=header_line)
+    if len(data_lines) > MAX_SAMPLES:
+        raise InputError(f"{len(data_lines)} data rows; a run may hold at most {MAX_SAMPLES} "
+                         "samples (resample it)", file=file, row=data_numbers[MAX_SAMPLES])
 
     known = [(i, name) for i, name in enumerate(header) if name in ALL_COLUMNS]
     ignored = [name for name in header if name not in ALL_COLUMNS]
     values = np.full((len(data_lines), len(known)), np.nan)
-    reader = csv.reader(data_lines)
-    for k, fields in enumerate(reader):
-        line = data_numbers[min(reader.line_num, len(data_numbers)) - 1]
+    for k, fields in enumerate(_records(data_lines, file, data_numbers)):
+        line = data_numbers[k]
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields as in the header, found "
                              f"{len(fields)}", file=file, row=line)
         row = values[k]
         for j, (i, name) in enumerate(known):
-            row[j] = _parse_number(fields[i], file, line, name)
-    n = k + 1
-    columns = {name: values[:n, j].copy() for j, (_, name) in enumerate(known)}
+            row[j] = parse_cell(fields[i], file, line, name)
+    columns = {name: values[:, j].copy() for j, (_, name) in enumerate(known)}
     return RawTable(file=file, metadata=metadata, columns=columns,
-                    rows=np.asarray(data_numbers[:n], dtype=np.int64), header_row=header_line,
+                    rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored)
+
+
+def _records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
+    """CSV records of `lines`, one per line: a quoted cell may not span lines (the csv
+    module would join `"1` and `2"` into 12), and csv's own errors name their line."""
+    reader = csv.reader(lines)
+    k = 0
+    while True:
+        try:
+            fields = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            line = numbers[min(reader.line_num, len(numbers)) - 1]
+            raise InputError(f"not a readable CSV line ({exc})", file=file, row=line) from None
+        if reader.line_num != k + 1:
+            raise InputError("a quoted cell runs over several lines", file=file,
+                             row=numbers[k])
+        k += 1
+        yield fields
 
 
 def _format(value: float, fmt: str) -> str:

@@ -5,6 +5,7 @@ Rows are numbered 1-based over the data (Parquet has no lines a user would edit)
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping
 
@@ -12,8 +13,9 @@ import numpy as np
 
 from twin.atomic import atomic_target
 from twin.errors import InputError
-from twin.runs.schema import ALL_COLUMNS
-from twin.runs.table import RawTable
+from twin.paths import check_input_file
+from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
+from twin.runs.table import RawTable, parse_cell
 
 
 def _is_tool_metadata(key: str) -> bool:
@@ -21,17 +23,53 @@ def _is_tool_metadata(key: str) -> bool:
     return key == "pandas" or key.startswith("ARROW:")
 
 
+def _column_values(column, file: str, name: str) -> np.ndarray:  # noqa: ANN001 - ChunkedArray
+    """A Parquet column as float64; text cells are read as the CSV reader reads them."""
+    import pyarrow as pa
+
+    kind = column.type
+    if pa.types.is_dictionary(kind):
+        column = column.cast(kind.value_type)
+        kind = column.type
+    if pa.types.is_null(kind):
+        return np.full(len(column), np.nan)
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind) or pa.types.is_decimal(kind):
+        # unsafe: a uint64 beyond 2**53 rounds to the nearest float instead of raising
+        values = column.cast(pa.float64(), safe=False).to_numpy(zero_copy_only=False)
+        values = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(np.isinf(values))
+        if bad.size:
+            raise InputError("not a finite number", file=file, row=int(bad[0]) + 1,
+                             column=name)
+        return values
+    if pa.types.is_string(kind) or pa.types.is_large_string(kind):
+        texts = column.to_pylist()
+        return np.array([math.nan if text is None else parse_cell(text, file, i, name)
+                         for i, text in enumerate(texts, start=1)], dtype=float)
+    raise InputError(f"column type {kind} is not numeric", file=file, column=name)
+
+
 def read_parquet_table(path: str | os.PathLike[str]) -> RawTable:
     """Read a Parquet recorded run into a `RawTable`."""
     import pyarrow as pa
-    import pyarrow.compute as pc
     import pyarrow.parquet as pq
 
     file = str(path)
+    check_input_file(path)
     try:
-        table = pq.read_table(path)
+        parquet = pq.ParquetFile(path)
+        # counted from the footer, before the columns are decompressed into memory
+        if parquet.metadata.num_rows > MAX_SAMPLES:
+            raise InputError(f"{parquet.metadata.num_rows} data rows; a run may hold at most "
+                             f"{MAX_SAMPLES} samples (resample it)", file=file,
+                             row=MAX_SAMPLES + 1)
+        table = parquet.read()
     except (OSError, pa.ArrowException) as exc:
         raise InputError(f"not a readable Parquet file: {exc}", file=file) from None
+    names = table.column_names
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise InputError("column appears twice", file=file, column=twice[0])
     metadata = {}
     for key, value in (table.schema.metadata or {}).items():
         name = key.decode("utf-8", "replace")
@@ -44,29 +82,7 @@ def read_parquet_table(path: str | os.PathLike[str]) -> RawTable:
     for name in table.column_names:
         if name not in ALL_COLUMNS:
             continue
-        column = table.column(name)
-        if pa.types.is_integer(column.type) or pa.types.is_floating(column.type):
-            values = column.cast(pa.float64()).to_numpy(zero_copy_only=False)
-        elif pa.types.is_string(column.type) or pa.types.is_large_string(column.type):
-            try:
-                values = pc.cast(column, pa.float64()).to_numpy(zero_copy_only=False)
-            except pa.ArrowInvalid:
-                texts = column.to_pylist()
-                for i, text in enumerate(texts, start=1):
-                    try:
-                        float(text) if text is not None else None
-                    except ValueError:
-                        raise InputError(f"cannot read {text!r} as a number", file=file,
-                                         row=i, column=name) from None
-                raise
-        else:
-            raise InputError(f"column type {column.type} is not numeric", file=file,
-                             column=name)
-        values = np.asarray(values, dtype=float)
-        bad = np.flatnonzero(np.isinf(values))
-        if bad.size:
-            raise InputError("not a finite number", file=file, row=int(bad[0]) + 1, column=name)
-        columns[name] = values
+        columns[name] = _column_values(table.column(name), file, name)
     ignored = [name for name in table.column_names if name not in ALL_COLUMNS]
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.arange(1, table.num_rows + 1, dtype=np.int64),

@@ -90,6 +90,37 @@ def _unit_floor(name: str, celsius: float, micron: float) -> float:
     return micron if name.endswith("_um") else celsius
 
 
+def drop_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
+    """Drop rows that repeat an earlier row exactly (every column, time included).
+
+    A logger re-sending its buffer writes a block of rows a second time; the copies carry
+    no new information.  Rows whose time goes back with different values are left for
+    `check_structure` to refuse.
+    """
+    names = list(table.columns)
+    if TIME not in table.columns or table.n_samples < 2:
+        return table, []
+    matrix = np.ascontiguousarray(np.stack([table.columns[n] for n in names], axis=1))
+    matrix[np.isnan(matrix)] = np.nan  # one NaN bit pattern: missing cells compare equal
+    keys = matrix.view(np.dtype((np.void, matrix.dtype.itemsize * matrix.shape[1]))).ravel()
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    repeated = first[inverse.ravel()] != np.arange(table.n_samples)
+    if not repeated.any():
+        return table, []
+    keep = ~repeated
+    kept = RawTable(file=table.file, metadata=table.metadata,
+                    columns={n: v[keep] for n, v in table.columns.items()},
+                    rows=table.rows[keep], header_row=table.header_row,
+                    ignored_columns=table.ignored_columns)
+    time = table.columns[TIME]
+    spans = [(float(time[a] - time[0]), float(time[b] - time[0])) for a, b in _runs(repeated)]
+    found = finding(TIME, "repeated_rows", "dropped (exact copies of earlier rows)",
+                    rows=table.rows[repeated], spans_s=spans, count=int(repeated.sum()),
+                    detail=f"{len(spans)} block(s) of rows repeated verbatim, as a logger "
+                           "re-sending its buffer writes them")
+    return kept, [found]
+
+
 def merge_duplicates(table: RawTable) -> tuple[np.ndarray, np.ndarray, dict, list[dict]]:
     """Merge samples sharing a timestamp into their mean (NaN-aware)."""
     time = table.columns[TIME]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -14,10 +15,10 @@ from twin.atomic import atomic_target
 from twin.errors import InputError
 from twin.runs.csv_format import read_csv_table, write_csv_table
 from twin.runs.parquet_format import read_parquet_table, write_parquet_table
-from twin.runs.quality import QualityConfig, finding, repair
+from twin.runs.quality import QualityConfig, drop_repeated_rows, finding, repair
 from twin.runs.schema import AMBIENT, COOLANT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
-from twin.runs.validate import check_structure, check_values
+from twin.runs.validate import check_operating_range, check_structure, check_values
 
 _READERS = {".csv": read_csv_table, ".parquet": read_parquet_table, ".pq": read_parquet_table}
 
@@ -138,11 +139,15 @@ class RecordedRun(Samples):
             disp_um=disp, valid={name: ok(name) for name in self.valid})
 
 
-def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None) -> RecordedRun:
+def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None,
+             max_speed_rpm: float = math.inf) -> RecordedRun:
     """Read, validate and repair a recorded run (CSV or Parquet, by file suffix).
 
     Hard errors raise `InputError` with the file, the row (1-based line in a CSV file)
-    and the column.  Repairs are listed in `RecordedRun.quality`.
+    and the column: besides the format, a run longer than `MAX_DURATION_S`, a speed above
+    `max_speed_rpm` (the spindle's limit: pass the spec's) or an ambient or coolant outside
+    `OPERATING_TEMPERATURE_C` is refused here, before any replay.  Repairs are listed in
+    `RecordedRun.quality`.
     """
     file = Path(path)
     reader = _READERS.get(file.suffix.lower())
@@ -150,18 +155,21 @@ def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None) 
         raise InputError(f"unknown run format {file.suffix!r}; expected .csv or .parquet",
                          file=str(path))
     table = reader(path)
-    return run_from_table(table, config)
+    return run_from_table(table, config, max_speed_rpm)
 
 
-def run_from_table(table: RawTable, config: QualityConfig | None = None) -> RecordedRun:
-    """Validate and repair a raw table into a `RecordedRun`."""
+def run_from_table(table: RawTable, config: QualityConfig | None = None,
+                   max_speed_rpm: float = math.inf) -> RecordedRun:
+    """Validate and repair a raw table into a `RecordedRun` (see `read_run`)."""
     config = config or QualityConfig()
+    table, repeats = drop_repeated_rows(table)
     check_structure(table)
     check_values(table)
     fixed = repair(table, config)
+    check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm)
     quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
                        detail="unknown column name") for n in table.ignored_columns]
-    quality += fixed.findings
+    quality += repeats + fixed.findings
     c = fixed.columns
     disp = None
     if any(n in c for n in DISPLACEMENTS):

@@ -28,3 +28,13 @@ WINDOW_S = 60.0
 
 MAX_SAMPLE_INTERVAL_S = 10.0
 """The contract accepts any sample rate of at least one sample per 10 s (median interval)."""
+
+MAX_DURATION_S = 24 * 3600.0
+"""Longest run the twin replays: one day (1440 windows), the longest run `twin synth`
+writes.  Checked on the time column before anything is allocated per step or window."""
+
+MAX_SAMPLES = 1_000_000
+"""Most samples a run may hold (a day at about 11 Hz); a faster log must be resampled."""
+
+OPERATING_TEMPERATURE_C = (-40.0, 80.0)
+"""Ambient and coolant temperatures the twin's film, viscosity and fit models cover (°C)."""

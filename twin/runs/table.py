@@ -7,9 +7,13 @@ every later error or finding can name the line a user sees in an editor.
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from twin.errors import InputError
 
 
 @dataclass
@@ -30,3 +34,31 @@ class RawTable:
     @property
     def n_samples(self) -> int:
         return int(self.rows.size)
+
+
+MISSING_TOKENS = frozenset({"", "nan", "na", "n/a", "null", "none"})
+"""Cell texts (case-insensitive, after stripping blanks) that mean "no value"."""
+
+MAX_NUMBER_CHARS = 64
+"""No number a logger writes needs more characters; a longer cell is refused unread."""
+
+# A plain decimal number as loggers write it.  Python's float() also takes `9_000`
+# (a source-code digit separator) and `infinity`; neither is a measurement.
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+
+
+def parse_cell(cell: str, file: str, row: int, column: str) -> float:
+    """One cell of a run table as a float (NaN for a missing value), or `InputError`."""
+    text = cell.strip()
+    if len(text) > MAX_NUMBER_CHARS:
+        raise InputError(f"a cell of {len(text)} characters is not a number", file=file,
+                         row=row, column=column)
+    if text.lower() in MISSING_TOKENS:
+        return math.nan
+    if not _NUMBER.fullmatch(text):
+        raise InputError(f"cannot read {cell!r} as a number", file=file, row=row,
+                         column=column)
+    value = float(text)
+    if math.isinf(value):
+        raise InputError(f"{cell!r} is not a finite number", file=file, row=row, column=column)
+    return value

@@ -14,7 +14,9 @@ from twin.runs.schema import (
     AMBIENT,
     CELSIUS_COLUMNS,
     COOLANT,
+    MAX_DURATION_S,
     MAX_SAMPLE_INTERVAL_S,
+    OPERATING_TEMPERATURE_C,
     REQUIRED,
     SPEED,
     TEMPERATURES,
@@ -63,6 +65,12 @@ def check_values(table: RawTable) -> None:
             f"the run lasts {duration:g} s; the twin needs at least two {WINDOW_S:g} s "
             f"windows ({2 * WINDOW_S:g} s)", file=table.file, row=int(table.rows[-1]),
             column=TIME)
+    if duration > MAX_DURATION_S:
+        i = int(np.flatnonzero(time - time[0] > MAX_DURATION_S)[0])
+        raise InputError(
+            f"time {time[i]:g} s lies more than {MAX_DURATION_S:g} s after the first sample; "
+            f"a run may last at most {MAX_DURATION_S / 3600:g} h", file=table.file,
+            row=int(table.rows[i]), column=TIME)
     interval = float(np.median(np.diff(unique_time)))
     if interval > MAX_SAMPLE_INTERVAL_S:
         raise InputError(
@@ -115,3 +123,28 @@ def _check_celsius(table: RawTable, name: str) -> None:
                 f"values look like Fahrenheit (starts at {t0:.1f} with ambient {a0:.1f} °C "
                 f"= {1.8 * a0 + 32:.1f} °F); the column must be in °C", file=table.file,
                 row=row, column=name)
+
+
+def check_operating_range(file: str, rows: np.ndarray, columns: dict[str, np.ndarray],
+                          max_speed_rpm: float) -> None:
+    """Speed within the spindle's limit, ambient and coolant within the twin's envelope.
+
+    Checked on the repaired values (a spike the repair removes is no error) so that a
+    replay never meets a value it cannot simulate; the error names the file row.
+    """
+    speed = columns[SPEED]
+    over = np.flatnonzero(speed > max_speed_rpm)
+    if over.size:
+        i = int(over[0])
+        raise InputError(f"speed {speed[i]:g} rpm exceeds the spindle's limit "
+                         f"{max_speed_rpm:g} rpm", file=file, row=int(rows[i]), column=SPEED)
+    lo, hi = OPERATING_TEMPERATURE_C
+    for name in (AMBIENT, COOLANT):
+        if name not in columns:
+            continue
+        values = columns[name]
+        outside = np.flatnonzero((values < lo) | (values > hi))
+        if outside.size:
+            i = int(outside[0])
+            raise InputError(f"{values[i]:g} °C is outside the {lo:g}..{hi:g} °C the twin "
+                             "models", file=file, row=int(rows[i]), column=name)

@@ -40,6 +40,7 @@ from twin.physics import (
     rotating_disk_h,
 )
 from twin.physics.contact import harmonic_mean, thermal_interference_um
+from twin.runs.schema import OPERATING_TEMPERATURE_C
 from twin.spindle.spec import ConvectionSpec, SpindleSpec
 
 SIDES = ("front", "rear")
@@ -120,9 +121,10 @@ def check_operating_point(spec: SpindleSpec, speed_rpm: float, ambient_C: float,
     for name, value in (("ambient_C", ambient_C), ("coolant_C", coolant_C)):
         if value is None:
             continue
-        if not math.isfinite(value) or not -40.0 <= value <= 80.0:
-            raise InputError(f"{name} must be a temperature between -40 and 80 °C, got {value}",
-                             column=name)
+        lo, hi = OPERATING_TEMPERATURE_C
+        if not math.isfinite(value) or not lo <= value <= hi:
+            raise InputError(f"{name} must be a temperature between {lo:g} and {hi:g} °C, "
+                             f"got {value}", column=name)
 
 
 def _pair(value: float | tuple[float, float] | None, default: float) -> dict[str, float]:

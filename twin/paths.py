@@ -1,0 +1,59 @@
+"""What the twin may read: every input is a regular file of bounded size.
+
+A fifo, a device or a folder given where a file is expected would block a reader forever
+(`/dev/zero`, a fifo nobody writes) or fill the memory; such an input is refused with an
+`InputError` naming it before a byte is read.  The `--out` side lives in `twin.atomic`.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+from twin.errors import InputError
+
+MAX_INPUT_BYTES = 512 * 2**20
+"""Largest input file read (512 MiB): a day of 10 Hz samples as CSV is under 100 MiB."""
+
+
+def check_input_file(path: str | os.PathLike[str], *, column: str | None = None,
+                     max_bytes: int = MAX_INPUT_BYTES) -> Path:
+    """`path` if it names an existing regular file of at most `max_bytes`, else InputError."""
+    file = Path(path)
+    try:
+        info = file.stat()
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", file=str(path),
+                         column=column) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise InputError("is a folder, not a file", file=str(path), column=column)
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError("is not a regular file (a device, fifo or socket)", file=str(path),
+                         column=column)
+    if info.st_size > max_bytes:
+        raise InputError(f"file of {info.st_size} bytes is larger than the {max_bytes} bytes "
+                         "an input may have", file=str(path), column=column)
+    return file
+
+
+def read_input_bytes(path: str | os.PathLike[str], *, column: str | None = None,
+                     max_bytes: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of a checked input file (`check_input_file`); OSError → InputError."""
+    file = check_input_file(path, column=column, max_bytes=max_bytes)
+    try:
+        return file.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", file=str(path),
+                         column=column) from None
+
+
+def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
+                    max_bytes: int = MAX_INPUT_BYTES) -> str:
+    """The UTF-8 text of a checked input file; a bad byte names its line."""
+    data = read_input_bytes(path, column=column, max_bytes=max_bytes)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
