@@ -160,9 +160,6 @@ def cdb_text(mesh, materials: Mapping[str, object] | None = None, title: str = "
 def write_cdb(mesh, path: str | Path, materials: Mapping[str, object] | None = None,  # noqa: ANN001
               title: str = "") -> Path:
     """Write the archive atomically."""
-    from apdl_like.outputs import _atomic
+    from twin.io.atomic import write_bytes
 
-    path = Path(path)
-    text = cdb_text(mesh, materials, title)
-    _atomic(path, lambda tmp: tmp.write_text(text, encoding="ascii"))
-    return path
+    return write_bytes(path, cdb_text(mesh, materials, title).encode("ascii"))

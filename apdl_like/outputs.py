@@ -8,21 +8,16 @@ stress) plus SEQV; NaN marks nodes outside the elements.  Every file is written 
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from twin.atomic import atomic_target
+from twin.io.atomic import write_text
+from twin.io.vtk import write_vtu
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
-
-
-def _atomic(path: Path, write: Callable[[Path], None]) -> None:
-    with atomic_target(path) as tmp:
-        write(tmp)
 
 
 def _cells(session: SessionState) -> list[tuple[str, np.ndarray]]:
@@ -67,7 +62,7 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
             s[:, j] = fem.glued_nodal(res.stress[key])
         data.update(U=u, S=s, SEQV=fem.glued_nodal(res.stress["von_mises"]))
     mesh = meshio.Mesh(points, _cells(session), point_data=data)
-    _atomic(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
+    write_vtu(path, mesh)
 
 
 def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
@@ -75,14 +70,13 @@ def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     out = Path(out_dir)
     written = []
     params = out / "params.json"
-    _atomic(params, lambda tmp: tmp.write_text(
-        json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n"))
+    write_text(params, json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n")
     written.append(params)
     for i, res in enumerate(session.solution.results):
         path = out / f"result_{res.load_step:03d}.vtu"
         write_result_vtu(session, i, path)
         written.append(path)
     log = out / "log.txt"
-    _atomic(log, lambda tmp: tmp.write_text("\n".join(session.log) + "\n", encoding="utf-8"))
+    write_text(log, "\n".join(session.log) + "\n")
     written.append(log)
     return written

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from apdl_like.loadset import LoadSet
-from twin.atomic import write_text_atomic
+from twin.io.atomic import write_text
 
 
 def component_name(name: str) -> str:
@@ -122,4 +122,4 @@ def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
 
 def write_window_deck(loads: LoadSet, layout: DeckLayout, path: str | Path) -> Path:
     """Write the window deck atomically (temp file in the same folder, then rename)."""
-    return write_text_atomic(path, window_deck(loads, layout))
+    return write_text(path, window_deck(loads, layout))

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.atomic import atomic_target
+from twin.io.atomic import atomic_target
 from twin.spindle.spec import BOUNDARY_NAMES, SpindleSpec
 
 MM = 1e-3

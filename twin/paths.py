@@ -2,7 +2,7 @@
 
 A fifo, a device or a folder given where a file is expected would block a reader forever
 (`/dev/zero`, a fifo nobody writes) or fill the memory; such an input is refused with an
-`InputError` naming it before a byte is read.  The `--out` side lives in `twin.atomic`.
+`InputError` naming it before a byte is read.  The `--out` side lives in `twin.io.atomic`.
 """
 
 from __future__ import annotations

@@ -19,10 +19,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from twin.atomic import write_bytes_atomic
 from twin.correction.features import HIDDEN_SIZES, INPUT_NAMES, OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.network import CONFIGS, TrainedNet
 from twin.errors import InputError
+from twin.io.atomic import write_bytes
 
 FORMAT = "spindle-twin-correction"
 VERSION = 1
@@ -86,7 +86,7 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
         sha256=_digest(tensors),
     )
     data = save(tensors, metadata={METADATA_KEY: json.dumps(meta, sort_keys=True)})
-    write_bytes_atomic(path, data)
+    write_bytes(path, data)
     return path
 
 

@@ -4,15 +4,14 @@ with loss curves, the R² table (both configurations) and predicted-vs-target pl
 from __future__ import annotations
 
 import io
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from twin.atomic import write_bytes_atomic
 from twin.correction.features import OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.training import TrainingResult
+from twin.io.atomic import write_json, write_text
 from twin.io.html_pages import png_data_uri, render_page
 
 
@@ -89,7 +88,7 @@ def write_report(
         },
         "metadata": results[chosen].model.metadata,
     }
-    write_bytes_atomic(json_path, json.dumps(summary, indent=2, default=_jsonable).encode())
+    write_json(json_path, summary)
 
     configs = [{"name": n, "saved": n == chosen, "time": f"{n} {r.seconds:.1f} s"}
                for n, r in results.items()]
@@ -102,13 +101,6 @@ def write_report(
     page = render_page("training_report.html.j2", model_name=Path(model_path).name,
                        meta=results[chosen].model.metadata, configs=configs, rows=rows,
                        images=images)
-    write_bytes_atomic(html_path, page.encode())
+    write_text(html_path, page)
     return json_path, html_path
 
-
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    return str(x)

@@ -2,6 +2,8 @@
 
 atomic       the one atomic writer (temporary file beside the target, then os.replace)
              and its text, JSON and CSV forms
+vtk          the one field-file writer (VTU per time + ParaView .pvd) and the names and
+             units of its arrays: temperature_C, displacement_um, von_mises_MPa
 html_pages   HTML pages from the jinja2 templates in `templates/` (package data)
 
 Imports are per module (`from twin.io.atomic import write_json`): this package imports

@@ -4,7 +4,6 @@ replay      one run × one correction method, window by window (the loop itself)
 metrics     accuracy.json metrics
 runfiles    one run × all methods → its output folder
 batch       many runs: local processes or dask, resume, summary.json
-outputs     atomic writers (CSV, JSON, VTU, PVD)
 snapshot    headless field pictures (pyvista)
 report      the self-contained report.html
 training    simulate_for_training: a run replayed with the window fit (training samples)

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from twin.errors import InputError
+from twin.io.atomic import write_json
 from twin.loop.metrics import mean_metrics
-from twin.loop.outputs import write_json_atomic
 from twin.loop.runfiles import is_done, replay_run_to_dir, resume_token, run_name
 
 
@@ -150,5 +150,5 @@ def write_summary(out_root: Path, accuracies: list[dict], failed: list[dict]) ->
     summary = {"runs": accuracies, "mean": mean_metrics(accuracies)}
     if failed:
         summary["failed"] = failed
-    write_json_atomic(Path(out_root) / "summary.json", summary)
+    write_json(Path(out_root) / "summary.json", summary)
     return summary

@@ -17,11 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.atomic import write_bytes_atomic, write_text_atomic
 from twin.contract import STEP_S, WINDOW_S
+from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.metrics import SENSORS, mean_metrics
-from twin.loop.outputs import write_json_atomic
 
 METHOD_COLORS = {"open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728"}
 
@@ -130,7 +129,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
         ax2.legend(fontsize=6, ncol=2)
     out.append(_png(fig))
     return [
-        write_bytes_atomic(run_dir / "plots" / name, png)
+        write_bytes(run_dir / "plots" / name, png)
         for name, png in zip(PLOTS, out, strict=True)
     ]
 
@@ -190,7 +189,7 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
     out_root = Path(out_root)
     if rebuild_summary:
         summary = collect_summary(out_root)
-        write_json_atomic(out_root / "summary.json", summary)
+        write_json(out_root / "summary.json", summary)
     else:
         summary = json.loads((out_root / "summary.json").read_text())
     runs = summary.get("runs", [])
@@ -221,5 +220,5 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
         runs=page_runs,
     )
     path = out_root / "report.html"
-    write_text_atomic(path, page)
+    write_text(path, page)
     return path

@@ -23,14 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.metrics import SENSORS, accuracy_metrics
-from twin.loop.outputs import (
-    write_csv_atomic,
-    write_json_atomic,
-    write_pvd_atomic,
-    write_text_atomic,
-    write_vtu_atomic,
-)
 from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
 
 DONE_FILE = ".done.json"
@@ -139,7 +133,7 @@ def replay_run_to_dir(
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
         for w in r.windows:
             if w.deck is not None:
-                write_text_atomic(deck_dir / f"window_{w.window:03d}.inp", w.deck)
+                write_text(deck_dir / f"window_{w.window:03d}.inp", w.deck)
     _write_fields(out_dir, model, results[primary])
     if snapshots != "none":
         from twin.loop.snapshot import render_snapshot
@@ -156,8 +150,8 @@ def replay_run_to_dir(
                 T_initial_C=r.T_initial_C,
             )
     render_run_plots(out_dir)
-    write_json_atomic(out_dir / "accuracy.json", accuracy)
-    write_json_atomic(out_dir / DONE_FILE, token)
+    write_json(out_dir / "accuracy.json", accuracy)
+    write_json(out_dir / DONE_FILE, token)
     return accuracy
 
 
@@ -183,7 +177,7 @@ def _write_keypoints(
                     nan,
                 ]
             )
-    write_csv_atomic(path, header, rows)
+    write_csv(path, header, rows)
 
 
 def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
@@ -219,18 +213,16 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
                     *c.C_C,
                 ]
             )
-    write_csv_atomic(path, header, rows)
+    write_csv(path, header, rows)
 
 
 def _write_fields(out_dir: Path, model, r: MethodReplay) -> None:  # noqa: ANN001
-    from twin.fields import field_mesh
+    from twin.io.vtk import write_field_series
+    from twin.spindle.fields import field_mesh
 
-    entries = []
-    for t in sorted(r.fields):
-        name = f"fields/{r.method}_t{t:05.0f}s.vtu"
-        write_vtu_atomic(out_dir / name, field_mesh(model, r.fields[t], r.T_initial_C))
-        entries.append((t, name))
-    write_pvd_atomic(out_dir / "fields.pvd", entries)
+    write_field_series(out_dir, ((t, f"fields/{r.method}_t{t:05.0f}s.vtu",
+                                  field_mesh(model, r.fields[t], r.T_initial_C))
+                                 for t in sorted(r.fields)))
 
 
 @functools.cache

@@ -33,8 +33,8 @@ def render_snapshot(
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
 
-    from twin.atomic import atomic_target
-    from twin.fields import field_arrays
+    from twin.io.atomic import atomic_target
+    from twin.spindle.fields import field_arrays
 
     if field not in FIELDS:
         raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")

@@ -11,8 +11,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from twin.atomic import atomic_target
 from twin.errors import InputError
+from twin.io.atomic import atomic_target
 from twin.paths import check_input_file
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
 from twin.runs.table import RawTable, parse_cell

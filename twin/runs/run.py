@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Mapping
@@ -11,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.atomic import atomic_target
 from twin.errors import InputError
+from twin.io.atomic import write_json
 from twin.runs.csv_format import read_csv_table, write_csv_table
 from twin.runs.parquet_format import read_parquet_table, write_parquet_table
 from twin.runs.quality import QualityConfig, drop_repeated_rows, finding, repair
@@ -211,6 +210,4 @@ def write_quality(run: RecordedRun, path: str | os.PathLike[str]) -> None:
     """Write `quality.json` (the run's data-quality findings), atomically."""
     doc = {"run": run.name, "file": run.path, "n_samples": int(run.time_s.size),
            "duration_s": run.duration_s, "findings": run.quality}
-    with atomic_target(path) as tmp, open(tmp, "w") as out:
-        json.dump(doc, out, indent=2)
-        out.write("\n")
+    write_json(path, doc)

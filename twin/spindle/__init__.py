@@ -11,6 +11,7 @@ spec        SpindleSpec, load_spec (TOML → validated pydantic models, InputErr
 model       SpindleModel (mesh, thermal, elastic, sensor_matrix, probe_vectors)
 conditions  BoundaryConditions, nominal_conditions, check_operating_point
 simulate    simulate → SimulationResult (key points, nose drift, energy balance)
+fields      field_arrays, field_mesh: a temperature state as the field-file arrays
 output      write_simulation (keypoints.csv, fields.pvd + .vtu, summary.json)
 """
 

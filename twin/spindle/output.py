@@ -1,32 +1,26 @@
 """Files of an open-loop run: keypoints.csv, fields.pvd + fields/*.vtu, summary.json.
 
-Every file is written atomically (a temporary file in the same folder, then os.replace).
+Every file is written atomically (`twin.io.atomic`).
 keypoints.csv has the columns of a recorded run (time_s, speed_rpm, ambient_C,
 T1_C..T5_C, disp_z_um, disp_r_um), so a simulated run can be replayed like a measured one.
-The .vtu files carry, on the thermal mesh nodes: temperature_C, displacement_m (u_r, u_z, 0;
-relative to the start of the run) and von_mises_Pa (thermal stress of the warming), and
-the region number per cell.
+The .vtu files are those of every field file (`twin.io.vtk`): temperature_C,
+displacement_um (u_r, u_z, 0; relative to the start of the run) and von_mises_MPa on the
+thermal mesh vertices, and the region number per cell.
 """
 
 from __future__ import annotations
 
 import csv
 import io
-import json
-import tempfile
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from twin.atomic import write_bytes_atomic
+from twin.io.atomic import write_json, write_text
+from twin.io.vtk import write_field_series
+from twin.spindle.fields import field_mesh
 from twin.spindle.model import SpindleModel
 from twin.spindle.simulate import SimulationResult
-
-
-def write_atomic(path: Path, data: str | bytes) -> None:
-    """Write text or bytes to `path` atomically (twin.atomic)."""
-    write_bytes_atomic(path, data.encode() if isinstance(data, str) else data)
 
 
 def keypoints_csv(result: SimulationResult) -> str:
@@ -81,53 +75,15 @@ def summary(model: SpindleModel, result: SimulationResult) -> dict:
     }
 
 
-def _vtu_bytes(model: SpindleModel, T: np.ndarray, T_start: np.ndarray) -> bytes:
-    import meshio
-
-    mesh = model.mesh
-    n_nodes = mesh.thermal.p.shape[1]
-    elastic = model.elastic
-    # displacement and stress of the warming since the start (see model docstring)
-    T_rel = T - T_start + elastic.T_ref
-    u = elastic.solve(T_rel)
-    stress = elastic.stresses(u, T_rel)
-    glued = mesh.node_map  # thermal node → glued node
-    n_glued = mesh.glued.p.shape[1]
-    disp = np.zeros((n_nodes, 3))
-    disp[:, 0] = u[0][:n_glued][glued]
-    disp[:, 1] = u[1][:n_glued][glued]
-    region_id = np.zeros(mesh.n_cells, dtype=np.int32)
-    for i, region in enumerate(sorted(model.spec.regions)):
-        region_id[mesh.region(region)] = i
-    out = meshio.Mesh(
-        np.ascontiguousarray(np.column_stack([mesh.thermal.p.T, np.zeros(n_nodes)])),
-        [("triangle", np.ascontiguousarray(mesh.thermal.t.T))],
-        point_data={"temperature_C": np.ascontiguousarray(T[:n_nodes]),
-                    "displacement_m": disp,
-                    "von_mises_Pa": np.ascontiguousarray(stress["von_mises"][:n_glued][glued])},
-        cell_data={"region": [region_id]},
-    )
-    with tempfile.TemporaryDirectory() as tmp:
-        f = Path(tmp) / "f.vtu"
-        meshio.write(f, out, file_format="vtu", binary=True, compression=None)
-        return f.read_bytes()
-
-
 def write_fields(model: SpindleModel, result: SimulationResult, out_dir: Path) -> Path:
-    """fields/step_NNNN.vtu per kept snapshot and a ParaView collection fields.pvd."""
+    """fields/step_NNNNN.vtu per kept snapshot and a ParaView collection fields.pvd."""
     if not result.fields:
         raise ValueError("the run kept no field snapshots (simulate(field_every_s=...))")
-    T_start = result.fields[0][1]
-    entries = []
-    for time_s, T in result.fields:
-        name = f"fields/step_{int(round(time_s / result.dt_s)):05d}.vtu"
-        write_atomic(out_dir / name, _vtu_bytes(model, T, T_start))
-        entries.append(f'    <DataSet timestep="{time_s:g}" part="0" file={quoteattr(name)}/>')
-    pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-           + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
-    path = out_dir / "fields.pvd"
-    write_atomic(path, pvd)
-    return path
+    # simulate starts from a uniform field at the ambient: the drift is relative to it
+    return write_field_series(out_dir, (
+        (t, f"fields/step_{int(round(t / result.dt_s)):05d}.vtu",
+         field_mesh(model, T, result.ambient_C))
+        for t, T in result.fields))
 
 
 def write_simulation(model: SpindleModel, result: SimulationResult, out_dir: str | Path,
@@ -135,9 +91,9 @@ def write_simulation(model: SpindleModel, result: SimulationResult, out_dir: str
     """Write keypoints.csv, fields (if kept and `fields`) and summary.json; return summary."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    write_atomic(out_dir / "keypoints.csv", keypoints_csv(result))
+    write_text(out_dir / "keypoints.csv", keypoints_csv(result))
     if fields and result.fields:
         write_fields(model, result, out_dir)
     info = summary(model, result)
-    write_atomic(out_dir / "summary.json", json.dumps(info, indent=2) + "\n")
+    write_json(out_dir / "summary.json", info)
     return info
