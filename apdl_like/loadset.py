@@ -21,9 +21,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from apdl_like.errors import ApdlError
+from apdl_like.model import record_groups
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -87,15 +86,6 @@ class LoadSet:
         return self.start_s + self.n_steps * self.dt_s
 
 
-def _groups(record: np.ndarray) -> list[np.ndarray]:
-    has = np.nonzero(record >= 0)[0]
-    if not has.size:
-        return []
-    order = has[np.argsort(record[has], kind="stable")]
-    splits = np.nonzero(np.diff(record[order]))[0] + 1
-    return np.split(order, splits)
-
-
 def record_solve(session: SessionState) -> dict:
     """What a SOLVE would solve, by mesh names (SOLVE with `record_only` set)."""
     from apdl_like.solve import fem_model
@@ -106,11 +96,11 @@ def record_solve(session: SessionState) -> dict:
     el = db.elements.arrays
     cell_rec = el["hgen_record"][fem.cell_element]
     heat = {}
-    for cells in _groups(cell_rec):
+    for cells in record_groups(cell_rec):
         heat[fem.region_for(cells)] = float(el["hgen"][fem.cell_element[cells[0]]])
     faces = db.faces
     conv = {}
-    for idx in _groups(faces.conv_record):
+    for idx in record_groups(faces.conv_record):
         conv[fem.boundary_for(fem.face_facets[idx])] = (float(faces.conv_h[idx[0]]),
                                                         float(faces.conv_bulk[idx[0]]))
     contact = {}

@@ -252,10 +252,47 @@ class ElementTable(_NumberedTable):
         self.version += 1
 
 
+def record_groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[np.ndarray]:
+    """Index sets sharing a load record id (and `extra` value), for entities with a record.
+
+    Groups come in ascending record order (then `extra`), members in ascending index order.
+    """
+    has = np.nonzero(record >= 0)[0]
+    if has.size == 0:
+        return []
+    if extra is None:
+        order = has[np.argsort(record[has], kind="stable")]
+        return np.split(order, np.nonzero(np.diff(record[order]))[0] + 1)
+    keys = np.column_stack([record[has].astype(float), np.nan_to_num(extra[has], nan=-1e300)])
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    splits = np.nonzero(np.diff(inverse[order]))[0] + 1
+    return [has[s] for s in np.split(order, splits)]
+
+
 @dataclass
 class Component:
+    """A named set of node or element numbers (CM, CMBLOCK)."""
+
     entity: str  # "NODE" or "ELEM"
     numbers: np.ndarray  # sorted APDL numbers
+    # the membership mask over the table it was last resolved against, and that
+    # table's version: a window deck selects the same components every minute
+    _mask: np.ndarray | None = field(default=None, repr=False, compare=False)
+    _mask_key: tuple[int, int] | None = field(default=None, repr=False, compare=False)
+
+    def mask(self, table: NodeTable | ElementTable) -> np.ndarray:
+        """Read-only membership mask over `table` (numbers not in the table are ignored)."""
+        table.flush()
+        key = (id(table), table.version)
+        if self._mask is None or self._mask_key != key:
+            mask = np.zeros(len(table.ids), bool)
+            idx = table.index(self.numbers)
+            mask[idx[idx >= 0]] = True
+            mask.flags.writeable = False
+            self._mask, self._mask_key = mask, key
+        return self._mask
 
 
 @dataclass

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 from apdl_like.errors import ApdlError
@@ -86,10 +87,20 @@ def _split_fields(body: str) -> list[str]:
 
 def lex_line(raw: str, file: str, number: int) -> Statement | None:
     """One deck line -> a statement, or None for blank and comment lines."""
+    try:
+        lexed = _lex(raw)
+    except ApdlError as exc:
+        raise exc.located(file, number, None) from None
+    if lexed is None:
+        return None
+    return Statement(file, number, lexed[0], lexed[1], raw)
+
+
+@lru_cache(maxsize=8192)
+def _lex(raw: str) -> tuple[str, tuple[str, ...]] | None:
+    """(name, fields) of one line; cached because a window deck repeats most of its lines."""
     if len(raw) > MAX_LINE_CHARS:
-        raise ApdlError(
-            f"line longer than {MAX_LINE_CHARS} characters", file=file, line=number
-        )
+        raise ApdlError(f"line longer than {MAX_LINE_CHARS} characters")
     head = raw.lstrip()
     upper = head[:7].upper()
     for text_cmd in _TEXT_COMMANDS:
@@ -97,23 +108,23 @@ def lex_line(raw: str, file: str, number: int) -> Statement | None:
         if upper.startswith(text_cmd) and (len(head) == n or head[n] in ", \t"):
             rest = head[len(text_cmd) :].lstrip(" \t")
             rest = rest[1:] if rest.startswith(",") else rest
-            return Statement(file, number, text_cmd, (rest.strip(),), raw)
+            return text_cmd, (rest.strip(),)
     body = _strip_comment(raw).strip()
     if not body:
         return None
     if "\x00" in body:
-        raise ApdlError("binary data in deck", file=file, line=number)
+        raise ApdlError("binary data in deck")
     m = _ASSIGNMENT.match(body)
     if m is not None and "," not in body[: m.start(2)]:
-        return Statement(file, number, "=", (m.group(1).upper(), m.group(2).strip()), raw)
+        return "=", (m.group(1).upper(), m.group(2).strip())
     parts = _split_fields(body) if "(" in body else body.split(",")
     name = parts[0].strip().upper()
     if not _COMMAND_NAME.match(name):
         shown = parts[0].strip() or "(empty)"
-        raise ApdlError(f"not a command or assignment: {shown!r}", file=file, line=number)
+        raise ApdlError(f"not a command or assignment: {shown!r}")
     if len(parts) - 1 > MAX_FIELDS:
-        raise ApdlError(f"more than {MAX_FIELDS} fields", file=file, line=number, command=name)
-    return Statement(file, number, name, tuple(p.strip() for p in parts[1:]), raw)
+        raise ApdlError(f"more than {MAX_FIELDS} fields", command=name)
+    return name, tuple(p.strip() for p in parts[1:])
 
 
 def _match_blocks(program: Program) -> None:

@@ -20,6 +20,7 @@ import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
+from apdl_like.model import record_groups
 from apdl_like.state import TCC_LOCATION, StepResult
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
@@ -88,13 +89,26 @@ def _material_key(mats: dict[str, Material]) -> tuple:
     return tuple(sorted((n, m.k, m.rho, m.c, m.E, m.nu, m.alpha) for n, m in mats.items()))
 
 
+def _material_inputs(session: SessionState, fem: FemModel) -> tuple:
+    """What `_materials` reads, cheaply: a window deck re-solves with unchanged materials."""
+    db = session.db
+    used = np.unique(db.elements.mat[fem.cell_element]).tolist()
+    props = tuple((m, tuple(sorted(db.materials[m].props.items())) if m in db.materials
+                   else None) for m in used)
+    return id(fem), db.settings.antype, props
+
+
 def thermal_problem(session: SessionState, fem: FemModel) -> ThermalProblem:
+    cache = session.fem
+    inputs = _material_inputs(session, fem)
+    if cache.thermal is not None and cache.thermal_inputs == inputs:
+        return cache.thermal
     mats = _materials(session, fem, "thermal")
     key = (id(fem), _material_key(mats), fem.order)
-    cache = session.fem
     if cache.thermal_key != key:
         cache.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
         cache.thermal_key = key
+    cache.thermal_inputs = inputs
     return cache.thermal  # type: ignore[return-value]
 
 
@@ -127,20 +141,6 @@ def _check_axisymmetric(session: SessionState, physics: str) -> None:
                             f"analyses are supported (KEYOPT,{t},3,1)")
 
 
-def _groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[np.ndarray]:
-    """Index sets sharing a record id (and `extra` value), for entities with a record."""
-    has = np.nonzero(record >= 0)[0]
-    if has.size == 0:
-        return []
-    keys = record[has].astype(float) if extra is None else \
-        np.column_stack([record[has].astype(float), np.nan_to_num(extra[has], nan=-1e300)])
-    _, inverse = np.unique(keys, axis=0 if extra is not None else None, return_inverse=True)
-    inverse = inverse.ravel()
-    order = np.argsort(inverse, kind="stable")
-    splits = np.nonzero(np.diff(inverse[order]))[0] + 1
-    return [has[s] for s in np.split(order, splits)]
-
-
 def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -> ThermalLoads:
     """The database's thermal loads as twin.fem ThermalLoads (ramped to `fraction`)."""
     db = session.db
@@ -153,7 +153,7 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
     cell_rec = el["hgen_record"][fem.cell_element]
     cell_prev = prev["hgen"][fem.cell_element] if prev is not None else None
     sources = {}
-    for cells in _groups(cell_rec, cell_prev):
+    for cells in record_groups(cell_rec, cell_prev):
         q = float(cell_hgen[cells[0]])
         if prev is not None:
             q0 = float(np.nan_to_num(cell_prev[cells[0]]))
@@ -163,7 +163,7 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
     faces = db.faces
     convection, flux = {}, {}
     fprev = prev["faces"] if prev is not None else None
-    for idx in _groups(faces.conv_record, None if fprev is None else fprev["conv_h"]):
+    for idx in record_groups(faces.conv_record, None if fprev is None else fprev["conv_h"]):
         h, tb = float(faces.conv_h[idx[0]]), float(faces.conv_bulk[idx[0]])
         if np.isnan(h) or np.isnan(tb):
             raise ApdlError("a face has CONV with only one of film coefficient and bulk "
@@ -175,7 +175,7 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
             h, tb = h0 + fraction * (h - h0), tb0 + fraction * (tb - tb0)
         if h != 0.0:
             convection[fem.boundary_for(fem.face_facets[idx])] = (h, tb)
-    for idx in _groups(faces.hflux_record, None if fprev is None else fprev["hflux"]):
+    for idx in record_groups(faces.hflux_record, None if fprev is None else fprev["hflux"]):
         q = float(faces.hflux[idx[0]])
         if fprev is not None:
             q0 = float(np.nan_to_num(fprev["hflux"][idx[0]]))

@@ -59,6 +59,7 @@ class FemCache:
     external_mesh: bool = False  # the mesh came from an AxiMesh: N/E may not change it
     thermal: ThermalProblem | None = None
     thermal_key: tuple | None = None
+    thermal_inputs: tuple | None = None  # the MP/ANTYPE inputs `thermal` was checked against
     elastic: ElasticProblem | None = None
     elastic_key: tuple | None = None
 

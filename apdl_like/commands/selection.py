@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -126,10 +127,12 @@ def allsel(s: SessionState, c: Call) -> None:
     s.db.elements.selected = np.ones(len(s.db.elements), bool)
 
 
+_COMPONENT_NAME = re.compile(r"[A-Z][A-Z0-9_]{0,31}\Z")
+
+
 def _component_name(c: Call, i: int) -> str:
     name = c.raw(i).upper()
-    if not name or len(name) > 32 or not name[0].isalpha() or \
-            not all(ch.isalnum() or ch == "_" for ch in name):
+    if not _COMPONENT_NAME.match(name):
         raise ApdlError(f"field {i}: {c.raw(i)!r} is not a valid component name")
     return name
 
@@ -161,12 +164,7 @@ def component(s: SessionState, name: str) -> Component:
 
 
 def component_mask(s: SessionState, comp: Component) -> np.ndarray:
-    table = s.db.nodes if comp.entity == "NODE" else s.db.elements
-    table.flush()
-    mask = np.zeros(len(table.ids), bool)
-    idx = table.index(comp.numbers)
-    mask[idx[idx >= 0]] = True
-    return mask
+    return comp.mask(s.db.nodes if comp.entity == "NODE" else s.db.elements)
 
 
 def cmsel(s: SessionState, c: Call) -> None:
