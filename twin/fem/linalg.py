@@ -14,6 +14,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from skfem import condense
 
 
 def factorize_symmetric(A: sp.csc_matrix) -> spla.SuperLU:
@@ -30,34 +31,30 @@ def factorize_symmetric(A: sp.csc_matrix) -> spla.SuperLU:
 class DirichletSolver:
     """A symmetric system A x = b, factorized once, with x[dofs] = values prescribed.
 
-    Like scikit-fem's `condense` + `solve`, but the factorization of A[free, free] and the
-    coupling A[free, dofs] are kept, so each further right-hand side costs one
-    back-substitution (condense would slice and factorize again every time).
+    scikit-fem's `condense` eliminates the prescribed dofs once; the factorization of
+    A[free, free] and the lift −A[free, dofs]·values are kept, so each right-hand side
+    costs one back-substitution (condense + solve would slice and factorize every time).
     """
 
     def __init__(self, A: sp.csr_matrix, dofs: np.ndarray, values: np.ndarray) -> None:
         n = A.shape[0]
-        self.dofs, self.values = dofs, values
         if dofs.size:
-            free = np.ones(n, dtype=bool)
-            free[dofs] = False
-            self.free = np.where(free)[0]
-            A_free = A[self.free][:, self.free]
-            self.coupling = A[self.free][:, dofs]
+            x = np.zeros(n)
+            x[dofs] = values
+            # with b = 0, condense's right-hand side b_I − A_ID x_D is the lift −A_ID x_D
+            A_free, self.lift, self.x, self.free = condense(A, np.zeros(n), x=x, D=dofs)
         else:
             self.free = None
             A_free = A
         # A is symmetric: its CSR arrays read as CSC describe the same matrix
         A_csc = sp.csc_matrix((A_free.data, A_free.indices, A_free.indptr), shape=A_free.shape)
         self.lu = factorize_symmetric(A_csc)
-        self.n = n
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         if self.free is None:
             return self.lu.solve(rhs)
-        x = np.empty(self.n)
-        x[self.dofs] = self.values
-        x[self.free] = self.lu.solve(rhs[self.free] - self.coupling @ self.values)
+        x = self.x.copy()
+        x[self.free] = self.lu.solve(rhs[self.free] + self.lift)
         return x
 
 

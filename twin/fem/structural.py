@@ -17,7 +17,7 @@ from collections.abc import Mapping
 
 import numpy as np
 import scipy.sparse.linalg as spla
-from skfem import Basis, ElementVector, asm
+from skfem import Basis, ElementVector, asm, condense
 
 from twin.fem.elements import element_for
 from twin.fem.forms import capacity, elasticity, thermal_strain_load, unit_load_weighted
@@ -85,11 +85,9 @@ class ElasticProblem:
         if not any(c for c in constraints.values() if "z" in c.lower()):
             raise ValueError("structure needs an axial (z) constraint to remove the rigid motion")
         self.fixed_dofs = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
-        free = np.ones(self.basis.N, dtype=bool)
-        free[self.fixed_dofs] = False
-        self.free_dofs = np.where(free)[0]
-        K_free = self.K[self.free_dofs][:, self.free_dofs].tocsc()
-        self._lu = factorize_symmetric(K_free)
+        K_free, _, self.free_dofs = condense(self.K, D=self.fixed_dofs)
+        # K is symmetric only to round-off: convert, rather than read CSR arrays as CSC
+        self._lu = factorize_symmetric(K_free.tocsc())
         self._stress_mass = None
 
     def _cell_constants(self, materials: Mapping[str, Material]):  # noqa: ANN202
