@@ -8,7 +8,6 @@ matches.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -16,8 +15,9 @@ from pathlib import Path
 
 from twin.errors import InputError
 from twin.io.atomic import write_json
-from twin.loop.metrics import mean_metrics
+from twin.loop.folders import folder_lock, remove_orphans
 from twin.loop.runfiles import is_done, replay_run_to_dir, resume_token, run_name
+from twin.loop.summary import collect_summary, read_accuracy
 
 
 @dataclass(frozen=True)
@@ -76,27 +76,36 @@ def replay_batch(
     resume: bool = False,
     progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
 ) -> BatchResult:
+    """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
+
+    Batches may write into one folder at once: each run folder is swapped in whole and
+    summary.json is rebuilt from the folders under the folder's lock, so no finished run
+    goes missing from it.  Temporary files of killed earlier batches are removed first.
+    """
     out_root = Path(out_root)
     out_root.mkdir(parents=True, exist_ok=True)
-    names = [run_name(r) for r in runs]
+    remove_orphans(out_root)
+    result = BatchResult()
+    named: list[tuple[str, str]] = []
+    for path in runs:
+        try:
+            named.append((str(path), run_name(path)))
+        except InputError as exc:
+            result.failed.append({"error": str(exc), "kind": "input", "run": Path(path).stem,
+                                  "path": str(path)})
+    names = [n for _, n in named]
     dupes = {n for n in names if names.count(n) > 1}
     if dupes:
         raise InputError(f"two runs share the output folder name {sorted(dupes)[0]!r}")
-    result = BatchResult()
     todo: list[ReplayJob] = []
-    for path in runs:
-        path = str(path)
-        if resume and Path(path).is_file():
-            out_dir = out_root / run_name(path)
-            try:
-                done = is_done(out_dir, resume_token(path, methods, model_path))
-            except OSError:
-                done = False
-            if done:
-                result.accuracies.append(json.loads((out_dir / "accuracy.json").read_text()))
-                result.skipped.append(run_name(path))
+    for path, name in named:
+        if resume:
+            finished = _finished(out_root / name, path, methods, model_path)
+            if finished is not None:
+                result.accuracies.append(finished)
+                result.skipped.append(name)
                 if progress:
-                    progress(run_name(path), "skipped")
+                    progress(name, "skipped")
                 continue
         todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots))
 
@@ -107,8 +116,20 @@ def replay_batch(
             result.failed.append(outcome)
     order = {n: i for i, n in enumerate(names)}
     result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
-    write_summary(out_root, result.accuracies, result.failed)
+    write_summary(out_root, result.failed, attempted=names)
     return result
+
+
+def _finished(out_dir: Path, path: str, methods: Sequence[str],
+              model_path: str | None) -> dict | None:
+    """The accuracy of a run folder --resume may keep, or None: replay it (again) when its
+    token does not match or its accuracy.json is missing or unreadable."""
+    try:
+        if not is_done(out_dir, resume_token(path, methods, model_path)):
+            return None
+    except OSError:
+        return None
+    return read_accuracy(out_dir / "accuracy.json")
 
 
 def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress):  # noqa: ANN001, ANN202
@@ -146,9 +167,10 @@ def _tell(progress, outcome: dict) -> None:  # noqa: ANN001
         progress(outcome["run"], f"failed: {outcome['error']}")
 
 
-def write_summary(out_root: Path, accuracies: list[dict], failed: list[dict]) -> dict:
-    summary = {"runs": accuracies, "mean": mean_metrics(accuracies)}
-    if failed:
-        summary["failed"] = failed
-    write_json(Path(out_root) / "summary.json", summary)
+def write_summary(out_root: Path, failed: list[dict], attempted: Sequence[str] = ()) -> dict:
+    """Rebuild DIR/summary.json under the folder's lock from every run folder (see
+    `collect_summary`), with this batch's failures."""
+    with folder_lock(Path(out_root)):
+        summary = collect_summary(Path(out_root), failed, attempted)
+        write_json(Path(out_root) / "summary.json", summary)
     return summary

@@ -20,7 +20,9 @@ import numpy as np
 from twin.contract import STEP_S, WINDOW_S
 from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.html_pages import png_data_uri, render_page
-from twin.loop.metrics import SENSORS, mean_metrics
+from twin.loop.folders import folder_lock
+from twin.loop.metrics import SENSORS
+from twin.loop.summary import collect_summary, run_folder
 
 METHOD_COLORS = {"open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728"}
 
@@ -167,37 +169,31 @@ def _findings(run_dir: Path) -> list[str] | None:
             (items if isinstance(items, list) else [items] if items else [])]
 
 
-def collect_summary(out_root: Path) -> dict:
-    """summary.json rebuilt from every run folder's accuracy.json (failures kept)."""
-    runs = []
-    for acc in sorted(Path(out_root).glob("*/accuracy.json")):
-        runs.append(json.loads(acc.read_text()))
-    summary = {"runs": runs, "mean": mean_metrics(runs)}
+def _summary_of_batch(out_root: Path) -> dict | None:
+    """summary.json as the batch just wrote it, or None when it must be rebuilt."""
     try:
-        old = json.loads((Path(out_root) / "summary.json").read_text())
-        done = {r["run"] for r in runs}
-        failed = [f for f in old.get("failed", []) if f.get("run") not in done]
-        if failed:
-            summary["failed"] = failed
+        summary = json.loads((out_root / "summary.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
-        pass
-    return summary
+        return None
+    return summary if isinstance(summary, dict) else None
 
 
 def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
     """Write DIR/report.html (and DIR/summary.json when rebuilding) from a replay folder."""
     out_root = Path(out_root)
-    if rebuild_summary:
-        summary = collect_summary(out_root)
-        write_json(out_root / "summary.json", summary)
-    else:
-        summary = json.loads((out_root / "summary.json").read_text())
+    summary = None if rebuild_summary else _summary_of_batch(out_root)
+    if summary is None:
+        with folder_lock(out_root):
+            summary = collect_summary(out_root)
+            write_json(out_root / "summary.json", summary)
     runs = summary.get("runs", [])
     methods = list(dict.fromkeys(m for r in runs for m in r["methods"]))
     mean = summary.get("mean", {})
     page_runs = []
     for r in runs:
-        run_dir = out_root / r["run"]
+        run_dir = run_folder(out_root, r["run"])
+        if run_dir is None:  # a name, never a path: nothing is read or drawn outside DIR
+            continue
         snapshots = sorted((run_dir / "snapshots").glob("*.png"))[-2:]
         page_runs.append({
             "name": r["run"],

@@ -23,7 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
+from twin.loop.folders import replaced_folder
 from twin.loop.metrics import SENSORS, accuracy_metrics
 from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
 
@@ -40,7 +42,14 @@ def file_digest(path: str | Path) -> str:
 
 
 def run_name(path: str | Path) -> str:
-    return Path(path).stem
+    """The run's folder name under DIR: the file name without its suffix.  A name that is
+    not one plain folder name (`..csv`, a leading dot) is refused: it would point at DIR
+    itself or hide among the temporary files."""
+    name = Path(path).stem
+    if not name or name.startswith(".") or name != Path(name).name:
+        raise InputError(f"{name!r} cannot name a run folder (a leading dot or a path)",
+                         file=str(path))
+    return name
 
 
 def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None) -> dict:
@@ -71,18 +80,27 @@ def replay_run_to_dir(
     spindle=None,  # noqa: ANN001 - a loaded SpindleModel to reuse, or None
     on_window: Callable[[str, int, int], None] | None = None,
 ) -> dict:
-    """Replay one run with `methods`, write its folder, return its accuracy.json dict."""
+    """Replay one run with `methods`, write its folder, return its accuracy.json dict.
+
+    The folder DIR/<run-name>/ is replaced as a whole (`replaced_folder`): a shorter rerun
+    leaves none of the longer run's files, and a failed one leaves no earlier result.
+    """
+    if snapshots not in SNAPSHOT_CHOICES:
+        raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
+    with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
+        return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
+                            on_window)
+
+
+def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
+                 on_window) -> dict:  # noqa: ANN001
     from twin.correction.methods import make_corrector
     from twin.loop.report import render_run_plots
     from twin.runs import read_run, write_quality
 
-    if snapshots not in SNAPSHOT_CHOICES:
-        raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
     model = spindle if spindle is not None else default_spindle()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
-    out_dir = Path(out_root) / run_name(run_path)
     token = resume_token(run_path, methods, model_path)
-    (out_dir / DONE_FILE).unlink(missing_ok=True)
 
     correctors = [make_corrector(m, model_path if m == "bpnn" else None) for m in methods]
     solver = deck_window_solver(model)  # one session serves every method of the run

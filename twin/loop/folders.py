@@ -1,0 +1,87 @@
+"""A replay output folder DIR: its lock, run folders replaced whole, orphans removed.
+
+Several batches may write into one DIR at once, and a batch may be killed at any moment.
+The rules that keep DIR consistent:
+- every file is written atomically (temporary name `.name.PID.HEX.suffix`, then renamed);
+- a run folder is built under a staging name and swapped in whole (`replaced_folder`);
+- the swap and summary.json's rebuild happen under DIR's lock (`folder_lock`);
+- the next batch into DIR removes what a killed one left (`remove_orphans`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import secrets
+import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from filelock import FileLock
+
+# `.name.PID.HEX…`: the atomic writer's temporary files and `replaced_folder`'s folders
+_ORPHAN = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{8}(\..*)?$")
+LOCK_FILE = ".twin.lock"
+
+
+def folder_lock(out_root: Path) -> FileLock:
+    """The lock of an output folder: batches writing into one DIR take turns at the moments
+    they change shared state (a run folder swapped in, summary.json rewritten)."""
+    out_root.mkdir(parents=True, exist_ok=True)
+    return FileLock(out_root / LOCK_FILE)
+
+
+@contextmanager
+def replaced_folder(target: Path) -> Iterator[Path]:
+    """Yield an empty staging folder beside `target`; on success it replaces `target` as a
+    whole.  On failure the staging folder and any earlier `target` are removed: a failed
+    rerun must not leave an older result standing as if it were current."""
+    tag = f"{os.getpid()}.{secrets.token_hex(4)}"
+    staging = target.with_name(f".{target.name}.{tag}.partial")
+    staging.mkdir(parents=True)
+    try:
+        yield staging
+    except BaseException:
+        with folder_lock(target.parent):
+            shutil.rmtree(staging, ignore_errors=True)
+            shutil.rmtree(target, ignore_errors=True)
+        raise
+    old = target.with_name(f".{target.name}.{tag}.old")
+    with folder_lock(target.parent):
+        try:
+            os.rename(target, old)
+        except FileNotFoundError:
+            old = None
+        os.rename(staging, target)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def remove_orphans(out_root: Path) -> list[Path]:
+    """Remove temporary files and staging folders that a killed process left in `out_root`
+    and its run folders (their process is gone); a live batch's are kept."""
+    removed = []
+    for folder in [out_root, *(p for p in out_root.iterdir() if p.is_dir())]:
+        for entry in folder.iterdir():
+            match = _ORPHAN.match(entry.name)
+            if match is None or _alive(int(match.group(1))):
+                continue
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry, ignore_errors=True)
+            else:
+                entry.unlink(missing_ok=True)
+            removed.append(entry)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True
+    return True
