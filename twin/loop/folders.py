@@ -62,7 +62,8 @@ def remove_orphans(out_root: Path) -> list[Path]:
     """Remove temporary files and staging folders that a killed process left in `out_root`
     and its run folders (their process is gone); a live batch's are kept."""
     removed = []
-    for folder in [out_root, *(p for p in out_root.iterdir() if p.is_dir())]:
+    runs = [p for p in out_root.iterdir() if p.is_dir() and not _ORPHAN.match(p.name)]
+    for folder in [out_root, *runs]:
         for entry in folder.iterdir():
             match = _ORPHAN.match(entry.name)
             if match is None or _alive(int(match.group(1))):

@@ -1,0 +1,158 @@
+"""Issue 14 regressions on replay output folders (defects 4, 8, 9, 10, 13, 15)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests.test_runs_reader import csv_text, warmup
+from twin.loop.batch import replay_batch
+from twin.loop.folders import LOCK_FILE, remove_orphans, replaced_folder
+from twin.loop.report import build_report
+from twin.loop.summary import collect_summary
+
+
+def replay(paths, out, resume=False):
+    return replay_batch([str(p) for p in paths], out, ["open_loop"], None, resume=resume)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("runs")
+    (folder / "a.csv").write_text(csv_text(warmup(n=240)))
+    (folder / "b.csv").write_text(csv_text(warmup(n=180)))
+    return folder
+
+
+@pytest.fixture(scope="module")
+def replayed(runs, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("replayed") / "out"
+    result = replay([runs / "a.csv", runs / "b.csv"], out)
+    assert result.exit_code == 0, result.failed
+    return out
+
+
+def copy_of(replayed: Path, tmp_path: Path) -> Path:
+    return Path(shutil.copytree(replayed, tmp_path / "out"))
+
+
+def summary_of(out: Path) -> dict:
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_defect4_failed_rerun_leaves_no_stale_result(replayed, runs, tmp_path):
+    out = copy_of(replayed, tmp_path)
+    broken = tmp_path / "a.csv"
+    broken.write_text("time_s,speed_rpm\n0,1\n")
+    result = replay([broken], out)
+    assert result.exit_code == 2
+    assert not (out / "a").exists()
+    summary = summary_of(out)
+    assert [r["run"] for r in summary["runs"]] == ["b"]
+    assert [f["run"] for f in summary["failed"]] == ["a"]
+    build_report(out)  # `twin report` must not bring the old numbers back
+    assert [r["run"] for r in summary_of(out)["runs"]] == ["b"]
+    assert [f["run"] for f in summary_of(out)["failed"]] == ["a"]
+
+
+def test_defect4_run_folder_replaced_as_a_whole(tmp_path):
+    target = tmp_path / "run"
+    (target / "decks").mkdir(parents=True)
+    (target / "decks" / "window_099.inp").write_text("old")
+    with replaced_folder(target) as staging:
+        (staging / "decks").mkdir()
+        (staging / "decks" / "window_001.inp").write_text("new")
+        assert (target / "decks" / "window_099.inp").exists()  # old result intact until done
+    assert sorted(p.name for p in (target / "decks").iterdir()) == ["window_001.inp"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [LOCK_FILE, "run"]
+    with pytest.raises(RuntimeError), replaced_folder(target) as staging:
+        (staging / "x").write_text("half")
+        raise RuntimeError("killed half-way")
+    assert [p.name for p in tmp_path.iterdir()] == [LOCK_FILE]
+
+
+def test_defect8_report_treats_run_names_as_names(replayed, tmp_path):
+    out = copy_of(replayed, tmp_path / "deep" / "er")
+    acc = out / "a" / "accuracy.json"
+    doc = json.loads(acc.read_text())
+    doc["run"] = "../../victim"
+    acc.write_text(json.dumps(doc))
+    before = sorted(str(p) for p in tmp_path.rglob("*") if out not in p.parents and p != out)
+    build_report(out)
+    after = sorted(str(p) for p in tmp_path.rglob("*") if out not in p.parents and p != out)
+    assert before == after
+    assert sorted(r["run"] for r in summary_of(out)["runs"]) == ["a", "b"]
+
+
+def test_defect9_resume_replays_a_run_with_corrupt_or_missing_accuracy(replayed, runs, tmp_path):
+    out = copy_of(replayed, tmp_path)
+    (out / "a" / "accuracy.json").write_text("{not json")
+    (out / "b" / "accuracy.json").unlink()
+    result = replay([runs / "a.csv", runs / "b.csv"], out, resume=True)
+    assert result.exit_code == 0 and result.skipped == []
+    assert json.loads((out / "a" / "accuracy.json").read_text())["run"] == "a"
+    assert (out / "b" / "accuracy.json").is_file()
+
+
+def test_defect9_resume_skips_a_finished_run(replayed, runs, tmp_path):
+    out = copy_of(replayed, tmp_path)
+    result = replay([runs / "a.csv"], out, resume=True)
+    assert result.skipped == ["a"] and result.exit_code == 0
+
+
+def test_report_lists_a_corrupt_accuracy_as_failed_instead_of_aborting(replayed, tmp_path):
+    out = copy_of(replayed, tmp_path)
+    (out / "b" / "accuracy.json").write_text('{"run": 5, "methods": []}')
+    build_report(out)
+    summary = summary_of(out)
+    assert [r["run"] for r in summary["runs"]] == ["a"]
+    assert summary["failed"][0]["run"] == "b" and "unreadable" in summary["failed"][0]["error"]
+
+
+def test_defect10_unreadable_file_does_not_stop_the_batch(runs, tmp_path):
+    missing, folder = tmp_path / "missing.csv", tmp_path / "folder.csv"
+    folder.mkdir()
+    result = replay([missing, folder, runs / "b.csv"], tmp_path / "out")
+    assert result.exit_code == 2
+    assert [a["run"] for a in result.accuracies] == ["b"]
+    assert sorted(f["run"] for f in summary_of(tmp_path / "out")["failed"]) == [
+        "folder", "missing"]
+
+
+def test_defect13_summary_lists_runs_of_a_concurrent_batch(replayed, runs, tmp_path):
+    # batch 1 finished run a into DIR while batch 2 replays b: batch 2's summary lists both
+    out = copy_of(replayed, tmp_path)
+    shutil.rmtree(out / "b")
+    (out / "summary.json").write_text(json.dumps({"runs": [], "mean": {}}))
+    replay([runs / "b.csv"], out)
+    assert sorted(r["run"] for r in summary_of(out)["runs"]) == ["a", "b"]
+
+
+def test_defect15_orphans_of_a_killed_run_removed_by_the_next(tmp_path):
+    dead = 2**22 + 12345  # above Linux's default pid_max: no such process
+    (tmp_path / "run").mkdir()
+    orphans = [tmp_path / f".summary.{dead}.deadbeef.json",
+               tmp_path / "run" / f".keypoints.{dead}.0badf00d.csv"]
+    for p in orphans:
+        p.write_text("half")
+    (tmp_path / f".run.{dead}.12345678.partial").mkdir()
+    live = tmp_path / f".summary.{os.getpid()}.deadbeef.json"
+    live.write_text("being written")
+    keep = tmp_path / "run" / "keypoints.csv"
+    keep.write_text("kept")
+    remove_orphans(tmp_path)
+    assert not any(p.exists() for p in orphans)
+    assert not (tmp_path / f".run.{dead}.12345678.partial").exists()
+    assert live.exists() and keep.exists()
+
+
+def test_summary_keeps_earlier_failures_until_the_run_is_retried(replayed, tmp_path):
+    out = copy_of(replayed, tmp_path)
+    failed = [{"run": "c", "error": "x", "kind": "input"}]
+    (out / "summary.json").write_text(json.dumps({"runs": [], "failed": failed}))
+    assert collect_summary(out)["failed"] == failed
+    assert "failed" not in collect_summary(out, attempted=["c"])
