@@ -13,7 +13,15 @@ Hard errors raise `twin.errors.InputError` naming file, line and column.
 """
 
 from twin.runs.quality import QualityConfig
-from twin.runs.run import RecordedRun, Samples, read_run, run_from_table, write_quality, write_run
+from twin.runs.run import (
+    RecordedRun,
+    Samples,
+    read_run,
+    read_table,
+    run_from_table,
+    write_quality,
+    write_run,
+)
 from twin.runs.schema import (
     ALL_COLUMNS,
     DISPLACEMENTS,
@@ -34,6 +42,7 @@ __all__ = [
     "RecordedRun",
     "Samples",
     "read_run",
+    "read_table",
     "run_from_table",
     "write_quality",
     "write_run",

@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -20,9 +20,15 @@ from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
 from twin.runs.table import RawTable, parse_cell
 
 
-def read_csv_table(path: str | os.PathLike[str]) -> RawTable:
-    """Read a CSV recorded run into a `RawTable` (no validation beyond parsing)."""
+def read_csv_table(path: str | os.PathLike[str],
+                   keep: Callable[[str], bool] | None = None) -> RawTable:
+    """Read a CSV recorded run into a `RawTable` (no validation beyond parsing).
+
+    `keep(name)` says which columns to read (default: the recorded-run schema); the
+    others are listed in `RawTable.ignored_columns`.
+    """
     file = str(path)
+    keep = keep or ALL_COLUMNS.__contains__
     text = read_input_text(path)
 
     # Split on '\n' only: editors number lines that way (str.splitlines would also
@@ -64,8 +70,8 @@ def read_csv_table(path: str | os.PathLike[str]) -> RawTable:
         raise InputError(f"{len(data_lines)} data rows; a run may hold at most {MAX_SAMPLES} "
                          "samples (resample it)", file=file, row=data_numbers[MAX_SAMPLES])
 
-    known = [(i, name) for i, name in enumerate(header) if name in ALL_COLUMNS]
-    ignored = [name for name in header if name not in ALL_COLUMNS]
+    known = [(i, name) for i, name in enumerate(header) if keep(name)]
+    ignored = [name for name in header if not keep(name)]
     values = np.full((len(data_lines), len(known)), np.nan)
     for k, fields in enumerate(_records(data_lines, file, data_numbers)):
         line = data_numbers[k]

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -49,8 +49,10 @@ def _column_values(column, file: str, name: str) -> np.ndarray:  # noqa: ANN001 
     raise InputError(f"column type {kind} is not numeric", file=file, column=name)
 
 
-def read_parquet_table(path: str | os.PathLike[str]) -> RawTable:
-    """Read a Parquet recorded run into a `RawTable`."""
+def read_parquet_table(path: str | os.PathLike[str],
+                       keep: Callable[[str], bool] | None = None) -> RawTable:
+    """Read a Parquet recorded run into a `RawTable`; `keep` as in `read_csv_table`."""
+    keep = keep or ALL_COLUMNS.__contains__
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -80,10 +82,10 @@ def read_parquet_table(path: str | os.PathLike[str]) -> RawTable:
 
     columns: dict[str, np.ndarray] = {}
     for name in table.column_names:
-        if name not in ALL_COLUMNS:
+        if not keep(name):
             continue
         columns[name] = _column_values(table.column(name), file, name)
-    ignored = [name for name in table.column_names if name not in ALL_COLUMNS]
+    ignored = [name for name in table.column_names if not keep(name)]
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.arange(1, table.num_rows + 1, dtype=np.int64),
                     ignored_columns=ignored)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -138,6 +138,20 @@ class RecordedRun(Samples):
             disp_um=disp, valid={name: ok(name) for name in self.valid})
 
 
+def read_table(path: str | os.PathLike[str],
+               keep: Callable[[str], bool] | None = None) -> RawTable:
+    """Read a CSV or Parquet table (by file suffix) without validation.
+
+    `keep(name)` selects the columns to read (default: the recorded-run schema).
+    """
+    file = Path(path)
+    reader = _READERS.get(file.suffix.lower())
+    if reader is None:
+        raise InputError(f"unknown run format {file.suffix!r}; expected .csv or .parquet",
+                         file=str(path))
+    return reader(path, keep)
+
+
 def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None,
              max_speed_rpm: float = math.inf) -> RecordedRun:
     """Read, validate and repair a recorded run (CSV or Parquet, by file suffix).
@@ -148,13 +162,7 @@ def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None,
     `OPERATING_TEMPERATURE_C` is refused here, before any replay.  Repairs are listed in
     `RecordedRun.quality`.
     """
-    file = Path(path)
-    reader = _READERS.get(file.suffix.lower())
-    if reader is None:
-        raise InputError(f"unknown run format {file.suffix!r}; expected .csv or .parquet",
-                         file=str(path))
-    table = reader(path)
-    return run_from_table(table, config, max_speed_rpm)
+    return run_from_table(read_table(path), config, max_speed_rpm)
 
 
 def run_from_table(table: RawTable, config: QualityConfig | None = None,
