@@ -1,0 +1,135 @@
+"""Drift data checks, fitting, causal prediction and the model file (synthetic machine)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.drift_synthetic import synthetic_columns, write_csv
+from twin.drift.data import read_drift_data
+from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
+from twin.drift.folds import block_labels
+from twin.drift.methods import METHODS, FitRows
+from twin.drift.model import fit_drift_model
+from twin.drift.modelfile import load_drift_model, save_drift_model
+from twin.errors import InputError
+
+
+@pytest.fixture(scope="module")
+def data_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("drift") / "machine.csv"
+    write_csv(path, synthetic_columns(), metadata="# machine: synthetic\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def ridge_model(data_file):
+    data = read_drift_data([data_file], targets=["drift_um"])
+    return fit_drift_model(data, method="ridge_dynamic", sensors="all", seed=0)
+
+
+def test_dynamic_ridge_beats_the_rises_baseline_on_unseen_blocks(data_file):
+    data = read_drift_data([data_file], targets=["drift_um"])
+    model = fit_drift_model(data, sensors="all", seed=0, candidates=["mlr", "ridge_dynamic"])
+    v = model.metadata["validation"]["methods"]
+    assert model.method == "ridge_dynamic"
+    assert v["ridge_dynamic"]["mean_rmse_um"] < 0.5 * v["mlr"]["mean_rmse_um"]
+    assert v["ridge_dynamic"]["mean_rmse_um"] < 0.025 * float(np.ptp(data.targets_um))
+
+
+@pytest.mark.parametrize("method", ["bp", "bayes", "stack"])
+def test_network_methods_predict_a_later_hour(data_file, method):
+    """Fit on the first 3 h, predict the 4th (the methods' own fit, no validation)."""
+    data = read_drift_data([data_file], targets=["drift_um"])
+    spec = FeatureSpec(tuple(data.sensors), tuple(reference_temperatures(data.T_C)),
+                       groups=METHODS[method].groups)
+    X = dynamic_features(spec, data.time_s, data.T_C, data.speed_rpm)
+    Y = data.targets_um
+    train = data.time_s < 3 * 3600
+    blocks = block_labels(int(train.sum()))
+    params = METHODS[method].fit(FitRows(X[train], Y[train], data.time_s[train], blocks, 1))
+    mean, std = METHODS[method].predict(params, X[~train])
+    rmse = float(np.sqrt(np.mean((mean - Y[~train]) ** 2)))
+    assert rmse < 0.1 * float(np.ptp(Y))           # drift spans ~25 µm
+    if method == "bayes":
+        assert std is not None and np.all(std > 0)
+        assert params["alpha"][0] > 0 and 0 < params["gamma"][0] < X.shape[1] * 10
+
+
+def test_prediction_is_causal(ridge_model, data_file, tmp_path):
+    columns = synthetic_columns()
+    later = columns["time_s"] > 2 * 3600
+    columns["A_C"][later] += 5.0
+    columns["speed_rpm"][later] = 8000.0
+    changed = tmp_path / "changed.csv"
+    write_csv(changed, columns)
+    names = list(ridge_model.spec.sensors)
+    a = ridge_model.predict(read_drift_data([data_file], sensors=names, require_targets=False))
+    b = ridge_model.predict(read_drift_data([changed], sensors=names, require_targets=False))
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x[~later], y[~later])
+        assert not np.allclose(x[later], y[later])
+
+
+def test_model_file_round_trip_without_pickle(ridge_model, data_file, tmp_path):
+    path = save_drift_model(ridge_model, tmp_path / "model.safetensors")
+    assert b"pickle" not in path.read_bytes() and path.read_bytes()[:1] != b"\x80"
+    loaded = load_drift_model(path)
+    data = read_drift_data([data_file], targets=["drift_um"])
+    for x, y in zip(ridge_model.predict(data), loaded.predict(data), strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert loaded.interval == ridge_model.interval
+    raw = bytearray(path.read_bytes())
+    raw[-3] ^= 0xFF                                  # flip bits in the last tensor
+    (tmp_path / "bad.safetensors").write_bytes(bytes(raw))
+    with pytest.raises(InputError, match="bad.safetensors.*(checksum|finite)"):
+        load_drift_model(tmp_path / "bad.safetensors")
+
+
+def _read(tmp_path, columns, targets=("drift_um",)):
+    path = tmp_path / "bad.csv"
+    write_csv(path, columns)
+    return read_drift_data([path], targets=list(targets))
+
+
+def test_missing_target_column_names_file_row_and_column(tmp_path):
+    with pytest.raises(InputError) as err:
+        _read(tmp_path, synthetic_columns(hours=0.5), targets=("ch9_um",))
+    assert (err.value.row, err.value.column) == (1, "ch9_um")
+    assert err.value.file.endswith("bad.csv")
+
+
+def test_no_temperature_columns(tmp_path):
+    columns = {k: v for k, v in synthetic_columns(hours=0.5).items() if not k.endswith("_C")}
+    with pytest.raises(InputError, match="no temperature columns") as err:
+        _read(tmp_path, columns)
+    assert err.value.row == 1
+
+
+def test_time_going_back_names_the_line(tmp_path):
+    columns = synthetic_columns(hours=0.5)
+    columns["time_s"][10] = columns["time_s"][8]
+    with pytest.raises(InputError, match="does not increase") as err:
+        _read(tmp_path, columns)
+    assert (err.value.row, err.value.column) == (12, "time_s")   # header is line 1
+
+
+def test_all_nan_column_is_an_error(tmp_path):
+    columns = synthetic_columns(hours=0.5)
+    columns["B_C"][:] = np.nan
+    with pytest.raises(InputError, match="no value") as err:
+        _read(tmp_path, columns)
+    assert (err.value.row, err.value.column) == (2, "B_C")
+
+
+def test_temperature_gaps_are_bridged_causally_and_reported(tmp_path):
+    columns = synthetic_columns(hours=0.5)
+    columns["A_C"][20:26] = np.nan
+    columns["A_C"][:2] = np.nan
+    data = _read(tmp_path, columns)
+    a = data.T_C[:, data.sensors.index("A_C")]
+    np.testing.assert_array_equal(a[20:26], a[19])
+    np.testing.assert_array_equal(a[:2], a[2])
+    assert a[26] != a[19]
+    found = {(f["column"], f["first_row"], f["last_row"]) for f in data.findings}
+    assert found == {("A_C", 2, 3), ("A_C", 22, 27)}

@@ -1,0 +1,206 @@
+"""Drift data: time, speed, temperature and displacement columns of one or more files.
+
+DESIGN.md, "Data-driven drift models": CSV or Parquet (`# key: value` lines allowed) with
+`time_s`, optional `speed_rpm`, any number of temperature columns `*_C` and displacement
+columns `*_um`.  The files are read with the recorded-run readers (`twin.runs`), so line
+numbers and error messages follow the same conventions.  Every file is its own continuous
+series (a *segment*): features restart at its first row.
+
+Gaps (NaN) in temperatures and speed are bridged causally — the last reading holds — and
+reported; a sensor that starts with a gap takes its first reading for the rows before it
+(the one place a value is taken from later rows, reported as such).  Targets keep their
+NaN: those rows are left out of fitting and metrics.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from twin.errors import InputError
+from twin.runs import read_table
+from twin.runs.schema import SPEED, TIME
+from twin.runs.table import RawTable
+
+TEMPERATURE_SUFFIX = "_C"
+DISPLACEMENT_SUFFIX = "_um"
+
+
+def is_drift_column(name: str) -> bool:
+    """Columns a drift model reads: time, speed, temperatures (`*_C`), drifts (`*_um`)."""
+    return name in (TIME, SPEED) or name.endswith((TEMPERATURE_SUFFIX, DISPLACEMENT_SUFFIX))
+
+
+def read_drift_table(path: str | os.PathLike[str]) -> RawTable:
+    """Read one drift-data file (CSV or Parquet) without further checks."""
+    return read_table(path, keep=is_drift_column)
+
+
+def temperature_columns(table: RawTable) -> list[str]:
+    return [n for n in table.columns if n.endswith(TEMPERATURE_SUFFIX)]
+
+
+def displacement_columns(table: RawTable) -> list[str]:
+    return [n for n in table.columns if n.endswith(DISPLACEMENT_SUFFIX)]
+
+
+@dataclass(frozen=True)
+class DriftData:
+    """Checked, gap-bridged drift data of one or more files, rows concatenated.
+
+    `T_C` (n, m) holds the temperature columns `sensors`; `targets_um` (n, p) the
+    displacement columns `targets` (NaN where not measured, or None when the files hold
+    none of them).  `segment_starts` are the first row of every file; `rows` the row of
+    every sample in its file (1-based line of a CSV file).
+    """
+
+    files: list[str]
+    time_s: np.ndarray
+    speed_rpm: np.ndarray | None
+    sensors: list[str]
+    T_C: np.ndarray
+    targets: list[str]
+    targets_um: np.ndarray | None
+    segment_starts: np.ndarray
+    rows: np.ndarray
+    findings: list[dict] = field(default_factory=list)
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.time_s.size)
+
+    def segment_ids(self) -> np.ndarray:
+        """Index of the file every row comes from."""
+        ids = np.zeros(self.n_samples, dtype=np.int64)
+        ids[self.segment_starts[1:]] = 1
+        return np.cumsum(ids)
+
+
+def _check_time(table: RawTable) -> np.ndarray:
+    if TIME not in table.columns:
+        raise InputError("no time column", file=table.file, row=table.header_row, column=TIME)
+    t = table.columns[TIME]
+    bad = np.flatnonzero(np.isnan(t))
+    if bad.size:
+        raise InputError("time is missing", file=table.file, row=int(table.rows[bad[0]]),
+                         column=TIME)
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise InputError(f"time does not increase ({t[i]:g} s after {t[i - 1]:g} s)",
+                         file=table.file, row=int(table.rows[i]), column=TIME)
+    return t
+
+
+def _check_not_empty(table: RawTable, name: str) -> np.ndarray:
+    values = table.columns[name]
+    if np.all(np.isnan(values)):
+        raise InputError("the column holds no value in any row", file=table.file,
+                         row=int(table.rows[0]), column=name)
+    return values
+
+
+def bridge_gaps(values: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """Hold the last reading across NaN gaps (causal); leading NaN take the first reading.
+
+    Returns the bridged copy and the gaps as (first index, last index) pairs.
+    """
+    x = np.asarray(values, dtype=float).copy()
+    missing = np.isnan(x)
+    if not missing.any():
+        return x, []
+    edges = np.diff(np.concatenate([[0], missing.view(np.int8), [0]]))
+    gaps = list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
+    idx = np.where(missing, 0, np.arange(x.size))
+    np.maximum.accumulate(idx, out=idx)
+    first_valid = int(np.flatnonzero(~missing)[0])
+    x = x[idx]
+    x[:first_valid] = values[first_valid]
+    return x, [(int(a), int(b)) for a, b in gaps]
+
+
+def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]]) -> list[dict]:
+    out = []
+    for a, b in gaps:
+        how = ("leading gap: first reading used for the rows before it" if a == 0
+               else "gap bridged causally: last reading held")
+        out.append({"file": table.file, "column": name, "first_row": int(table.rows[a]),
+                    "last_row": int(table.rows[b]), "n_rows": b - a + 1, "repair": how})
+    return out
+
+
+def drift_data(
+    tables: Sequence[RawTable],
+    sensors: Sequence[str] | None = None,
+    targets: Sequence[str] = (),
+    require_targets: bool = True,
+    require_speed: bool = False,
+) -> DriftData:
+    """Check the tables and assemble a `DriftData`.
+
+    `sensors` None takes every temperature column (the first file's, which every further
+    file must also hold); `targets` must be present in every file when `require_targets`.
+    """
+    if not tables:
+        raise InputError("no data file given")
+    first = tables[0]
+    if sensors is None:
+        sensors = temperature_columns(first)
+        if not sensors:
+            raise InputError("no temperature columns (names ending in _C)", file=first.file,
+                             row=first.header_row)
+    sensors, targets = list(sensors), list(targets)
+    use_speed = require_speed or all(SPEED in t.columns for t in tables)
+    times, speeds, temps, drifts, rows, starts, findings = [], [], [], [], [], [], []
+    n = 0
+    for table in tables:
+        t = _check_time(table)
+        if not temperature_columns(table):
+            raise InputError("no temperature columns (names ending in _C)", file=table.file,
+                             row=table.header_row)
+        wanted = [*sensors, *([SPEED] if use_speed else [])]
+        if require_targets:
+            wanted += targets
+        for name in wanted:
+            if name not in table.columns:
+                raise InputError("required column is missing", file=table.file,
+                                 row=table.header_row, column=name)
+        T = np.empty((t.size, len(sensors)))
+        for j, name in enumerate(sensors):
+            T[:, j], gaps = bridge_gaps(_check_not_empty(table, name))
+            findings += _gap_findings(table, name, gaps)
+        if use_speed:
+            speed, gaps = bridge_gaps(_check_not_empty(table, SPEED))
+            findings += _gap_findings(table, SPEED, gaps)
+            speeds.append(speed)
+        if targets and all(name in table.columns for name in targets):
+            drifts.append(np.stack([_check_not_empty(table, name) for name in targets], axis=1))
+        else:
+            drifts.append(np.full((t.size, len(targets)), np.nan))
+        times.append(t)
+        temps.append(T)
+        rows.append(table.rows)
+        starts.append(n)
+        n += t.size
+    targets_um = np.concatenate(drifts) if targets else None
+    return DriftData(
+        files=[t.file for t in tables], time_s=np.concatenate(times),
+        speed_rpm=np.concatenate(speeds) if use_speed else None, sensors=sensors,
+        T_C=np.concatenate(temps), targets=targets, targets_um=targets_um,
+        segment_starts=np.asarray(starts, dtype=np.int64), rows=np.concatenate(rows),
+        findings=findings)
+
+
+def read_drift_data(
+    paths: Sequence[str | os.PathLike[str]],
+    sensors: Sequence[str] | None = None,
+    targets: Sequence[str] = (),
+    require_targets: bool = True,
+    require_speed: bool = False,
+) -> DriftData:
+    """Read and check drift-data files (see `drift_data`)."""
+    return drift_data([read_drift_table(p) for p in paths], sensors, targets,
+                      require_targets, require_speed)

@@ -1,0 +1,132 @@
+"""Fitting a drift model (sensor choice, validation, default method) and predicting with it.
+
+`fit_drift_model` ranks the sensors, picks them (`--sensors auto|K|all|LIST`), runs the
+time-blocked validation of the candidate methods (all of them, or the one forced), fits
+the chosen method on every row with a measured drift, and keeps the interval rule from
+the out-of-fold residuals.  `DriftModel.predict` is causal: the features of a row use
+that row and earlier rows of its file only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from twin.drift.data import DriftData
+from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
+from twin.drift.folds import block_labels
+from twin.drift.intervals import apply_interval
+from twin.drift.methods import METHODS, FitRows, method_named
+from twin.drift.ranking import SensorRanking, rank_sensors
+from twin.drift.validation import MethodValidation, choose_default, validate_method
+from twin.errors import InputError
+
+Progress = Callable[[str], None] | None
+
+
+@dataclass(frozen=True)
+class DriftModel:
+    """A fitted drift model: method, targets, features, parameters, interval rule."""
+
+    method: str
+    targets: list[str]
+    spec: FeatureSpec
+    params: dict[str, np.ndarray]
+    interval: dict
+    metadata: dict = field(default_factory=dict)
+
+    def predict_arrays(self, time_s: np.ndarray, T_C: np.ndarray, speed_rpm: np.ndarray | None,
+                       segment_starts: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(mean, lo, hi), each (n, p) in µm, for temperatures T_C of `spec.sensors`."""
+        X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
+        mean, std = METHODS[self.method].predict(self.params, X)
+        lo, hi = apply_interval(self.interval, mean, std)
+        return mean, lo, hi
+
+    def predict(self, data: DriftData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        columns = [data.sensors.index(s) for s in self.spec.sensors]
+        return self.predict_arrays(data.time_s, data.T_C[:, columns], data.speed_rpm,
+                                   data.segment_starts)
+
+
+def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str]) -> list[str]:
+    """`auto` (cluster representatives), `all`, a count K (best K representatives) or a list."""
+    text = option.strip()
+    if text == "all":
+        return list(available)
+    if text == "auto":
+        return ranking.pick()
+    if text.isdigit():
+        k = int(text)
+        if k < 1:
+            raise InputError("the sensor count must be at least 1", column="--sensors")
+        return ranking.pick(k)
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    unknown = [n for n in names if n not in available]
+    if unknown or not names:
+        raise InputError(f"unknown temperature columns {unknown}; the data hold "
+                         f"{', '.join(available)}", column="--sensors")
+    return names
+
+
+def sensor_ranking(data: DriftData) -> SensorRanking:
+    """Rank the data's temperature sensors for its targets (rows with every target)."""
+    rows = measured_rows(data)
+    return rank_sensors(data.sensors, data.T_C[rows],
+                        {t: data.targets_um[rows, j] for j, t in enumerate(data.targets)})
+
+
+def measured_rows(data: DriftData) -> np.ndarray:
+    if data.targets_um is None:
+        raise InputError("no target column given", column="--target")
+    rows = np.flatnonzero(np.all(np.isfinite(data.targets_um), axis=1))
+    if rows.size < 20:
+        raise InputError(f"only {rows.size} rows hold every target; need at least 20",
+                         file=data.files[0], column=",".join(data.targets))
+    return rows
+
+
+def fit_drift_model(data: DriftData, method: str | None = None, sensors: str = "auto",
+                    seed: int = 0, progress: Progress = None,
+                    candidates: Sequence[str] | None = None) -> DriftModel:
+    """Fit a drift model; `method` None picks the best of `candidates` (default: all)."""
+    if method is not None:
+        method_named(method)
+    ranking = sensor_ranking(data)
+    chosen_sensors = parse_sensors(sensors, ranking, data.sensors)
+    columns = [data.sensors.index(s) for s in chosen_sensors]
+    T = data.T_C[:, columns]
+    reference = tuple(float(v) for v in reference_temperatures(T))
+    rows = measured_rows(data)
+    Y = data.targets_um[rows]
+    blocks = block_labels(data.n_samples, data.segment_ids())[rows]
+    names = [method] if method else list(candidates or METHODS)
+    features: dict[tuple[str, ...], np.ndarray] = {}
+    results: list[MethodValidation] = []
+    for name in names:
+        spec = FeatureSpec(tuple(chosen_sensors), reference, groups=METHODS[name].groups)
+        if spec.groups not in features:
+            features[spec.groups] = dynamic_features(spec, data.time_s, T, data.speed_rpm,
+                                                     data.segment_starts)[rows]
+        results.append(validate_method(name, features[spec.groups], Y, data.time_s[rows],
+                                       blocks, seed, progress))
+    best = method or choose_default(results)
+    result = next(r for r in results if r.name == best)
+    spec = FeatureSpec(tuple(chosen_sensors), reference, groups=METHODS[best].groups)
+    if progress:
+        progress(f"fitting {best} on all rows")
+    params = METHODS[best].fit(FitRows(features[spec.groups], Y, data.time_s[rows], blocks,
+                                       seed, progress))
+    metadata = {
+        "training_files": list(data.files), "n_rows": int(rows.size), "seed": seed,
+        "sensors_option": sensors, "ranking": ranking.to_json(),
+        "validation": {"blocks": int(np.unique(blocks).size), "chosen": best,
+                       "methods": {r.name: r.to_json(data.targets) for r in results}},
+        "data_findings": data.findings,
+    }
+    return DriftModel(best, list(data.targets), spec,
+                      {k: np.asarray(v, dtype=float) for k, v in params.items()},
+                      result.interval, metadata)

@@ -1,0 +1,85 @@
+"""The drift model file: parameters as safetensors tensors, everything else as JSON.
+
+Tensors are float64 arrays named as the method stores them; the safetensors header
+holds one metadata entry `spindle_twin_drift` with JSON: format, version, method,
+targets, feature spec, interval rule, metadata (ranking, validation) and a SHA-256 of
+the tensors.  Loading reads tensors and JSON only (no unpickling) and checks them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from twin.atomic import write_bytes_atomic
+from twin.drift.features import FeatureSpec
+from twin.drift.methods import METHODS
+from twin.drift.model import DriftModel
+from twin.errors import InputError
+
+FORMAT = "spindle-twin-drift"
+VERSION = 1
+METADATA_KEY = "spindle_twin_drift"
+
+
+def _digest(tensors: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256()
+    for name in sorted(tensors):
+        h.update(name.encode())
+        h.update(str(tensors[name].shape).encode())
+        h.update(np.ascontiguousarray(tensors[name], dtype="<f8").tobytes())
+    return h.hexdigest()
+
+
+def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
+    """Write the model atomically."""
+    from safetensors.numpy import save
+
+    tensors = {k: np.ascontiguousarray(v, dtype="<f8") for k, v in model.params.items()}
+    doc = {"format": FORMAT, "version": VERSION, "method": model.method,
+           "targets": model.targets, "features": model.spec.to_json(),
+           "interval": model.interval, "metadata": model.metadata, "sha256": _digest(tensors)}
+    data = save(tensors, metadata={METADATA_KEY: json.dumps(doc, sort_keys=True,
+                                                             allow_nan=True)})
+    return write_bytes_atomic(path, data)
+
+
+def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
+    """Read and check a drift model file; any problem raises InputError naming the file."""
+    from safetensors import SafetensorError
+    from safetensors.numpy import load
+
+    file = str(path)
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read the model file: {exc.strerror}", file=file) from None
+    try:
+        tensors = load(raw)
+        header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
+        doc = json.loads(header["__metadata__"][METADATA_KEY])
+    except (SafetensorError, ValueError, KeyError, TypeError, UnicodeDecodeError):
+        raise InputError("not a spindle-twin drift model file (safetensors with "
+                         f"'{METADATA_KEY}' metadata)", file=file) from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise InputError(f"metadata format is not {FORMAT!r}", file=file)
+    if doc.get("version") != VERSION:
+        raise InputError(f"model version {doc.get('version')!r} is not supported "
+                         f"(expected {VERSION})", file=file)
+    if doc.get("method") not in METHODS:
+        raise InputError(f"unknown method {doc.get('method')!r}", file=file)
+    for name, array in tensors.items():
+        if array.dtype != np.float64 or not np.all(np.isfinite(array)):
+            raise InputError(f"tensor {name!r} is not finite float64", file=file)
+    if doc.get("sha256") != _digest(tensors):
+        raise InputError("checksum mismatch: the weights were modified or damaged", file=file)
+    try:
+        spec = FeatureSpec.from_json(doc["features"])
+        return DriftModel(doc["method"], list(doc["targets"]), spec, dict(tensors),
+                          dict(doc["interval"]), dict(doc.get("metadata", {})))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"malformed model metadata: {exc}", file=file) from None
