@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.atomic import write_bytes_atomic
 from twin.drift.features import FeatureSpec
 from twin.drift.methods import METHODS
 from twin.drift.model import DriftModel
 from twin.errors import InputError
+from twin.io.atomic import write_bytes
 
 FORMAT = "spindle-twin-drift"
 VERSION = 1
@@ -45,7 +45,7 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
            "interval": model.interval, "metadata": model.metadata, "sha256": _digest(tensors)}
     data = save(tensors, metadata={METADATA_KEY: json.dumps(doc, sort_keys=True,
                                                              allow_nan=True)})
-    return write_bytes_atomic(path, data)
+    return write_bytes(path, data)
 
 
 def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
