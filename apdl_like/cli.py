@@ -15,6 +15,7 @@ from pathlib import Path
 import typer
 
 from twin.errors import InputError, report_errors
+from twin.io.destinations import check_out_dir, check_out_file
 
 app = typer.Typer(
     name="apdl-like",
@@ -40,6 +41,7 @@ def run(
 
     if not deck.is_file():
         raise ApdlError("deck not found", file=str(deck))
+    check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
     session = Session(base_dir=deck.parent)
     session.run_file(deck)
     written = write_outputs(session.state, out)
@@ -59,6 +61,8 @@ def export_cdb(
     """Write the default spindle mesh as an ANSYS archive (NBLOCK, EBLOCK, CMBLOCK)."""
     from apdl_like.cdb import write_cdb
     from twin.fem import AxiMesh
+
+    check_out_file(out, inputs=[mesh])
 
     if mesh is None:
         from twin.spindle.model import DEFAULT_MESH_PATH, fem_material

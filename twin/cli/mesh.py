@@ -20,6 +20,7 @@ def mesh(
     """Mesh the axisymmetric spindle (regions, boundaries, contact interfaces)."""
     from meshes.spindle import build_mesh, mesh_quality, write_msh
     from twin.errors import InputError
+    from twin.io.destinations import check_out_file
     from twin.spindle.spec import load_spec
 
     if not (size_factor > 0 and size_factor < 100):
@@ -27,6 +28,7 @@ def mesh(
                          column="--size-factor")
     if out.suffix != ".msh":
         raise InputError("the mesh file must end in .msh", file=str(out))
+    check_out_file(out, inputs=[spec])
     the_spec = load_spec(spec)
     result = build_mesh(the_spec, size_factor)
     write_msh(result, out)

@@ -8,6 +8,7 @@ import typer
 
 from twin.cli.inputs import EXAMPLES_DIR, bundled_runs, checked_model, parse_methods
 from twin.errors import InputError
+from twin.io.destinations import check_out_dir
 
 
 def replay(
@@ -46,6 +47,8 @@ def replay(
         raise InputError(
             "no runs given and no bundled example runs found", file=str(EXAMPLES_DIR / "runs")
         )
+    check_out_dir(out, inputs=[*paths, model], owned=[
+        *(Path(p).stem for p in paths), "summary.json", "report.html"])
     model_path = checked_model(method_list, model)
     console = Console(stderr=True, quiet=quiet)
     console.print(f"replaying {len(paths)} run(s) with {', '.join(method_list)} → {out}")

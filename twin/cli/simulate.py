@@ -27,6 +27,7 @@ def simulate_command(
     Writes keypoints.csv, fields.pvd + fields/*.vtu and summary.json to OUT.
     """
     from twin.errors import InputError
+    from twin.io.destinations import check_out_dir
     from twin.spindle import SpindleModel, simulate, write_simulation
     from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
@@ -36,6 +37,8 @@ def simulate_command(
                          column="--size-factor")
     if not field_every >= 0:
         raise InputError(f"must be >= 0, got {field_every}", column="--field-every")
+    check_out_dir(out, inputs=[spec],
+                  owned=["keypoints.csv", "fields.pvd", "fields", "summary.json"])
     # validate the operating point before the (slower) model build
     check_operating_point(load_spec(spec), speed, ambient, coolant)
     model = SpindleModel.load(spec, size_factor=size_factor)

@@ -8,6 +8,7 @@ import typer
 
 from twin.cli.inputs import checked_model, parse_methods
 from twin.errors import InputError
+from twin.io.destinations import check_out_file
 
 
 def snapshot(
@@ -32,6 +33,7 @@ def snapshot(
     model_path = checked_model([method_name], model)
     if out.suffix.lower() != ".png":
         raise InputError("the picture must be a .png file", file=str(out), column="--out")
+    check_out_file(out, inputs=[run, model])
     spindle = default_spindle()
     recorded = read_run(run, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
     try:

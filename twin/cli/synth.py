@@ -27,7 +27,8 @@ def synth(
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Emulate a recorded run: the truth model plus sensor lag, noise and faults."""
-    from twin.plant.emulator import synthesize, write_synth
+    from twin.io.destinations import check_out_file
+    from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
     from twin.plant.scenario import load_scenario
 
@@ -47,6 +48,7 @@ def synth(
                          column="--out")
     if not out.parent.is_dir():
         raise InputError("output folder does not exist", file=str(out.parent), column="--out")
+    check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
     run = synthesize(
         speed_rpm=speed,
         profile=None if profile is None else read_speed_profile(profile),

@@ -32,16 +32,18 @@ def train(
     """
     from twin.correction.modelfile import save_model
     from twin.correction.network import DEFAULT, PAPER
-    from twin.correction.report import write_report
+    from twin.correction.report import report_paths, write_report
     from twin.correction.samples import SampleSet, samples_for
     from twin.correction.training import train_model
     from twin.correction.training_data import TARGET_RULES, default_simulator, run_curves
     from twin.errors import InputError
+    from twin.io.destinations import check_out_file
     from twin.runs import read_run
     from twin.spindle.spec import load_spec
 
     if targets not in TARGET_RULES:
         raise InputError(f"--targets must be one of {', '.join(TARGET_RULES)}, not {targets!r}")
+    check_out_file(out, inputs=runs, also=report_paths(out))
     simulator = default_simulator(targets)
     limit_rpm = load_spec(None).spindle.max_speed_rpm  # the networks train on that spindle
     sets = []

@@ -2,21 +2,27 @@
 
 A crash or a kill never leaves a half-written output (that --resume or a reader could
 mistake for a finished one).  Every file the project writes goes through `atomic_target`;
-`write_bytes`, `write_text`, `write_json` and `write_csv` are its common forms.
+`write_bytes`, `write_text`, `write_json` and `write_csv` are its common forms.  The rename
+replaces only a regular file or nothing (`twin.io.destinations`), and temporary files a
+killed writer left beside a target are removed by the next write of that target.
 """
 
 from __future__ import annotations
 
 import csv
+import glob
 import io
 import json
 import os
+import re
 import secrets
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+
+from twin.io.destinations import refuse_special
 
 
 @contextmanager
@@ -28,13 +34,55 @@ def atomic_target(path: str | os.PathLike[str]) -> Iterator[Path]:
     (umask), unlike mkstemp's 0600.  The parent folder is created if needed.
     """
     target = Path(path)
+    refuse_special(target)
     target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = target.with_name(f".{target.stem}.{os.getpid()}.{secrets.token_hex(4)}{target.suffix}")
+    remove_orphans_of(target)
+    tmp = target.with_name(temporary_name(target.stem, target.suffix))
     try:
         yield tmp
+        refuse_special(target)  # again: something may have appeared there meanwhile
         os.replace(tmp, target)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+# `.stem.PID.HEX.suffix`: the process that writes it, so a later one can tell an orphan
+_TEMPORARY = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{8}(\..*)?$")
+
+
+def temporary_name(stem: str, suffix: str = "") -> str:
+    """A hidden name beside an output, unique to this process and call."""
+    return f".{stem}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
+
+
+def is_orphan(name: str) -> bool:
+    """True for a `temporary_name` whose writing process is gone (killed mid-way)."""
+    match = _TEMPORARY.match(name)
+    return match is not None and not _alive(int(match.group(1)))
+
+
+def is_temporary(name: str) -> bool:
+    """True for any `temporary_name`, orphaned or still being written."""
+    return _TEMPORARY.match(name) is not None
+
+
+def remove_orphans_of(target: Path) -> None:
+    """Remove the temporary files a killed writer of `target` left beside it."""
+    for entry in target.parent.glob(f".{glob.escape(target.stem)}.*{glob.escape(target.suffix)}"):
+        if is_orphan(entry.name) and entry.is_file():
+            entry.unlink(missing_ok=True)
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (OverflowError, OSError):
+        return True  # another user's process, or a pid this system cannot have: keep
+    return True
 
 
 def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:

@@ -11,8 +11,6 @@ The rules that keep DIR consistent:
 from __future__ import annotations
 
 import os
-import re
-import secrets
 import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -20,8 +18,8 @@ from pathlib import Path
 
 from filelock import FileLock
 
-# `.name.PID.HEX…`: the atomic writer's temporary files and `replaced_folder`'s folders
-_ORPHAN = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{8}(\..*)?$")
+from twin.io.atomic import is_orphan, is_temporary, temporary_name
+
 LOCK_FILE = ".twin.lock"
 
 
@@ -37,8 +35,7 @@ def replaced_folder(target: Path) -> Iterator[Path]:
     """Yield an empty staging folder beside `target`; on success it replaces `target` as a
     whole.  On failure the staging folder and any earlier `target` are removed: a failed
     rerun must not leave an older result standing as if it were current."""
-    tag = f"{os.getpid()}.{secrets.token_hex(4)}"
-    staging = target.with_name(f".{target.name}.{tag}.partial")
+    staging = target.with_name(temporary_name(target.name, ".partial"))
     staging.mkdir(parents=True)
     try:
         yield staging
@@ -47,7 +44,7 @@ def replaced_folder(target: Path) -> Iterator[Path]:
             shutil.rmtree(staging, ignore_errors=True)
             shutil.rmtree(target, ignore_errors=True)
         raise
-    old = target.with_name(f".{target.name}.{tag}.old")
+    old = target.with_name(temporary_name(target.name, ".old"))
     with folder_lock(target.parent):
         try:
             os.rename(target, old)
@@ -62,11 +59,10 @@ def remove_orphans(out_root: Path) -> list[Path]:
     """Remove temporary files and staging folders that a killed process left in `out_root`
     and its run folders (their process is gone); a live batch's are kept."""
     removed = []
-    runs = [p for p in out_root.iterdir() if p.is_dir() and not _ORPHAN.match(p.name)]
+    runs = [p for p in out_root.iterdir() if p.is_dir() and not is_temporary(p.name)]
     for folder in [out_root, *runs]:
         for entry in folder.iterdir():
-            match = _ORPHAN.match(entry.name)
-            if match is None or _alive(int(match.group(1))):
+            if not is_orphan(entry.name):
                 continue
             if entry.is_dir() and not entry.is_symlink():
                 shutil.rmtree(entry, ignore_errors=True)
@@ -74,15 +70,3 @@ def remove_orphans(out_root: Path) -> list[Path]:
                 entry.unlink(missing_ok=True)
             removed.append(entry)
     return removed
-
-
-def _alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError, OSError):
-        return True
-    return True

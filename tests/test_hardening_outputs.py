@@ -1,0 +1,153 @@
+"""Issue 14 regressions on --out (defects 1 and 11): refused before any work, exit 2,
+inputs and special files untouched.  Special files are fifos and symlinks in tmp_path:
+real /dev files are never touched."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import pytest
+from typer.testing import CliRunner
+
+from apdl_like.cli import app as apdl_app
+from tests.test_runs_reader import csv_text, warmup
+from twin.cli import app
+from twin.errors import InputError
+from twin.io.atomic import atomic_target, temporary_name, write_text
+from twin.io.destinations import check_out_dir, check_out_file
+
+
+@pytest.fixture
+def fifo(tmp_path):
+    path = tmp_path / "pipe.csv"
+    os.mkfifo(path)
+    return path
+
+
+def is_fifo(path) -> bool:
+    return stat.S_ISFIFO(os.lstat(path).st_mode)
+
+
+def test_defect1_writer_never_replaces_a_fifo_or_a_symlink_to_one(tmp_path, fifo):
+    link = tmp_path / "link.csv"
+    link.symlink_to(fifo)
+    for target in (fifo, link):
+        with pytest.raises(InputError, match="not a regular file"):
+            write_text(target, "data")
+    assert is_fifo(fifo) and os.path.islink(link)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.csv", "pipe.csv"]
+
+
+def test_defect1_writer_checks_again_right_before_the_rename(tmp_path):
+    target = tmp_path / "late.csv"
+    with pytest.raises(InputError, match="not a regular file"), atomic_target(target) as tmp:
+        tmp.write_text("data")
+        os.mkfifo(target)  # appears while the output is being written
+    assert is_fifo(target) and sorted(p.name for p in tmp_path.iterdir()) == ["late.csv"]
+
+
+def test_defect1_folder_where_a_file_is_expected_and_the_reverse(tmp_path):
+    (tmp_path / "dir.msh").mkdir()
+    with pytest.raises(InputError, match="is a folder"):
+        check_out_file(tmp_path / "dir.msh")
+    (tmp_path / "file").write_text("keep")
+    with pytest.raises(InputError, match="is a file; a folder is expected"):
+        check_out_dir(tmp_path / "file")
+    with pytest.raises(InputError, match="is not a folder"):
+        check_out_file(tmp_path / "file" / "x.csv")
+
+
+def test_defect11_out_may_not_be_an_input(tmp_path):
+    run = tmp_path / "run.csv"
+    run.write_text("x")
+    with pytest.raises(InputError, match="also an input"):
+        check_out_file(tmp_path / "." / "run.csv", inputs=[run])
+    with pytest.raises(InputError, match="also an input"):
+        check_out_file(tmp_path / "out.csv", inputs=[run], also=[run])
+    (tmp_path / "out" / "run").mkdir(parents=True)
+    inside = tmp_path / "out" / "run" / "r.csv"
+    inside.write_text("x")
+    with pytest.raises(InputError, match="lies where this command writes"):
+        check_out_dir(tmp_path / "out", inputs=[inside], owned=["run"])
+    check_out_dir(tmp_path / "out", inputs=[inside], owned=["other"])
+
+
+def test_orphaned_temporary_files_removed_by_the_next_write(tmp_path):
+    dead = 2**22 + 4242  # above Linux's default pid_max
+    orphan = tmp_path / f".summary.{dead}.0badf00d.json"
+    orphan.write_text("half")
+    live = tmp_path / temporary_name("summary", ".json")
+    live.write_text("being written by this process")
+    other = tmp_path / f".report.{dead}.0badf00d.html"
+    other.write_text("half, another output")
+    write_text(tmp_path / "summary.json", "{}")
+    assert not orphan.exists() and live.exists() and other.exists()
+
+
+def run_cli(application, args):
+    result = CliRunner().invoke(application, [str(a) for a in args])
+    assert "Traceback" not in result.output
+    return result
+
+
+@pytest.fixture
+def run_file(tmp_path):
+    path = tmp_path / "run.csv"
+    path.write_text(csv_text(warmup()))
+    return path
+
+
+def test_defect11_synth_profile_as_out_refused(tmp_path):
+    profile = tmp_path / "p.csv"
+    profile.write_text("time_s,speed_rpm\n0,9000\n")
+    before = profile.read_bytes()
+    result = run_cli(app, ["synth", "--profile", profile, "--minutes", 3, "--ambient", 25,
+                           "--seed", 1, "--out", profile])
+    assert result.exit_code == 2 and "p.csv" in result.output
+    assert profile.read_bytes() == before
+
+
+def test_defect11_train_run_as_out_refused(run_file):
+    before = run_file.read_bytes()
+    result = run_cli(app, ["train", run_file, "--out", run_file, "--epochs", 1, "--quiet"])
+    assert result.exit_code == 2 and "also an input" in result.output
+    assert run_file.read_bytes() == before
+
+
+@pytest.mark.parametrize("command", [
+    ["synth", "--speed", 9000, "--minutes", 3, "--ambient", 25, "--seed", 1, "--out"],
+    ["mesh", "--out"],
+    ["train", "RUN", "--epochs", 1, "--out"],
+    ["snapshot", "RUN", "--time", 100, "--method", "open_loop", "--out"],
+])
+def test_defect1_file_outputs_refuse_a_fifo(tmp_path, run_file, command):
+    suffix = {"synth": ".csv", "mesh": ".msh", "train": ".safetensors", "snapshot": ".png"}
+    target = tmp_path / f"pipe{suffix[command[0]]}"
+    os.mkfifo(target)
+    args = [run_file if a == "RUN" else a for a in command]
+    result = run_cli(app, [*args, target])
+    assert result.exit_code == 2 and "not a regular file" in result.output
+    assert is_fifo(target)
+
+
+@pytest.mark.parametrize("command", [
+    ["replay", "RUN", "--methods", "open_loop", "--out"],
+    ["simulate", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--out"],
+])
+def test_defect6_folder_outputs_refuse_a_file(tmp_path, run_file, command):
+    target = tmp_path / "file"
+    target.write_text("keep")
+    args = [run_file if a == "RUN" else a for a in command]
+    result = run_cli(app, [*args, target])
+    assert result.exit_code == 2 and "a folder is expected" in result.output
+    assert target.read_text() == "keep"
+
+
+def test_defect1_apdl_outputs_refuse_special_files_and_inputs(tmp_path, fifo):
+    deck = tmp_path / "d.inp"
+    deck.write_text("A = 1\n")
+    result = run_cli(apdl_app, ["export-cdb", "--out", fifo])
+    assert result.exit_code == 2 and is_fifo(fifo)
+    result = run_cli(apdl_app, ["run", deck, "--out", deck])
+    assert result.exit_code == 2 and deck.read_text() == "A = 1\n"

@@ -1,0 +1,114 @@
+"""Where a command may write: the checks every `--out` passes before any work starts.
+
+The atomic writer (`twin.io.atomic`) writes a temporary file beside the target and renames
+it over the target.  That rename must never replace something that is not an output:
+
+- one of the command's own inputs (`twin synth --profile P --out P`);
+- a folder where a file is expected, or a file where a folder is expected;
+- an existing non-regular file: a device (`--out /dev/null` run as root would replace the
+  system's /dev/null by a regular file), a fifo or a socket, directly or through a symlink.
+
+`check_out_file` and `check_out_dir` refuse such a target with an `InputError` (exit 2)
+naming it; commands call them first, before reading or computing anything.  The writer
+repeats the regular-file check right before its rename (`atomic_target`).
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from collections.abc import Iterable
+from pathlib import Path
+
+from twin.errors import InputError
+
+StrPath = str | os.PathLike[str]
+
+
+def _same(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    try:
+        path.resolve().relative_to(folder.resolve())
+    except ValueError:
+        return False
+    return True
+
+
+def _check_ancestors(target: Path, option: str) -> None:
+    """The nearest existing ancestor of `target` must be a folder (mkdir would fail)."""
+    for parent in target.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(f"{parent} is not a folder", file=str(target), column=option)
+            return
+
+
+def refuse_special(target: Path, option: str = "--out") -> None:
+    """InputError if `target` exists (through any symlink) and is not a regular file."""
+    try:
+        info = target.stat()
+    except FileNotFoundError:
+        return  # nothing there (or a dangling symlink, which the rename replaces)
+    except OSError as exc:
+        raise InputError(f"cannot use as output: {exc.strerror or exc}", file=str(target),
+                         column=option) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise InputError("is a folder; a file is expected", file=str(target), column=option)
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError("is not a regular file (a device, fifo or socket); refusing to "
+                         "replace it", file=str(target), column=option)
+
+
+def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
+                   option: str = "--out", also: Iterable[StrPath] = ()) -> Path:
+    """`out` as a Path if a command may write the file there (see the module doc).
+
+    `inputs` are the files the command reads; `also` are further files it writes beside
+    `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.
+    """
+    target = Path(out)
+    _check_ancestors(target, option)
+    read = [Path(p) for p in inputs if p is not None]
+    for written in (target, *(Path(p) for p in also)):
+        refuse_special(written, option)
+        for source in read:
+            if _same(written, source):
+                raise InputError(f"is also an input of this command ({source}); refusing to "
+                                 "overwrite it", file=str(written), column=option)
+    return target
+
+
+def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
+                  option: str = "--out", owned: Iterable[str] = ()) -> Path:
+    """`out` as a Path if a command may write its output folder there.
+
+    The folder may exist (its other contents stay) or not (it is created).  `owned` are
+    the names inside it the command replaces (files or whole folders): no input may lie
+    there.
+    """
+    target = Path(out)
+    _check_ancestors(target, option)
+    if target.exists() or target.is_symlink():
+        try:
+            info = target.stat()
+        except OSError as exc:
+            raise InputError(f"cannot use as output folder: {exc.strerror or exc}",
+                             file=str(target), column=option) from None
+        if not stat.S_ISDIR(info.st_mode):
+            kind = "a file" if stat.S_ISREG(info.st_mode) else "not a folder"
+            raise InputError(f"is {kind}; a folder is expected", file=str(target),
+                             column=option)
+    for source in (Path(p) for p in inputs if p is not None):
+        for name in owned:
+            place = target / name
+            if _same(place, source) or (place.is_dir() and _inside(source, place)):
+                raise InputError(f"the input {source} lies where this command writes "
+                                 f"{place}; refusing to replace it", file=str(target),
+                                 column=option)
+    return target
