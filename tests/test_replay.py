@@ -16,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from twin.cli import app
+from twin.estimation.parameters import apply_factors
 from twin.loop.runfiles import default_spindle
 from twin.runs import write_run
 from twin.spindle.conditions import nominal_conditions
@@ -25,8 +26,13 @@ MINUTES = 5
 
 
 def make_recorded_run(
-    path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7, seed=0
+    path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7, seed=0,
+    factors=None, noise_C=0.02, edit=None,
 ):
+    """`factors` (twin.estimation.parameters names → multiplier) replaces heat/resistance;
+    `edit(time_s, temps)` may change the measured temperatures in place before writing."""
+    if factors is None:
+        factors = {"H_front": heat, "H_rear": heat, "R_front": resistance}
     model = default_spindle()
     T = np.full(model.n_dofs, ambient_C)
     T0 = T.copy()
@@ -36,9 +42,7 @@ def make_recorded_run(
         bc = nominal_conditions(
             model, speed_rpm, ambient_C, None, T_bearings_C=(s[0], s[2]), T_sleeves_C=(s[1], s[3])
         )
-        loads = bc.to_thermal_loads(
-            H_front=heat * bc.H_front, H_rear=heat * bc.H_rear, R_front=resistance * bc.R_front
-        )
+        loads = apply_factors(bc, factors).to_thermal_loads()
         for T_step in model.thermal.transient(loads, 4.0).march(T, 15):
             times.append(times[-1] + 4.0)
             temps.append(model.sensor_matrix @ T_step)
@@ -46,7 +50,9 @@ def make_recorded_run(
         T = T_step
     rng = np.random.default_rng(seed)
     t = np.array(times)
-    temps = np.array(temps) + 0.02 * rng.standard_normal((t.size, 5))
+    temps = np.array(temps) + noise_C * rng.standard_normal((t.size, 5))
+    if edit is not None:
+        edit(t, temps)
     cols = {
         "time_s": t,
         "speed_rpm": np.full(t.size, speed_rpm),
@@ -111,7 +117,9 @@ def test_replay_writes_the_design_layout_and_schemas(replayed, runs_dir):
             "rmse_C",
             "rmse_um",
             "max_abs_C",
+            "band_coverage_pct",
         }
+        assert metrics["band_coverage_pct"] is None  # these methods have no band
         assert set(metrics["rmse_C"]) == {"T1", "T2", "T3", "T4", "T5"}
     summary = json.loads((replayed / "summary.json").read_text())
     assert [r["run"] for r in summary["runs"]] == ["hot_9000"]

@@ -8,7 +8,7 @@ from pathlib import Path
 from twin.errors import InputError
 
 EXAMPLES_DIR = Path(__file__).resolve().parent.parent.parent / "examples"
-METHOD_NAMES = ("open_loop", "ratio", "bpnn")
+METHOD_NAMES = ("open_loop", "ratio", "bpnn", "estimator")
 
 
 def bundled_runs() -> list[Path]:

@@ -18,7 +18,9 @@ def replay(
     out: Path = typer.Option(..., "--out", help="output folder"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
     methods: str = typer.Option(
-        "open_loop,ratio,bpnn", "--methods", help="comma-separated: open_loop, ratio, bpnn"
+        "open_loop,ratio,bpnn,estimator",
+        "--methods",
+        help="comma-separated: open_loop, ratio, bpnn, estimator",
     ),
     jobs: int = typer.Option(1, "--jobs", min=1, help="local worker processes"),
     dask: str | None = typer.Option(

@@ -16,7 +16,7 @@ def snapshot(
     time_s: float = typer.Option(..., "--time", help="run time of the picture, s"),
     out: Path = typer.Option(..., "--out", help="PNG file"),
     field: str = typer.Option("temperature", "--field", help="temperature | displacement"),
-    method: str = typer.Option("bpnn", "--method", help="open_loop | ratio | bpnn"),
+    method: str = typer.Option("bpnn", "--method", help="open_loop | ratio | bpnn | estimator"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
     section: bool = typer.Option(False, "--section", help="flat r–z section, not 3-D"),
 ) -> None:
@@ -40,7 +40,7 @@ def snapshot(
         r = replay_method(
             recorded,
             spindle,
-            make_corrector(method_name, model_path),
+            make_corrector(method_name, model_path, spindle=spindle),
             keep_fields=False,
             field_at_s=time_s,
         )

@@ -1,20 +1,19 @@
-"""The three correction methods of the twin: `open_loop`, `ratio` and `bpnn`.
+"""The correction methods of the twin: `open_loop`, `ratio`, `bpnn` (and, built here, the
+`estimator` of `twin.estimation`).
 
 Each is a small object with one method, `correct(features) -> Correction`, called once per
 60 s window with only data from before the window (see `WindowFeatures`).  A `Correction`
 unpacks like the 4-tuple (H_front, H_rear, R_front, R_rear) and also carries the factors
 C_H and C_C relative to the previous window, for `corrections.csv`.
 
-    method = make_corrector("ratio")                  # or "open_loop", or "bpnn" with model=
+    method = make_corrector("ratio")   # "open_loop"; "bpnn" with model=; "estimator" with spindle=
     H_front, H_rear, R_front, R_rear = method.correct(features)
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Protocol
 
 import numpy as np
 
@@ -23,7 +22,6 @@ from twin.correction.features import (
     OUTPUTS,
     RING_SENSOR,
     SLEEVE_SENSOR,
-    BoundaryValues,
     WindowFeatures,
     window_line_fit,
 )
@@ -40,8 +38,9 @@ from twin.correction.formulas import (
     total_rise_ratio,
     window_rise_ratio,
 )
+from twin.correction.result import Correction, Corrector
 
-METHODS: tuple[str, ...] = ("open_loop", "ratio", "bpnn")
+METHODS: tuple[str, ...] = ("open_loop", "ratio", "bpnn", "estimator")
 
 PAPER_GAINS = (1.0, 1.0, 1.0)
 """H = H_prev · (Eq. 2 ratio) · C_H and R = R' · C_C literally.  In closed loop on the lumped
@@ -51,45 +50,6 @@ same heat error and their product applies it twice, and C_H from a 60 s rise of 
 is mostly sensor noise.  The default therefore applies Eq. 2 in full, Eq. 3 not at all
 (C_H is still reported), and Eq. 6 with exponent 0.5 (the drop of the rear bearing is only a
 few tenths of a kelvin, so its ratio is noisy)."""
-
-
-@dataclass(frozen=True)
-class Correction:
-    """Boundary values for one window (W/m³, m²K/W) and their factors on the previous window."""
-
-    H_front_W_m3: float
-    H_rear_W_m3: float
-    R_front_m2K_W: float
-    R_rear_m2K_W: float
-    C_H: tuple[float, float] = (1.0, 1.0)
-    """(front, rear) heat of this window / heat of the previous window."""
-    C_C: tuple[float, float] = (1.0, 1.0)
-    """(front, rear) resistance of this window / resistance of the previous window."""
-
-    @property
-    def values(self) -> BoundaryValues:
-        return BoundaryValues(
-            self.H_front_W_m3, self.H_rear_W_m3, self.R_front_m2K_W, self.R_rear_m2K_W
-        )
-
-    def __iter__(self) -> Iterator[float]:
-        return iter(self.values)
-
-    @classmethod
-    def relative_to(
-        cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues
-    ) -> Correction:
-        v = [float(x) for x in values]
-        p = [float(x) for x in previous]
-        return cls(*v, C_H=(v[0] / p[0], v[1] / p[1]), C_C=(v[2] / p[2], v[3] / p[3]))
-
-
-class Corrector(Protocol):
-    """Anything that turns a window's features into its four boundary values."""
-
-    name: str
-
-    def correct(self, features: WindowFeatures) -> Correction: ...
 
 
 @dataclass(frozen=True)
@@ -214,8 +174,11 @@ class BpnnCorrection:
         return Correction.relative_to(values, features.previous)
 
 
-def make_corrector(name: str, model: object | str | Path | None = None) -> Corrector:
-    """The correction method called `name`; `bpnn` needs a model (object or model-file path)."""
+def make_corrector(
+    name: str, model: object | str | Path | None = None, spindle: object | None = None
+) -> Corrector:
+    """The correction method called `name`; `bpnn` needs a model (object or model-file path),
+    `estimator` the SpindleModel it filters with (`spindle`)."""
     if name == "open_loop":
         return OpenLoop()
     if name == "ratio":
@@ -228,4 +191,10 @@ def make_corrector(name: str, model: object | str | Path | None = None) -> Corre
 
             model = load_model(model)
         return BpnnCorrection(model)
+    if name == "estimator":
+        if spindle is None:
+            raise ValueError("the estimator needs the spindle model")
+        from twin.estimation.method import EnsembleEstimator
+
+        return EnsembleEstimator(spindle)
     raise ValueError(f"unknown correction method {name!r}; expected one of {', '.join(METHODS)}")

@@ -48,6 +48,17 @@ class ThermalStepper:
         self._make_balance = balance
         self._balance: HeatBalance | None = None
 
+    @property
+    def explicit(self) -> sp.csr_matrix:
+        """C/Δt − (1 − θ)K (W/K): what multiplies the old temperature on the right-hand side."""
+        return self._explicit
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """(C/Δt + θK)⁻¹ rhs for one (n,) or, without prescribed temperatures, several (n, m)
+        right-hand sides (W → K).  Several columns share the factorization: an ensemble of
+        tangent-linear perturbations costs one multi-column back-substitution per step."""
+        return self._solver.solve(rhs)
+
     def step(self, T: np.ndarray) -> np.ndarray:
         """Advance one Δt from nodal temperature T (°C)."""
         return self._solver.solve(self._explicit @ T + self.f)

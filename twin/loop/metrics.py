@@ -10,6 +10,8 @@ data-quality check excluded (NaN in the measured arrays).
       100 · (1 − Σ|T_twin − T_meas| / Σ|T_meas − T_meas(0)|)
 - deformation accuracy, axial nose drift:
       100 · (1 − Σ|δ_twin − δ_meas| / Σ|δ_meas|)
+- band coverage (methods with a 90 % band): share of the valid measured T1..T5 samples and
+  drift samples that lie inside the band, %
 
 Why the floor: the paper divides by the measured temperature in °C, a ratio whose zero
 is where water freezes, not where the error stops mattering.  Its runs sit at workshop
@@ -45,11 +47,13 @@ def accuracy_metrics(
     drift_twin_um: np.ndarray,
     drift_meas_um: np.ndarray | None,
     first_window_end_s: float = 60.0,
+    band: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> dict:
     """Metrics of one method on one run.
 
     time_s (k,), T_twin_C / T_meas_C (k, 5), T_meas0_C (5,) measured at the run start,
-    drift_twin_um / drift_meas_um (k,) axial nose drift (None: not measured).
+    drift_twin_um / drift_meas_um (k,) axial nose drift (None: not measured),
+    band (lo, hi), each (k, 6): T1..T5 °C and the axial drift µm (None: no band).
     """
     after = np.asarray(time_s) > first_window_end_s - 1e-9
     tw = np.asarray(T_twin_C, float)[after]
@@ -76,7 +80,14 @@ def accuracy_metrics(
         "rmse_C": rmse,
         "rmse_um": None,
         "max_abs_C": float(err.max()),
+        "band_coverage_pct": None,
     }
+    if band is not None:
+        measured = np.column_stack([
+            np.asarray(T_meas_C, float),
+            np.full(len(time_s), np.nan) if drift_meas_um is None else drift_meas_um,
+        ])
+        out["band_coverage_pct"] = band_coverage(measured[after], band[0][after], band[1][after])
     if drift_meas_um is not None:
         dm = np.asarray(drift_meas_um, float)[after]
         dt = np.asarray(drift_twin_um, float)[after]
@@ -86,6 +97,15 @@ def accuracy_metrics(
             out["deformation_accuracy_pct"] = float(100.0 * (1.0 - e.sum() / np.abs(dm[okd]).sum()))
             out["rmse_um"] = float(np.sqrt(np.mean(e**2)))
     return out
+
+
+def band_coverage(measured: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float | None:
+    """Share (%) of the finite measured values with a finite band that lie in [lo, hi]."""
+    ok = np.isfinite(measured) & np.isfinite(lo) & np.isfinite(hi)
+    if not ok.any():
+        return None
+    inside = (measured >= lo) & (measured <= hi)
+    return float(100.0 * np.sum(inside & ok) / np.sum(ok))
 
 
 def mean_metrics(runs: list[dict]) -> dict:

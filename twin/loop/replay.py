@@ -4,7 +4,8 @@ For each 60 s window k, covering [60k, 60k + 60) s, using only data measured bef
 window starts:
 
     features (speed, ambient, T1..T5 measured and simulated so far, run time)
-      → correction (open_loop | ratio | bpnn) → H_front, H_rear, R_front, R_rear
+      → correction (open_loop | ratio | bpnn | estimator) → H_front, H_rear, R_front, R_rear
+        (an estimator also sets the analysed start field and motor/film factors)
       → window deck (apdl_like) → 15 backward-Euler steps of 4 s in the persistent session
       → T1..T5 and the nose drift per step (probes), fields at the window end
 
@@ -22,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.correction.features import BoundaryValues, TwinState, WindowFeatures
-from twin.correction.methods import Correction, Corrector
+from twin.correction.result import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
@@ -65,6 +66,9 @@ class MethodReplay:
     fields: dict[float, np.ndarray] = field(default_factory=dict)  # window-end T fields
     T_initial_C: float = 20.0
     wall_s: float = 0.0
+    band_sd: np.ndarray | None = None
+    """(k, 6) forecast spread (1 σ) of T1..T5 (°C) and the axial drift (µm), for methods
+    with uncertainty (the estimator); None otherwise."""
 
 
 WindowSolver = Callable[[BoundaryConditions, Correction, np.ndarray, float, int], tuple]
@@ -189,6 +193,7 @@ def replay_method(
     fields: dict[float, np.ndarray] = {}
     previous: BoundaryValues | None = None
     previous_nominal: BoundaryValues | None = None
+    band: np.ndarray | None = None
 
     for k in range(windows):
         start = float(starts[k])
@@ -224,6 +229,14 @@ def replay_method(
             twin_state=TwinState(T, bc),
         )
         corr = corrector.correct(features)
+        if corr.state_C is not None:  # an estimator's analysed field
+            T = np.asarray(corr.state_C, dtype=float)
+        if corr.factors:  # model-form factors (motor, film groups) go into the deck's loads
+            bc = bc.scaled(corr.factors)
+        if corr.band_sd is not None:
+            if band is None:
+                band = np.full((n_steps, 6), np.nan)
+            band[k * STEPS_PER_WINDOW : (k + 1) * STEPS_PER_WINDOW] = corr.band_sd
         steps, deck = solver(bc, corr, T, start, k)
         T = steps[-1]
         sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
@@ -248,4 +261,5 @@ def replay_method(
         fields=fields,
         T_initial_C=T0,
         wall_s=time.perf_counter() - t_wall,
+        band_sd=band,
     )

@@ -24,7 +24,9 @@ from twin.loop.folders import folder_lock
 from twin.loop.metrics import SENSORS
 from twin.loop.summary import collect_summary, run_folder
 
-METHOD_COLORS = {"open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728"}
+METHOD_COLORS = {
+    "open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728", "estimator": "#2ca02c"
+}
 
 
 def _read_csv(path: Path) -> dict[str, list[str]]:
@@ -49,6 +51,17 @@ def _png(fig) -> bytes:  # noqa: ANN001
     fig.savefig(buf, format="png", dpi=80)
     plt.close(fig)
     return buf.getvalue()
+
+
+def _shade_band(ax, kp: dict, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,  # noqa: ANN001
+                method: str) -> None:
+    """The method's 90 % band, shaded, where keypoints.csv has one."""
+    if lo not in kp:
+        return
+    low, high = _floats(kp[lo])[sel], _floats(kp[hi])[sel]
+    if np.isfinite(low).any():
+        ax.fill_between(t_min[sel], low, high, color=METHOD_COLORS.get(method), alpha=0.2,
+                        lw=0, label=f"{method} 90 % band")
 
 
 def render_run_plots(run_dir: Path) -> list[Path]:
@@ -81,6 +94,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
                 lw=1.3,
                 label=m,
             )
+            _shade_band(ax, kp, sel, t_min, f"{s}_twin_lo_C", f"{s}_twin_hi_C", m)
         ax.set_title(s)
         ax.set_xlabel("time [min]")
         ax.grid(alpha=0.3)
@@ -98,6 +112,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
         ax1.plot(
             t_min[sel], _floats(kp["disp_z_twin_um"])[sel], color=METHOD_COLORS.get(m), label=m
         )
+        _shade_band(ax1, kp, sel, t_min, "disp_z_twin_lo_um", "disp_z_twin_hi_um", m)
     ax1.set_title("axial nose drift")
     ax1.set_xlabel("time [min]")
     ax1.set_ylabel("drift [µm]")

@@ -1,8 +1,10 @@
 """Replay one recorded run with every requested method and write its output folder.
 
 Layout under DIR/<run-name>/ (shared DESIGN.md):
-    keypoints.csv      time_s, method, T1..T5 twin and measured, nose drift twin/measured
-    corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C
+    keypoints.csv      time_s, method, T1..T5 twin and measured, nose drift twin/measured,
+                       and the 90 % band (…_twin_lo/_hi) when a method has one (estimator)
+    corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C, and
+                       <name>_factor for further estimated values (motor, film groups)
     accuracy.json      per-method metrics (twin.loop.metrics)
     quality.json       data-quality findings of the recorded run
     decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/)
@@ -102,7 +104,9 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
     token = resume_token(run_path, methods, model_path)
 
-    correctors = [make_corrector(m, model_path if m == "bpnn" else None) for m in methods]
+    correctors = [
+        make_corrector(m, model_path if m == "bpnn" else None, spindle=model) for m in methods
+    ]
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
     results: dict[str, MethodReplay] = {}
@@ -120,27 +124,14 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
         )
 
     first = next(iter(results.values()))
-    measured = run.at(first.time_s)
-    meas_T = np.where(measured.valid_T, measured.T_C, np.nan)
-    meas_drift = None
-    if measured.disp_um is not None and "disp_z_um" in measured.valid:
-        meas_drift = np.where(measured.valid["disp_z_um"], measured.disp_um[:, 2], np.nan)
-    start = run.before(np.array([run.time_s[0]]))
-    meas_T0 = np.where(start.valid_T[0], start.T_C[0], np.nan)
-    if np.any(~np.isfinite(meas_T0)):  # a sensor that starts invalid: its first good value
-        good = np.where(run.valid_T, run.T_C, np.nan)
-        for i in np.where(~np.isfinite(meas_T0))[0]:
-            finite = np.isfinite(good[:, i])
-            meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
-
+    meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
     accuracy = {
         "run": run_name(run_path),
         "speed_rpm": float(np.mean(run.speed_rpm)),
         "ambient_C": float(np.mean(run.ambient_C)),
         "duration_s": float(run.duration_s),
         "methods": {
-            name: accuracy_metrics(r.time_s, r.T_twin_C, meas_T, meas_T0, r.drift_z_um, meas_drift)
-            for name, r in results.items()
+            name: method_accuracy(r, meas_T, meas_T0, meas_drift) for name, r in results.items()
         },
     }
 
@@ -173,28 +164,76 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
     return accuracy
 
 
+def measured_reference(
+    run, time_s: np.ndarray  # noqa: ANN001 - twin.runs.RecordedRun
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """What a replay is compared with at `time_s`: T1..T5 (k, 5) and the axial drift (k,)
+    (NaN where invalid; None if not recorded), and T1..T5 at the run start (5,)."""
+    measured = run.at(time_s)
+    meas_T = np.where(measured.valid_T, measured.T_C, np.nan)
+    meas_drift = None
+    if measured.disp_um is not None and "disp_z_um" in measured.valid:
+        meas_drift = np.where(measured.valid["disp_z_um"], measured.disp_um[:, 2], np.nan)
+    start = run.before(np.array([run.time_s[0]]))
+    meas_T0 = np.where(start.valid_T[0], start.T_C[0], np.nan)
+    if np.any(~np.isfinite(meas_T0)):  # a sensor that starts invalid: its first good value
+        good = np.where(run.valid_T, run.T_C, np.nan)
+        for i in np.where(~np.isfinite(meas_T0))[0]:
+            finite = np.isfinite(good[:, i])
+            meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
+    return meas_T, meas_T0, meas_drift
+
+
+def method_accuracy(
+    r: MethodReplay, meas_T: np.ndarray, meas_T0: np.ndarray, meas_drift: np.ndarray | None
+) -> dict:
+    """accuracy.json entry of one method (twin.loop.metrics), its band included."""
+    return accuracy_metrics(
+        r.time_s, r.T_twin_C, meas_T, meas_T0, r.drift_z_um, meas_drift, band=band_of(r)
+    )
+
+
+def band_of(r: MethodReplay) -> tuple[np.ndarray, np.ndarray] | None:
+    """(lo, hi), each (k, 6): the 90 % band of T1..T5 (°C) and the axial drift (µm)."""
+    if r.band_sd is None:
+        return None
+    from twin.estimation.method import BAND_Z
+
+    centre = np.column_stack([r.T_twin_C, r.drift_z_um])
+    return centre - BAND_Z * r.band_sd, centre + BAND_Z * r.band_sd
+
+
 def _write_keypoints(
     path: Path, results: dict[str, MethodReplay], meas_T: np.ndarray, meas_drift: np.ndarray | None
 ) -> None:
     header = ["time_s", "method"]
     header += [f"{s}_twin_C" for s in SENSORS] + [f"{s}_meas_C" for s in SENSORS]
     header += ["disp_z_twin_um", "disp_z_meas_um", "disp_r_twin_um", "disp_r_meas_um"]
+    with_band = any(r.band_sd is not None for r in results.values())
+    if with_band:
+        for s in SENSORS:
+            header += [f"{s}_twin_lo_C", f"{s}_twin_hi_C"]
+        header += ["disp_z_twin_lo_um", "disp_z_twin_hi_um"]
     rows = []
     nan = float("nan")
     for name, r in results.items():
+        band = band_of(r)
         for i, t in enumerate(r.time_s):
-            rows.append(
-                [
-                    float(t),
-                    name,
-                    *r.T_twin_C[i],
-                    *meas_T[i],
-                    r.drift_z_um[i],
-                    nan if meas_drift is None else meas_drift[i],
-                    r.drift_r_um[i],
-                    nan,
+            row = [
+                float(t),
+                name,
+                *r.T_twin_C[i],
+                *meas_T[i],
+                r.drift_z_um[i],
+                nan if meas_drift is None else meas_drift[i],
+                r.drift_r_um[i],
+                nan,
+            ]
+            if with_band:
+                row += [nan] * 12 if band is None else [
+                    v for j in range(6) for v in (band[0][i, j], band[1][i, j])
                 ]
-            )
+            rows.append(row)
     write_csv(path, header, rows)
 
 
@@ -213,6 +252,11 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
         "C_C_front",
         "C_C_rear",
     ]
+    # further values a method estimates (the estimator's motor and film factors)
+    extra = list(dict.fromkeys(
+        k for r in results.values() for w in r.windows for k in w.correction.factors
+    ))
+    header += [f"{k}_factor" for k in extra]
     rows = []
     for name, r in results.items():
         for w in r.windows:
@@ -229,6 +273,7 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
                     c.R_rear_m2K_W,
                     *c.C_H,
                     *c.C_C,
+                    *(c.factors.get(k, float("nan")) for k in extra),
                 ]
             )
     write_csv(path, header, rows)

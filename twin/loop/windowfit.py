@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.correction.features import WindowFeatures
-from twin.correction.methods import Correction
+from twin.correction.result import Correction
 from twin.loop.replay import STEP_S, STEPS_PER_WINDOW, direct_window_solver
 from twin.runs import RecordedRun
 from twin.spindle.model import SpindleModel

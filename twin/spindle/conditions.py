@@ -21,6 +21,7 @@ temperature (a chiller tracking the room).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 from twin.errors import InputError
@@ -44,6 +45,27 @@ from twin.runs.schema import OPERATING_TEMPERATURE_C
 from twin.spindle.spec import ConvectionSpec, SpindleSpec
 
 SIDES = ("front", "rear")
+
+FILM_GROUPS: dict[str, tuple[str, ...]] = {
+    "coolant": ("coolant",),
+    "housing": ("housing_outer", "mount"),
+    "air_gap": ("air_gap_rotor", "air_gap_stator"),
+    "rotor": ("rotor_end_front", "rotor_end_rear", "nose_face", "nose_outer", "shaft_rear",
+              "shaft_internal", "internal_air"),
+}
+"""Convection boundaries grouped by the correlation that gives their film coefficient
+(DESIGN.md, "Emulator inputs"): coolant = jacket channels; housing = outer housing and
+mount; air_gap = rotor and stator gap faces; rotor = rotor ends, shaft ends, nose and
+internal air.  A group's film coefficients are wrong together on a real spindle (one
+correlation, one flow), so a model-form factor acts on a whole group."""
+
+
+def film_group(boundary: str) -> str | None:
+    """The FILM_GROUPS group of a convection boundary (None: in no group)."""
+    for group, members in FILM_GROUPS.items():
+        if boundary in members:
+            return group
+    return None
 
 
 @dataclass(frozen=True)
@@ -71,6 +93,25 @@ class BoundaryConditions:
         for region, q in self.motor_heat.items():
             out[region] = q * self.motor_volume_m3.get(region, math.nan)
         return out
+
+    def scaled(self, factors: Mapping[str, float]) -> BoundaryConditions:
+        """A copy with model-form factors applied: `motor` multiplies the motor heat,
+        `film_<group>` the film coefficients of a FILM_GROUPS group (bulk temperatures stay).
+        """
+        films: dict[str, float] = {}
+        for name, f in factors.items():
+            group = name.removeprefix("film_")
+            if name != "motor" and not (name.startswith("film_") and group in FILM_GROUPS):
+                raise ValueError(f"unknown model-form factor {name!r}")
+            if not (math.isfinite(f) and f > 0):
+                raise ValueError(f"{name} factor must be a finite positive number, got {f!r}")
+            if name != "motor":
+                films[group] = float(f)
+        motor = float(factors.get("motor", 1.0))
+        convection = {b: (h * films.get(film_group(b) or "", 1.0), t_inf)
+                      for b, (h, t_inf) in self.convection.items()}
+        return replace(self, motor_heat={r: q * motor for r, q in self.motor_heat.items()},
+                       convection=convection)
 
     def with_values(self, **values: float) -> BoundaryConditions:
         """A copy with some of H_front, H_rear, R_front, R_rear replaced."""

@@ -1,0 +1,80 @@
+"""Estimator benchmarks (issue 13): ensemble size against accuracy and time; the default
+estimator's time per 30 min run and its peak memory.
+
+- per ensemble size: the estimator replayed through its window decks (what `twin replay`
+  does for the method) on every bundled run, warm process: best-of-two wall time and CPU
+  time per run, mean temperature / deformation accuracy and band coverage;
+- the default (EstimatorConfig()) in a fresh `twin replay --methods estimator` process:
+  wall time and peak RSS (imports, model load and all writes included).
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bench.loop import _cli
+
+ROOT = Path(__file__).resolve().parent.parent
+MEMBERS = (8, 16, 24, 32, 48)
+
+
+def bundled_runs() -> list[Path]:
+    runs = sorted((ROOT / "examples" / "runs").glob("*.csv"))
+    return [r for r in runs if not r.name.endswith(".truth.csv")]
+
+
+def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
+    from twin.estimation.method import EnsembleEstimator, EstimatorConfig
+    from twin.loop.replay import deck_window_solver, replay_method
+    from twin.loop.runfiles import default_spindle, measured_reference, method_accuracy
+    from twin.runs import read_run
+
+    model = default_spindle()
+    runs = [read_run(p) for p in bundled_runs()]
+    rows = []
+    for n in members:
+        est = EnsembleEstimator(model, EstimatorConfig(members=n))
+        wall, cpu, metrics = [], [], []
+        for run in runs:
+            best_wall = best_cpu = float("inf")
+            for _ in range(2):
+                t, c = time.perf_counter(), time.process_time()
+                r = replay_method(run, model, est, solver=deck_window_solver(model),
+                                  keep_fields=False)
+                best_wall = min(best_wall, time.perf_counter() - t)
+                best_cpu = min(best_cpu, time.process_time() - c)
+            minutes = run.duration_s / 60.0
+            wall.append(best_wall * 30.0 / minutes)
+            cpu.append(best_cpu * 30.0 / minutes)
+            metrics.append(method_accuracy(r, *measured_reference(run, r.time_s)))
+
+        def mean(key: str, rows=metrics) -> float | None:
+            v = [m[key] for m in rows if m[key] is not None]
+            return float(np.mean(v)) if v else None
+
+        rows.append({
+            "members": n,
+            "wall_s_per_30min_run": float(np.mean(wall)),
+            "cpu_s_per_30min_run": float(np.mean(cpu)),
+            "temperature_accuracy_pct": mean("temperature_accuracy_pct"),
+            "deformation_accuracy_pct": mean("deformation_accuracy_pct"),
+            "band_coverage_pct": mean("band_coverage_pct"),
+        })
+        print(f"  members {n}: {rows[-1]}")
+    return rows
+
+
+def run() -> dict:
+    runs = bundled_runs()
+    with tempfile.TemporaryDirectory() as tmp:
+        wall, rss = _cli("replay", str(runs[0]), "--out", str(Path(tmp) / "out"), "--methods",
+                         "estimator", "--snapshots", "none", "--quiet")
+    return {
+        "runs": [r.name for r in runs],
+        "default_fresh_process": {"run": runs[0].name, "wall_s": wall, "peak_rss_mb": rss},
+        "ensemble_size": ensemble_table(),
+    }

@@ -1,0 +1,68 @@
+"""What a correction method returns for one window (`Correction`) and the method protocol.
+
+A `Correction` unpacks like the 4-tuple (H_front, H_rear, R_front, R_rear) and also carries
+the factors C_H and C_C relative to the previous window, for `corrections.csv`.  An
+estimator (`twin.estimation`) may also set model-form factors (motor loss, film groups), the
+analysed field the window starts from, and the spread of its forecast.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from twin.correction.features import BoundaryValues, WindowFeatures
+
+
+@dataclass(frozen=True)
+class Correction:
+    """Boundary values for one window (W/m³, m²K/W) and their factors on the previous window."""
+
+    H_front_W_m3: float
+    H_rear_W_m3: float
+    R_front_m2K_W: float
+    R_rear_m2K_W: float
+    C_H: tuple[float, float] = (1.0, 1.0)
+    """(front, rear) heat of this window / heat of the previous window."""
+    C_C: tuple[float, float] = (1.0, 1.0)
+    """(front, rear) resistance of this window / resistance of the previous window."""
+    factors: Mapping[str, float] = field(default_factory=dict)
+    """Further estimated multipliers on nominal values: `motor` (motor loss) and
+    `film_<group>` (twin.spindle.conditions.FILM_GROUPS).  The loop applies them to the
+    window's conditions (so they are in the deck) and corrections.csv lists them."""
+    state_C: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """The analysed temperature field (°C per dof) the window starts from; None: the loop's
+    own field, carried over from the previous window."""
+    band_sd: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """(steps, 6) forecast spread (1 σ) at each solver step of the window: T1..T5 in °C
+    (measurement noise included) and the axial nose drift in µm; None: no uncertainty."""
+
+    @property
+    def values(self) -> BoundaryValues:
+        return BoundaryValues(
+            self.H_front_W_m3, self.H_rear_W_m3, self.R_front_m2K_W, self.R_rear_m2K_W
+        )
+
+    def __iter__(self) -> Iterator[float]:
+        return iter(self.values)
+
+    @classmethod
+    def relative_to(
+        cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
+    ) -> Correction:
+        """These values with C_H, C_C on `previous`; `extra`: factors, state_C, band_sd."""
+        v = [float(x) for x in values]
+        p = [float(x) for x in previous]
+        return cls(*v, C_H=(v[0] / p[0], v[1] / p[1]), C_C=(v[2] / p[2], v[3] / p[3]),
+                   **extra)
+
+
+class Corrector(Protocol):
+    """Anything that turns a window's features into its four boundary values."""
+
+    name: str
+
+    def correct(self, features: WindowFeatures) -> Correction: ...

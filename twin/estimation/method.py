@@ -1,0 +1,269 @@
+"""Method `estimator`: joint, causal state–parameter estimation with an ensemble Kalman filter.
+
+What it estimates
+    The twin's temperature field (every dof) and log-factors φ on nominal boundary values
+    (`twin.estimation.parameters.DEFAULT_PARAMETERS`): bearing heat (front, rear), ring/sleeve
+    contact resistance (front, rear), motor loss and the film coefficients of the rotor group
+    (rotor ends, shaft, nose, internal air).  The coolant, housing and air-gap film factors
+    are available (`EstimatorConfig.parameters`) but not estimated by default.
+
+Why these (sensitivity and observability study, `python -m twin.estimation.sensitivity`,
+run with the twin model itself: 30 min from a cold start, T1..T5 and the axial drift every
+60 s, forward differences of 0.05 in each log-factor; J/σ with σ = 0.1 K per sample)
+    Peak response per unit log-factor at 9000 rpm (K on T1..T5 | µm of drift):
+        H_front 12.5 4.2 0.1 0.1 0.0 | 11.2     H_rear  0.0 0.0 17.6 12.4 0.0 | 0.1
+        R_front  3.5 0.3 0.0 0.0 0.0 |  1.4     R_rear  0.0 0.0  2.3  0.8 0.0 | 0.0
+        motor    0.8 0.3 2.8 2.1 0.6 |  1.3     rotor   2.1 0.7  4.8  3.4 0.0 | 6.2
+        coolant  0.9 1.0 0.5 0.5 0.7 |  0.5     air gap 0.4 0.1  1.3  0.9 0.0 | 1.0
+        housing  0.0 0.0 0.4 0.5 0.0 |  0.0
+    Singular values of J/σ (all nine): 1010, 731, 101, 81, 71, 37, 8.7, 5.7, 2.9 (at 4000
+    rpm: 330 … 4.0, 2.9, 1.0).  The last three directions are (v7) motor + coolant + rotor
+    film together, (v8) air gap with housing and motor, (v9) housing film.  J/σ counts 30
+    samples as independent; the model-form error that matters here (placement, mesh,
+    conductivity) is correlated over the run and about 0.2–0.3 K, which divides these
+    values by roughly 5–10: v7–v9 fall to about one noise unit — not identifiable.
+    Consequences: the housing film is left out (it moves no sensor or drift measurably);
+    the air-gap film is left out (weak, and confounded with the rotor film and motor loss,
+    which carry the same rotor heat path); of motor / coolant / rotor film, which together
+    form the unidentifiable v7, the coolant film is left out because it matters least for
+    the drift (0.5 µm against 1.3 and 6.2).  On emulated runs with model-form error, the
+    nine-parameter filter drove exactly that v7 direction to motor ≈ 1.4–2.0, coolant film
+    ≈ 1.3–1.7 (truths 0.9–1.25 and 0.8–0.95): sensor fits to 0.1 K, drift 5–10 % worse.
+    Conductivity and expansion multipliers are not estimated: conductivity is nearly
+    collinear with the contact and film factors in T1..T5, and expansion moves no
+    temperature at all (it scales the drift only, which the filter does not assimilate).
+
+The filter (Evensen 2009; REFERENCE.md §7)
+    Ensemble of N members (default 24) as mean + anomalies of [T; φ] (`ensemble`).  Each
+    window: (1) analysis with the measurements of the window just ended (ETKF, `analysis`;
+    T1..T5 averaged over three 20 s bins: 15 observations; invalid samples — dead, stuck,
+    dropped out per the data-quality check — are left out), updating field and log-factors
+    through their ensemble covariance with the predicted sensor values inside the window;
+    (2) random walk of the log-factors, spread capped at the prior, mean clipped to the
+    bounds; (3) forecast of the next window (`forecast`): the mean by the FEM with the mean
+    factors, members tangent-linear on the mean's factorization.  Multiplicative inflation
+    (default 1.05) guards against collapse; the bounded log-space priors against drift.
+
+Causality
+    Window k's loads and starting field use measurements up to 60k s only: the analysis at
+    the start of window k uses the samples in (60(k−1), 60k].
+
+Deck, analysed state and members
+    The window deck `decks/window_kkk.inp` carries the mean's loads (bearing heat and contact
+    resistance in their usual commands, motor and film factors already applied to the
+    rotor/stator heat and the film coefficients).  It runs from the analysed mean field at
+    60k s (the session's state, set before the deck), so deck + analysed field reproduce the
+    reported twin trajectory exactly.  The members never appear in decks: each is the mean
+    plus a tangent-linear anomaly, and only their spread is reported (the 90 % band).
+
+Band
+    Per solver step, ±1.645 σ around the mean: σ² = member variance of the sensor value +
+    model error (`model_sd_C`) + sensor noise; for the drift, the member variance + the
+    expansion uncertainty the filter cannot see (`drift_rel_sd` of the drift) + probe noise.
+
+Stops: at 0 rpm the bearing and motor heat are zero, so their factors have no effect and
+are not updated (their spread is capped at the prior); the films and the field go on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from twin.correction.features import WindowFeatures
+from twin.correction.result import Correction
+from twin.estimation.analysis import etkf_update
+from twin.estimation.ensemble import Ensemble, add_random_walk, cap_spread
+from twin.estimation.forecast import WindowForecast, forecast_window
+from twin.estimation.parameters import (
+    BOUNDARY_VALUES,
+    DEFAULT_PARAMETERS,
+    TangentOperators,
+    apply_factors,
+    factors_of,
+    parameters,
+)
+
+BAND_Z = 1.6448536269514722
+"""Half-width of a central 90 % normal interval in σ."""
+
+
+@dataclass(frozen=True)
+class EstimatorConfig:
+    """Settings of the ensemble filter (defaults measured on the synthetic suite)."""
+
+    members: int = 24
+    parameters: tuple[str, ...] = DEFAULT_PARAMETERS
+    inflation: float = 1.05
+    """Multiplicative covariance inflation per analysis (ρ)."""
+    model_sd_C: float = 0.15
+    """Model error of a predicted sensor value, °C (mesh, placement, lag, conductivity)."""
+    sensor_sd_C: float = 0.05
+    """Thermocouple noise per sample, °C."""
+    sensor_lag_s: float = 10.0
+    """Assumed thermocouple time constant, s (sheathed thermocouples: about 4–20 s)."""
+    lag_sd_s: float = 6.0
+    """Its uncertainty, s: a rate of change r adds lag_sd_s·r to the observation error."""
+    bins_per_window: int = 3
+    """Observation bins per 60 s window; each bin's mean is one observation per sensor."""
+    initial_field_sd_C: float = 0.2
+    """Uncertainty of the uniform start field (the mean of the first T1..T5)."""
+    drift_rel_sd: float = 0.03
+    """Relative uncertainty of the drift beyond the field (expansion ±5 %, uniform)."""
+    drift_noise_um: float = 0.1
+    step_s: float = 4.0
+    steps_per_window: int = 15
+    window_s: float = 60.0
+    seed: int = 0
+    field_update: float = 1.0
+    """Share of the analysis increment applied to the field (1: the full ETKF update)."""
+
+
+@dataclass
+class EnsembleEstimator:
+    """The `estimator` correction method (module doc); one instance replays runs one at a
+    time (window 0 starts a new run)."""
+
+    model: object = field(repr=False)  # twin.spindle.SpindleModel
+    config: EstimatorConfig = EstimatorConfig()
+    name: str = "estimator"
+    _ensemble: Ensemble | None = field(default=None, init=False, repr=False)
+    _forecast: WindowForecast | None = field(default=None, init=False, repr=False)
+    _rng: np.random.Generator | None = field(default=None, init=False, repr=False)
+    _drift_start_um: float = field(default=0.0, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._params = parameters(self.config.parameters)
+        self._prior_sd = np.array([p.prior_sd for p in self._params])
+        self._walk_sd = np.array([p.walk_sd for p in self._params])
+        self._bounds = np.array([p.log_bounds for p in self._params])
+        S = self.model.sensor_matrix
+        self._sensors = S
+        self._drift_um = 1e6 * np.asarray(self.model.probe_vectors[0])
+
+    @property
+    def log_factors(self) -> dict[str, float]:
+        """Current mean log-factors by name (after the last analysis)."""
+        if self._ensemble is None:
+            return {}
+        return dict(zip(self.config.parameters, self._ensemble.log_factor_mean.tolist(),
+                        strict=True))
+
+    def correct(self, features: WindowFeatures) -> Correction:
+        f = features
+        cfg = self.config
+        if f.twin_state is None:
+            raise ValueError("the estimator needs the twin's state (run it through the loop)")
+        if f.window == 0 or self._ensemble is None:
+            self._rng = np.random.default_rng(cfg.seed)
+            self._drift_start_um = float(self._drift_um @ f.twin_state.field_C)
+            self._ensemble = Ensemble.initial(
+                f.twin_state.field_C, cfg.initial_field_sd_C, self._prior_sd, cfg.members,
+                self._rng,
+            )
+        else:
+            with threadpool_limits(1):
+                self._ensemble = self._analysis(f)
+        ens = self._ensemble
+        ens.log_factor_anomalies = cap_spread(
+            add_random_walk(ens.log_factor_anomalies, self._walk_sd, self._rng), self._prior_sd
+        )
+        ens.log_factor_mean = np.clip(ens.log_factor_mean, self._bounds[:, 0], self._bounds[:, 1])
+
+        factors = factors_of(cfg.parameters, ens.log_factor_mean)
+        bc = apply_factors(f.twin_state.conditions, factors)
+        loads = bc.to_thermal_loads()
+        thermal = self.model.thermal
+        substeps = cfg.steps_per_window // cfg.bins_per_window
+        with threadpool_limits(1):  # tiny dense blocks: BLAS threads only contend
+            self._forecast = forecast_window(
+                thermal.transient(loads, cfg.step_s),
+                thermal.transient(loads, cfg.step_s * substeps),
+                substeps,
+                TangentOperators(thermal, bc, cfg.parameters),
+                ens, self._sensors, self._drift_um, cfg.steps_per_window,
+            )
+        extra = {k: v for k, v in factors.items() if k not in BOUNDARY_VALUES}
+        return Correction.relative_to(
+            (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
+            factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd(self._forecast),
+        )
+
+    # ------------------------------------------------------------------ steps
+    def _analysis(self, f: WindowFeatures) -> Ensemble:
+        """Update the forecast ensemble with the samples of the window just ended."""
+        cfg = self.config
+        fc = self._forecast
+        end = fc.end
+        # the reported trajectory (the deck's) is the mean: use it for the innovations,
+        # and the loop's field at the window end as the forecast mean
+        end.field_mean = np.asarray(f.twin_state.field_C, float)
+        steps = cfg.steps_per_window
+        # what the thermocouples would read of the mean: its sensor values through the lag
+        sim_t = np.asarray(f.simulated_time_s, float)
+        read = thermocouple_reading(sim_t, np.asarray(f.simulated_C, float), cfg.sensor_lag_s)
+        in_window = sim_t > f.start_s - cfg.window_s + 1e-9
+        read, read_t = read[in_window], sim_t[in_window]
+        if len(read_t) != steps:  # the loop's history must hold the whole window
+            raise ValueError(f"window {f.window}: expected {steps} simulated steps, "
+                             f"got {len(read_t)}")
+        bins = np.array_split(np.arange(steps), cfg.bins_per_window)
+        t_meas = np.asarray(f.measured_time_s, float)
+        meas = np.asarray(f.measured_C, float)
+        y_mean, y_anom, observed, sd = [], [], [], []
+        for i, b in enumerate(bins):
+            lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
+            m, counts = bin_mean(t_meas, meas, lo, hi)
+            observed.append(np.where(counts >= 2, m, np.nan))  # a lone sample is too noisy
+            y_mean.append(read[b].mean(axis=0))
+            y_anom.append(0.5 * (fc.sensors_anomalies_C[i] + fc.sensors_anomalies_C[i + 1]))
+            # the lag is known only roughly: its error grows with the rate of change
+            rate = np.abs(read[b[-1]] - read[b[0]]) / max(hi - lo - cfg.step_s, cfg.step_s)
+            sd.append(np.sqrt(cfg.model_sd_C**2 + (cfg.lag_sd_s * rate) ** 2
+                              + cfg.sensor_sd_C**2 / np.maximum(counts, 1)))
+        prior_mean, anomalies = end.stacked()
+        mean, anomalies = etkf_update(
+            prior_mean, anomalies, np.concatenate(y_mean), np.vstack(y_anom),
+            np.concatenate(observed), np.concatenate(sd), cfg.inflation,
+        )
+        n = end.field_mean.size
+        mean[:n] = prior_mean[:n] + cfg.field_update * (mean[:n] - prior_mean[:n])
+        return Ensemble.from_stacked(mean, anomalies, n)
+
+    def _band_sd(self, fc: WindowForecast) -> np.ndarray:
+        cfg = self.config
+        var_T, var_d = fc.spread_at_steps()
+        sd_T = np.sqrt(var_T + cfg.model_sd_C**2 + cfg.sensor_sd_C**2)
+        drift = fc.drift_mean_um - self._drift_start_um
+        sd_d = np.sqrt(var_d + (cfg.drift_rel_sd * drift) ** 2 + cfg.drift_noise_um**2)
+        return np.column_stack([sd_T, sd_d])
+
+
+def thermocouple_reading(time_s: np.ndarray, metal_C: np.ndarray, lag_s: float) -> np.ndarray:
+    """First-order lag τ dy/dt = x − y of metal temperatures (rows at time_s), starting
+    settled; exact for a temperature linear between the rows."""
+    x = np.asarray(metal_C, float)
+    y = np.empty_like(x)
+    y[0] = x[0]
+    if lag_s <= 0:
+        return x.copy()
+    for i in range(1, len(x)):
+        h = float(time_s[i] - time_s[i - 1])
+        a = np.exp(-h / lag_s)
+        # x linear over the step: y⁺ = a·y + (1 − a)·x⁺ − τ(1 − a − h/τ·a)·(x⁺ − x)/h
+        slope = (x[i] - x[i - 1]) / h if h > 0 else 0.0
+        y[i] = a * y[i - 1] + (1 - a) * x[i] - lag_s * (1 - a) * slope + h * a * slope
+    return y
+
+
+def bin_mean(time_s: np.ndarray, values: np.ndarray, lo_s: float,
+             hi_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per column, the mean of the finite values sampled in (lo_s, hi_s] and their count."""
+    rows = (time_s > lo_s + 1e-9) & (time_s <= hi_s + 1e-9)
+    v = values[rows]
+    ok = np.isfinite(v)
+    counts = ok.sum(axis=0)
+    total = np.where(ok, v, 0.0).sum(axis=0)
+    return np.where(counts > 0, total / np.maximum(counts, 1), np.nan), counts

@@ -1,0 +1,155 @@
+"""The boundary values the estimator carries, as log-factors on the twin's nominal values.
+
+A parameter φ multiplies one nominal boundary value by e^φ: φ = 0 is the handbook model,
+φ = ln 1.3 a 30 % larger value.  Log space keeps every value positive, makes "30 % too
+large" and "30 % too small" symmetric, and lets the filter's Gaussian statistics describe
+the ±20–40 % uncertainties of REFERENCE.md §7.  Each parameter has a prior spread (the
+uncertainty of its correlation), a random walk per window (how fast the true value may
+move: the preload of a bearing swings within minutes, a film correlation does not) and hard
+bounds (no physical spindle is outside them).
+
+The tangent operators here give, for a mean temperature T̄ after a backward-Euler step,
+∂(right-hand side − A(φ)·T̄)/∂φ_i: the heat a unit log-change of each parameter adds at
+every node, which is what the ensemble's perturbations are driven by (`twin.estimation.
+forecast`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from twin.spindle.conditions import FILM_GROUPS, SIDES, BoundaryConditions
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One estimated log-factor.
+
+    name       H_front, H_rear (bearing heat), R_front, R_rear (ring/sleeve contact
+               resistance), motor (motor loss), film_<group> (FILM_GROUPS film coefficients)
+    prior_sd   spread of the prior in log space (0.2 ≈ ±20 %)
+    walk_sd    random-walk spread added per 60 s window, log space
+    bounds     (lowest, highest) factor on the nominal value
+    """
+
+    name: str
+    prior_sd: float
+    walk_sd: float
+    bounds: tuple[float, float]
+
+    @property
+    def log_bounds(self) -> tuple[float, float]:
+        return math.log(self.bounds[0]), math.log(self.bounds[1])
+
+
+ALL_PARAMETERS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter("H_front", 0.30, 0.030, (0.3, 3.0)),
+        Parameter("H_rear", 0.30, 0.030, (0.3, 3.0)),
+        Parameter("R_front", 0.40, 0.030, (0.2, 5.0)),
+        Parameter("R_rear", 0.40, 0.030, (0.2, 5.0)),
+        Parameter("motor", 0.20, 0.010, (0.4, 2.5)),
+        Parameter("film_coolant", 0.25, 0.005, (0.3, 3.0)),
+        Parameter("film_housing", 0.25, 0.005, (0.3, 3.0)),
+        Parameter("film_air_gap", 0.25, 0.005, (0.3, 3.0)),
+        Parameter("film_rotor", 0.25, 0.005, (0.3, 3.0)),
+    )
+}
+"""Every candidate.  Prior spreads follow REFERENCE.md §7 (motor ±20–30 %, films ±20–40 %)
+and the paper's corrections (bearing heat and contact resistance moving by tens of %)."""
+
+DEFAULT_PARAMETERS: tuple[str, ...] = (
+    "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor",
+)
+"""The estimator's default set; see `twin.estimation.method` for the sensitivity study."""
+
+
+def parameters(names: Sequence[str]) -> tuple[Parameter, ...]:
+    """The Parameter of each name (ValueError naming an unknown one)."""
+    out = []
+    for name in names:
+        if name not in ALL_PARAMETERS:
+            raise ValueError(
+                f"unknown estimated parameter {name!r}; choose from {', '.join(ALL_PARAMETERS)}"
+            )
+        out.append(ALL_PARAMETERS[name])
+    return tuple(out)
+
+
+def factors_of(names: Sequence[str], log_factors: np.ndarray) -> dict[str, float]:
+    """{name: e^φ} for every name (names not estimated are absent)."""
+    return {n: float(math.exp(v)) for n, v in zip(names, np.asarray(log_factors), strict=True)}
+
+
+BOUNDARY_VALUES = ("H_front", "H_rear", "R_front", "R_rear")
+
+
+def apply_factors(bc: BoundaryConditions, factors: dict[str, float]) -> BoundaryConditions:
+    """The conditions with every factor applied (bearing heat, contact, motor, films)."""
+    values = {v: getattr(bc, v) * factors[v] for v in BOUNDARY_VALUES if v in factors}
+    out = bc.scaled({k: v for k, v in factors.items() if k not in BOUNDARY_VALUES})
+    return out.with_values(**values) if values else out
+
+
+class TangentOperators:
+    """∂(heat balance of a step)/∂φ for each parameter, at the applied conditions.
+
+    For a backward-Euler step (C/Δt + K(φ)) T⁺ = C/Δt T + f(φ), a log-change δφ moves the
+    new temperature by (C/Δt + K)⁻¹ G δφ with G = ∂f/∂φ − ∂K/∂φ T⁺, column by column:
+
+        H_side     H · Σ ∫ v dV over the bearing's regions          (heat added, W)
+        motor      Σ q ∫ v dV over rotor and stator
+        R_side     (1/R) K_side T⁺                                  (K_side: unit interface)
+        film_g     Σ_b∈g h_b (∫ v T∞ dA − M_b T⁺)                   (M_b: unit film matrix)
+
+    Built once per window from the applied conditions; `columns(T)` is cheap (one sparse
+    mat-vec per contact and film parameter).
+    """
+
+    def __init__(self, problem, bc: BoundaryConditions, names: Sequence[str]) -> None:  # noqa: ANN001
+        n = problem.n_dofs
+        self.names = tuple(names)
+        self.constant = np.zeros((n, len(self.names)))
+        self.linear: list[tuple[int, sp.csr_matrix]] = []
+        interfaces = dict(bc.interfaces)
+        for i, name in enumerate(self.names):
+            if name in ("H_front", "H_rear"):
+                side = name.split("_")[1]
+                value = getattr(bc, name)
+                for region in bc.bearing_regions[side]:
+                    self.constant[:, i] += value * problem.source_vector(region)
+            elif name == "motor":
+                for region, q in bc.motor_heat.items():
+                    self.constant[:, i] += q * problem.source_vector(region)
+            elif name in ("R_front", "R_rear"):
+                side = name.split("_")[1]
+                assert side in SIDES
+                op = problem.ops.matrix({f"interface:{interfaces[side]}": 1.0})
+                self.linear.append((i, -op / getattr(bc, name)))
+            elif name.startswith("film_"):
+                group = name[len("film_"):]
+                op = None
+                for b in FILM_GROUPS[group]:
+                    if b not in bc.convection:
+                        continue
+                    h, t_inf = bc.convection[b]
+                    self.constant[:, i] += h * t_inf * problem.facet_load(b)
+                    term = h * problem.ops.matrix({f"film:{b}": 1.0})
+                    op = term if op is None else op + term
+                if op is not None:
+                    self.linear.append((i, op))
+            else:
+                raise ValueError(f"no tangent operator for parameter {name!r}")
+
+    def columns(self, T: np.ndarray) -> np.ndarray:
+        """G (n, p) at the new temperature T (°C), W per unit log-factor."""
+        G = self.constant.copy()
+        for i, op in self.linear:
+            G[:, i] -= op @ T
+        return G
