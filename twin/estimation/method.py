@@ -72,6 +72,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import WindowFeatures
 from twin.correction.result import Correction
 from twin.estimation.analysis import etkf_update
@@ -113,9 +114,9 @@ class EstimatorConfig:
     drift_rel_sd: float = 0.03
     """Relative uncertainty of the drift beyond the field (expansion ±5 %, uniform)."""
     drift_noise_um: float = 0.1
-    step_s: float = 4.0
-    steps_per_window: int = 15
-    window_s: float = 60.0
+    step_s: float = STEP_S
+    steps_per_window: int = STEPS_PER_WINDOW
+    window_s: float = WINDOW_S
     seed: int = 0
     field_update: float = 1.0
     """Share of the analysis increment applied to the field (1: the full ETKF update)."""
