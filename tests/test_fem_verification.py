@@ -23,6 +23,17 @@ def on_z(value: float):
     return lambda r, z: np.isclose(z, value)
 
 
+def shaft_in_sleeve(r_edges, z_edges, r_seat: float, boundaries) -> AxiMesh:
+    """A shaft (r < r_seat) in a sleeve, joined across the split interface "seat"."""
+    return AxiMesh.structured(
+        r_edges,
+        z_edges,
+        regions={"shaft": lambda r, z: r < r_seat, "sleeve": lambda r, z: r > r_seat},
+        boundaries=boundaries,
+        interfaces={"seat": on_r(r_seat)},
+    )
+
+
 # --------------------------------------------------------------------------------------
 # 1. Manufactured solution with every term: conduction, source, flux, convection, fixed
 #    temperature and a contact resistance across an interface.
@@ -215,15 +226,14 @@ def test_crank_nicolson_is_second_order_in_time():
 # --------------------------------------------------------------------------------------
 @pytest.mark.parametrize("order", [1, 2])
 def test_free_thermal_expansion(order):
-    mesh = AxiMesh.structured(
+    mesh = shaft_in_sleeve(
         np.linspace(0.0, 0.1, 9),
         np.linspace(0.0, 0.2, 9),
-        regions={"core": lambda r, z: r < 0.05, "ring": lambda r, z: r > 0.05},
+        0.05,
         boundaries={"axis": on_r(0.0), "base": on_z(0.0)},
-        interfaces={"seat": on_r(0.05)},
     )
     soft = Material(k=20.0, rho=7000.0, c=500.0, E=70e9, nu=0.33, alpha=STEEL.alpha)
-    materials = {"core": STEEL, "ring": soft}
+    materials = {"shaft": STEEL, "sleeve": soft}
     elastic = ElasticProblem(mesh, materials, {"axis": "r", "base": "z"}, T_ref=20.0, order=order)
     thermal = ThermalProblem(mesh, materials, order=order)
     dT = 80.0
@@ -280,12 +290,11 @@ def test_thick_cylinder_thermal_stress():
 @pytest.mark.parametrize("order", [1, 2])
 def test_contact_resistance_jump_is_flux_times_r(order):
     a, rc, b, q, r_contact = 0.02, 0.05, 0.1, 5e4, 2e-4
-    mesh = AxiMesh.structured(
+    mesh = shaft_in_sleeve(
         np.linspace(a, b, 25),
         np.linspace(0.0, 0.02, 3),
-        regions={"shaft": lambda r, z: r < rc, "sleeve": lambda r, z: r > rc},
+        rc,
         boundaries={"bore": on_r(a), "surface": on_r(b)},
-        interfaces={"seat": on_r(rc)},
     )
     problem = ThermalProblem(mesh, {"shaft": STEEL, "sleeve": STEEL}, order=order)
     loads = ThermalLoads(
@@ -310,12 +319,11 @@ def test_contact_resistance_jump_is_flux_times_r(order):
 # --------------------------------------------------------------------------------------
 @pytest.mark.parametrize("theta", [1.0, 0.5])
 def test_energy_balance_closes_to_round_off(theta):
-    mesh = AxiMesh.structured(
+    mesh = shaft_in_sleeve(
         np.linspace(0.01, 0.08, 15),
         np.linspace(0.0, 0.1, 21),
-        regions={"shaft": lambda r, z: r < 0.04, "sleeve": lambda r, z: r > 0.04},
+        0.04,
         boundaries={"bore": on_r(0.01), "surface": on_r(0.08), "end": on_z(0.1)},
-        interfaces={"seat": on_r(0.04)},
     )
     problem = ThermalProblem(mesh, {"shaft": STEEL, "sleeve": STEEL})
     loads = ThermalLoads(
@@ -414,12 +422,11 @@ def test_low_rank_window_update_equals_a_fresh_factorization():
     its steps must equal those of a direct solve of the same backward-Euler system."""
     import scipy.sparse.linalg as spla
 
-    mesh = AxiMesh.structured(
+    mesh = shaft_in_sleeve(
         np.linspace(0.01, 0.08, 15),
         np.linspace(0.0, 0.1, 11),
-        regions={"shaft": lambda r, z: r < 0.04, "sleeve": lambda r, z: r > 0.04},
+        0.04,
         boundaries={"surface": on_r(0.08)},
-        interfaces={"seat": on_r(0.04)},
     )
     problem = ThermalProblem(mesh, {"shaft": STEEL, "sleeve": STEEL})
     T = np.full(problem.n_dofs, 22.0)

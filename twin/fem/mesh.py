@@ -22,9 +22,12 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from skfem import MeshTri
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,14 @@ def _facet_keys(facets: np.ndarray, n_nodes: int) -> np.ndarray:
     lo = np.minimum(facets[0], facets[1]).astype(np.int64)
     hi = np.maximum(facets[0], facets[1]).astype(np.int64)
     return lo * n_nodes + hi
+
+
+def _named(table: Mapping[str, T], name: str, kind: str) -> T:
+    """table[name], or a ValueError listing the known names of that kind."""
+    try:
+        return table[name]
+    except KeyError:
+        raise ValueError(f"unknown {kind} {name!r}; known: {', '.join(sorted(table))}") from None
 
 
 def _lookup(sorted_keys: np.ndarray, order: np.ndarray, keys: np.ndarray, what: str) -> np.ndarray:
@@ -82,28 +93,15 @@ class AxiMesh:
         return self.thermal.t.shape[1]
 
     def region(self, name: str) -> np.ndarray:
-        try:
-            return self.regions[name]
-        except KeyError:
-            raise ValueError(
-                f"unknown region {name!r}; known: {', '.join(sorted(self.regions))}"
-            ) from None
+        """Cell indices of region `name`."""
+        return _named(self.regions, name, "region")
 
     def boundary(self, name: str) -> np.ndarray:
-        try:
-            return self.boundaries[name]
-        except KeyError:
-            raise ValueError(
-                f"unknown boundary {name!r}; known: {', '.join(sorted(self.boundaries))}"
-            ) from None
+        """Facet indices (thermal mesh) of boundary `name`."""
+        return _named(self.boundaries, name, "boundary")
 
     def interface(self, name: str) -> Interface:
-        try:
-            return self.interfaces[name]
-        except KeyError:
-            raise ValueError(
-                f"unknown interface {name!r}; known: {', '.join(sorted(self.interfaces))}"
-            ) from None
+        return _named(self.interfaces, name, "interface")
 
     def glued_facets(self, name: str) -> np.ndarray:
         """Facet indices of boundary `name` in the glued (structural) mesh."""
