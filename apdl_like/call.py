@@ -19,12 +19,13 @@ from apdl_like.parser import Statement
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
-ANY = frozenset({"BEGIN", "PREP7", "SOLU", "POST1"})
+ANY = frozenset({"BEGIN", "PREP7", "SOLU", "POST1", "POST26"})
 PREP7 = frozenset({"PREP7"})
 SOLU = frozenset({"SOLU"})
 LOADS = frozenset({"PREP7", "SOLU"})
 POST = frozenset({"POST1"})
-MODEL = frozenset({"PREP7", "SOLU", "POST1"})
+POST26 = frozenset({"POST26"})
+MODEL = frozenset({"PREP7", "SOLU", "POST1", "POST26"})
 
 Handler = Callable[["SessionState", "Call"], None]
 

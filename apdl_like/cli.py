@@ -33,8 +33,11 @@ def run(
                                           "resolved in its folder."),
     out: Path = typer.Option(..., "--out", help="Output folder (created if missing)."),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
+    strict: bool = typer.Option(False, "--strict", help="An unknown or unsupported command "
+                                                        "is an error (exit 2), not a warning."),
 ) -> None:
-    """Run a deck: DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt."""
+    """Run a deck: DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt and
+    the files the deck writes (/OUT, *CFOPEN)."""
     from apdl_like.errors import ApdlError
     from apdl_like.outputs import write_outputs
     from apdl_like.session import Session
@@ -42,8 +45,15 @@ def run(
     if not deck.is_file():
         raise ApdlError("deck not found", file=str(deck))
     check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
-    session = Session(base_dir=deck.parent)
-    session.run_file(deck)
+    session = Session(base_dir=deck.parent, strict=strict)
+    try:
+        session.run_file(deck)
+    finally:
+        if not quiet:
+            for warning in session.state.listing.warnings:
+                typer.echo(warning, err=True)
+    for name in session.state.listing.files:  # the files the deck wrote, same checks
+        check_out_file(out / name, inputs=[deck])
     written = write_outputs(session.state, out)
     if not quiet:
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "

@@ -9,7 +9,10 @@ Grammar (APDL/Fortran precedence; `**` binds tighter than unary minus, so -2**2 
     atom  := NUMBER | NAME | NAME "(" expr ("," expr)* ")" | "(" expr ")"
 
 Numbers take any float notation, including Fortran's `1.5D3`.  Names are parameters
-(case-insensitive).  Functions: ABS SQRT EXP LOG LOG10 SIN COS TAN ASIN ACOS ATAN ATAN2 MIN
+(case-insensitive; `_NAME` too, MAPDL's hidden ones); `NAME(i[,j[,k]])` is an element of an
+array parameter (1-based) unless NAME is a function.  A parameter may share a name with a
+model function (`*GET,TEMP,...` then `TEMP/28`): without parentheses it is the parameter.
+Functions: ABS SQRT EXP LOG LOG10 SIN COS TAN ASIN ACOS ATAN ATAN2 MIN
 MAX SIGN NINT MOD (radians), plus model functions such as NX(n), NY(n), NODE(x,y,z) that the
 caller supplies at evaluation time.  Text is compiled once into closures (cached), so a deck
 that runs every 60 s pays the parse only once.
@@ -41,7 +44,7 @@ _TOKEN = re.compile(
     r"|(?P<op>\*\*|[-+*/(),])"
     r")"
 )
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
 def _sign(a: float, b: float) -> float:
@@ -85,7 +88,6 @@ MODEL_FUNCTIONS: dict[str, tuple[int, int]] = {
     "UY": (1, 1),
 }
 
-RESERVED = frozenset(BUILTINS) | frozenset(MODEL_FUNCTIONS)
 
 
 def _tokenize(text: str) -> list[tuple[str, str]]:
@@ -109,7 +111,7 @@ def is_parameter_name(name: str) -> bool:
     return (
         bool(_NAME.match(name))
         and len(name) <= MAX_NAME_CHARS
-        and name.upper() not in RESERVED
+        and name.upper() not in BUILTINS
     )
 
 
@@ -207,7 +209,7 @@ class _Parser:
                 self.expect(")")
                 self.depth -= 1
                 return self.call(name, args)
-            if name in RESERVED:
+            if name in BUILTINS:
                 raise self.fail(f"function {name} needs arguments")
             if len(name) > MAX_NAME_CHARS:
                 raise self.fail(f"parameter name {value!r} longer than {MAX_NAME_CHARS}")
@@ -231,7 +233,9 @@ class _Parser:
             if not lo <= len(args) <= hi:
                 raise self.fail(f"{name} takes {_arity(lo, hi)}, got {len(args)}")
             return _model_call(name, args)
-        raise self.fail(f"unknown function {name}")
+        if len(args) > 3:
+            raise self.fail(f"array {name} takes 1 to 3 subscripts, got {len(args)}")
+        return _array_element(name, args)
 
 
 def _arity(lo: int, hi: int) -> str:
@@ -249,11 +253,51 @@ def _constant(value: float) -> Evaluator:
 def _parameter(name: str) -> Evaluator:
     def param(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
         try:
-            return params[name]
+            value = params[name]
         except KeyError:
             raise ApdlError(f"undefined parameter {name}") from None
+        if isinstance(value, float):
+            return value
+        if isinstance(value, str):
+            raise ApdlError(f"{name} is a character parameter (a number is needed here)")
+        if isinstance(value, int):
+            return float(value)
+        raise ApdlError(f"{name} is an array: give its subscripts, {name}(i,j)")
 
     return param
+
+
+def _array_element(name: str, args: list[Evaluator]) -> Evaluator:
+    def element(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
+        array = params.get(name)
+        if array is None:
+            raise ApdlError(f"unknown function or array {name}")
+        return array_value(name, array, [a(params, funcs) for a in args])
+
+    return element
+
+
+def array_value(name: str, array: object, subscripts: list[float]) -> float:
+    """NAME(i, j, k) of a numeric array parameter (1-based subscripts, missing ones 1)."""
+    if not hasattr(array, "shape"):
+        raise ApdlError(f"{name} is not an array parameter")
+    index = array_index(name, array.shape, subscripts)  # type: ignore[attr-defined]
+    value = array[index]  # type: ignore[index]
+    if isinstance(value, str):
+        raise ApdlError(f"{name} is a character array (a number is needed here)")
+    return float(value)
+
+
+def array_index(name: str, shape: tuple[int, ...], subscripts: list[float]) -> tuple[int, ...]:
+    """0-based index of `NAME(i, j, k)`; an ApdlError names the subscript out of range."""
+    out = []
+    for axis, size in enumerate(shape):
+        sub = subscripts[axis] if axis < len(subscripts) else 1.0
+        i = int(round(sub))
+        if abs(sub - i) > 1e-9 or not 1 <= i <= size:
+            raise ApdlError(f"subscript {axis + 1} of {name} is {sub:g}, outside 1..{size}")
+        out.append(i - 1)
+    return tuple(out)
 
 
 def _negate(inner: Evaluator) -> Evaluator:

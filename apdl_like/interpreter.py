@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING
 from apdl_like.call import Call
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import compile_expression, is_parameter_name
-from apdl_like.parser import Program, Statement, read_deck
-from apdl_like.registry import REGISTRY
+from apdl_like.params import store, subscripts, value_of
+from apdl_like.parser import Program, Statement, read_deck, split_fields
+from apdl_like.registry import lookup
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -86,17 +87,18 @@ def _condition(session: SessionState, st: Statement) -> tuple[bool, str]:
 
 
 def _assign(session: SessionState, st: Statement) -> None:
-    name, expr = st.fields
+    """`NAME = value` or `NAME(i,j) = v1, v2, ...` (down the column)."""
+    name, subs_text, *values = st.fields
     if not is_parameter_name(name):
-        raise st.error(f"{name!r} is not a valid parameter name (≤ 32 characters, letter first, "
-                       "not a function name)")
-    if not expr:
-        session.params.pop(name, None)  # `NAME =` deletes the parameter, as in APDL
-        return
-    if expr.startswith("'"):
-        raise st.error("character parameters are not supported (numeric parameters only)")
+        raise st.error(f"{name!r} is not a valid parameter name (≤ 32 characters, letter or _ "
+                       "first, not a function name)")
+    params, funcs = session.params, session.model_functions
     try:
-        session.params[name] = compile_expression(expr)(session.params, session.model_functions)
+        if not subs_text and values == [""]:
+            params.pop(name, None)  # `NAME =` deletes the parameter, as in APDL
+            return
+        subs = subscripts(split_fields(subs_text), params, funcs) if subs_text else []
+        store(params, name, subs, [value_of(v, params, funcs) for v in values])
     except ApdlError as exc:
         raise st.error(exc.reason) from None
 
@@ -114,6 +116,8 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
             raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
         name = st.name
         try:
+            if name == "ERROR":
+                raise st.error(st.fields[0])
             if name == "=":
                 _assign(session, st)
             elif name == "*DO":
@@ -245,12 +249,16 @@ def _input(session: SessionState, st: Statement, depth: int) -> None:
 
 
 def _dispatch(session: SessionState, st: Statement) -> None:
-    spec = REGISTRY.get(st.name)
+    spec = lookup(st.name)
     if spec is None:
-        raise st.error(f"unknown or unsupported command {st.name}")
+        message = f"unknown or unsupported command {st.name}"
+        if session.strict:
+            raise st.error(message + " (--strict)")
+        session.warn(st.error(message + "; ignored"))
+        return
     if session.processor not in spec.processors:
         where = {"BEGIN": "the begin level", "PREP7": "/PREP7", "SOLU": "/SOLU",
-                 "POST1": "/POST1"}
+                 "POST1": "/POST1", "POST26": "/POST26"}
         allowed = " or ".join(where[p] for p in sorted(spec.processors))
         raise st.error(f"not valid in {where[session.processor]} (use it in {allowed})")
     if len(st.fields) > spec.max_fields:

@@ -350,6 +350,12 @@ class SolutionSettings:
     nsubst: int | None = None
     kbc: int = 0
     timint: bool | None = None  # None: the default of the analysis type
+    autots: bool | None = None  # None: MAPDL's default (on for a thermal transient)
+    dtmin: float | None = None  # DELTIM bounds (with AUTOTS)
+    dtmax: float | None = None
+    nsub_max: int | None = None  # NSUBST bounds (with AUTOTS)
+    nsub_min: int | None = None
+    theta: float = 1.0  # TINTP: 1 backward Euler, 0.5 Crank-Nicolson
     outres: str = "ALL"
     tref: float = 0.0
     tunif: float = 0.0
@@ -375,6 +381,9 @@ class Database:
     meshed_areas: set[int] = field(default_factory=set)
     esize: float | None = None
     title: str = ""
+    csys: int = 0  # active coordinate system (0 Cartesian, 1 cylindrical: x = r, y = θ in °)
+    # coupled DOF sets (CP): set number -> (label, node numbers)
+    couplings: dict[int, tuple[str, np.ndarray]] = field(default_factory=dict)
     last_real: tuple[int, int] | None = None  # (set, next location) for RMORE
     # contact interface (of an AxiMesh session) -> its real-constant set (TCC at 14)
     contact_real_sets: dict[str, int] = field(default_factory=dict)

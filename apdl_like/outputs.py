@@ -66,7 +66,8 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
 
 
 def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
-    """params.json, result_NNN.vtu (one per solved load step) and log.txt under `out_dir`."""
+    """params.json, result_NNN.vtu (one per solved load step), log.txt and the files the deck
+    wrote (/OUT, *CFOPEN; names checked when the deck opened them) under `out_dir`."""
     out = Path(out_dir)
     written = []
     params = out / "params.json"
@@ -79,4 +80,8 @@ def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     log = out / "log.txt"
     write_text(log, "\n".join(session.log) + "\n")
     written.append(log)
+    for name, lines in sorted(session.listing.files.items()):
+        path = out / name
+        write_text(path, "".join(line + "\n" for line in lines))
+        written.append(path)
     return written

@@ -1,12 +1,17 @@
 """Lexing an APDL deck into statements (APDL conventions, case-insensitive).
 
 One line is one statement: a command with comma-separated fields (`D,ALL,TEMP,20`; empty
-fields allowed, `NSEL,S,LOC,X,,0.1`), or a parameter assignment `NAME = expr`.  `!` starts a
-comment; `/COM` and `/TITLE` keep the rest of the line as text.  Fields stay text here; the
-command that uses a field decides whether it is a label or an expression.
+fields allowed, `NSEL,S,LOC,X,,0.1`), or a parameter assignment `NAME = expr` or
+`NAME(i,j) = v1, v2, ...` (array elements down a column).  `!` starts a comment, and so does
+a line starting with `C***` (MAPDL's old comment card); `/COM` and `/TITLE` keep the rest of
+the line as text; text in single quotes is a character value (commas and `!` inside it are
+text).  Fields stay text here; the command that uses a field decides whether it is a label,
+an expression or a character value.  `*VWRITE`/`*MWRITE` carry their format line.
 
-`parse_deck` also matches the blocks (`*DO/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) so that a
-deck with an unclosed block fails before anything runs.
+A line that cannot be lexed becomes an `ERROR` statement holding the message, so a bad line
+stops the deck where it stands, not before the lines ahead of it have run.  Blocks
+(`*DO/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) are matched up front; a block that does not close
+truncates the program at its opening line, with the error raised there.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ MAX_DECK_BYTES = 20_000_000  # far above any real deck; stops accidental binary/
 MAX_LINE_CHARS = 640  # the APDL command-line limit
 MAX_FIELDS = 40
 
-_ASSIGNMENT = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*)\s*=(?!=)(.*)\Z", re.S)
+_ASSIGNMENT = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*(\([^=']*\))?\s*=(?!=)(.*)\Z", re.S)
 _COMMAND_NAME = re.compile(r"[/*]?[A-Za-z][A-Za-z0-9_\-]*\Z")
 _TEXT_COMMANDS = ("/COM", "/TITLE", "/STITLE", "/EOF")
 
@@ -33,16 +38,21 @@ class Statement:
 
     file: str
     line: int
-    name: str  # upper-case command name, or "=" for an assignment
-    fields: tuple[str, ...]  # text after the name, split at commas (assignment: (name, expr))
+    name: str  # upper-case command name, "=" for an assignment, "ERROR" for a bad line
+    # text after the name, split at commas; an assignment: (name, subscripts text, value 1,
+    # value 2, ...); an ERROR: (message,)
+    fields: tuple[str, ...]
     text: str = ""  # the raw line (for /COM, /TITLE and messages)
-    block: tuple[str, ...] = ()  # NBLOCK/EBLOCK/CMBLOCK: the format line and the data lines
+    # NBLOCK/EBLOCK/CMBLOCK: the format line and the data lines; *VWRITE: the format line
+    block: tuple[str, ...] = ()
 
     def error(self, message: str) -> ApdlError:
         return ApdlError(message, file=self.file, line=self.line, command=self.shown)
 
     @property
     def shown(self) -> str:
+        if self.name == "ERROR":
+            return self.fields[1]
         return f"{self.fields[0]}=" if self.name == "=" else self.name
 
 
@@ -70,11 +80,16 @@ def _strip_comment(line: str) -> str:
     return line
 
 
-def _split_fields(body: str) -> list[str]:
-    """Split at commas outside parentheses: `*GET,T,NODE,NODE(0.1,0),TEMP` has 5 fields."""
-    parts, depth, start = [], 0, 0
+def split_fields(body: str) -> list[str]:
+    """Split at commas outside parentheses and quotes: `*GET,T,NODE,NODE(0.1,0),TEMP` has 5
+    fields, `L(1) = 'T,F(AT X','q'` has 2 values."""
+    parts, depth, start, quoted = [], 0, 0, False
     for i, ch in enumerate(body):
-        if ch == "(":
+        if ch == "'":
+            quoted = not quoted
+        elif quoted:
+            continue
+        elif ch == "(":
             depth += 1
         elif ch == ")":
             depth = max(depth - 1, 0)
@@ -90,7 +105,7 @@ def lex_line(raw: str, file: str, number: int) -> Statement | None:
     try:
         lexed = _lex(raw)
     except ApdlError as exc:
-        raise exc.located(file, number, None) from None
+        lexed = ("ERROR", (exc.reason, exc.command or ""))
     if lexed is None:
         return None
     return Statement(file, number, lexed[0], lexed[1], raw)
@@ -103,6 +118,8 @@ def _lex(raw: str) -> tuple[str, tuple[str, ...]] | None:
         raise ApdlError(f"line longer than {MAX_LINE_CHARS} characters")
     head = raw.lstrip()
     upper = head[:7].upper()
+    if upper.startswith("C***"):
+        return None
     for text_cmd in _TEXT_COMMANDS:
         n = len(text_cmd)
         if upper.startswith(text_cmd) and (len(head) == n or head[n] in ", \t"):
@@ -115,9 +132,11 @@ def _lex(raw: str) -> tuple[str, tuple[str, ...]] | None:
     if "\x00" in body:
         raise ApdlError("binary data in deck")
     m = _ASSIGNMENT.match(body)
-    if m is not None and "," not in body[: m.start(2)]:
-        return "=", (m.group(1).upper(), m.group(2).strip())
-    parts = _split_fields(body) if "(" in body else body.split(",")
+    if m is not None and "," not in body[: m.start(1) if m.group(2) is None else m.end(1)]:
+        subscripts = (m.group(2) or "").strip()[1:-1].strip()
+        values = split_fields(m.group(3)) if "," in m.group(3) else [m.group(3)]
+        return "=", (m.group(1).upper(), subscripts, *(v.strip() for v in values))
+    parts = split_fields(body) if "(" in body or "'" in body else body.split(",")
     name = parts[0].strip().upper()
     if not _COMMAND_NAME.match(name):
         shown = parts[0].strip() or "(empty)"
@@ -170,6 +189,7 @@ def _if_is_block(st: Statement) -> bool:
 
 
 BLOCK_COMMANDS = ("NBLOCK", "EBLOCK", "CMBLOCK")
+FORMAT_COMMANDS = ("*VWRITE", "*MWRITE", "*VREAD", "*MSG")  # the next line is their format
 MAX_BLOCK_LINES = 5_000_000
 
 
@@ -223,12 +243,30 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
         if st.name == "/EOF":
             break
         if st.name in BLOCK_COMMANDS:
-            data, used = _block_lines(st, lines, number)
+            try:
+                data, used = _block_lines(st, lines, number)
+            except ApdlError as exc:
+                statements.append(Statement(file, st.line, "ERROR", (exc.reason, st.name)))
+                break
             st = Statement(st.file, st.line, st.name, st.fields, st.text, data)
             number += used
+        elif st.name in FORMAT_COMMANDS:
+            if number >= len(lines):
+                statements.append(Statement(file, st.line, "ERROR",
+                                            ("the format line is missing", st.name)))
+                break
+            st = Statement(st.file, st.line, st.name, st.fields, st.text, (lines[number],))
+            number += 1
         statements.append(st)
     program = Program(file, statements)
-    _match_blocks(program)
+    try:
+        _match_blocks(program)
+    except ApdlError as exc:
+        # run what comes before the bad block, then stop there with its message
+        bad = next(i for i, st in enumerate(statements) if st.line == exc.line)
+        program = Program(file, statements[:bad] + [
+            Statement(file, statements[bad].line, "ERROR", (exc.reason, exc.command or ""))])
+        _match_blocks(program)
     return program
 
 

@@ -11,9 +11,9 @@ from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 
 from apdl_like.call import CommandSpec
-from apdl_like.commands import begin, blocks, loads, post1, prep7, selection, solution
+from apdl_like.commands import begin, blocks, loads, post1, prep7, selection, solution, tables
 
-FAMILIES = (begin, blocks, loads, post1, prep7, selection, solution)
+FAMILIES = (begin, blocks, loads, post1, prep7, selection, solution, tables)
 
 
 def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:
@@ -28,3 +28,23 @@ def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:
 
 REGISTRY: Mapping[str, CommandSpec] = build_registry(
     spec for family in FAMILIES for spec in family.COMMANDS)
+
+ABBREVIATION_LENGTH = 4  # MAPDL reads a command by its first four characters
+
+
+def lookup(name: str) -> CommandSpec | None:
+    """The command `name` stands for: exact, or the same first four letters.
+
+    `FINI` is FINISH, `ANTY` ANTYPE, `/SOLUTION` /SOLU (a longer spelling); a name that fits
+    several commands stands for none.
+    """
+    spec = REGISTRY.get(name)
+    if spec is not None:
+        return spec
+    core = name.lstrip("/*")
+    if len(core) < ABBREVIATION_LENGTH:
+        return None
+    prefix = name[: len(name) - len(core) + ABBREVIATION_LENGTH]
+    matches = [spec for key, spec in REGISTRY.items()
+               if key.startswith(prefix) and (key.startswith(name) or name.startswith(key))]
+    return matches[0] if len(matches) == 1 else None

@@ -42,8 +42,10 @@ from twin.fem import AxiMesh, Material, ThermalProblem
 class Session:
     """A persistent APDL-like session: runs decks against one `SessionState`."""
 
-    def __init__(self, base_dir: str | Path | None = None) -> None:
-        self.state = SessionState(base_dir=Path(base_dir) if base_dir is not None else None)
+    def __init__(self, base_dir: str | Path | None = None, strict: bool = False) -> None:
+        """base_dir  the folder /INPUT reads from; strict  unknown commands are errors"""
+        self.state = SessionState(base_dir=Path(base_dir) if base_dir is not None else None,
+                                  strict=strict)
         self.layout: DeckLayout | None = None  # the deck names of an AxiMesh's sets
 
     # read-only views the callers use most
@@ -61,7 +63,7 @@ class Session:
 
     @property
     def log(self) -> list[str]:
-        return self.state.log
+        return self.state.listing.log
 
     @property
     def thermal(self) -> ThermalProblem | None:

@@ -10,9 +10,12 @@
               `Session.set_state` / `Session.advance`
     budget    `RunBudget`, the per-run counters that keep a deck finite: written by
               `apdl_like.interpreter`; reset by `Session.run_program`
-    processor, log, base_dir, record_only, recorded_solves
-              the deck context: processor commands, /COM and messages, /INPUT folder, and
-              the solve-recording mode of `apdl_like.loadset.read_window_deck`
+    listing   `Listing`: the run's log, warnings and the files the deck writes (/OUT,
+              *CFOPEN), kept in memory until the CLI writes them inside --out
+    saved     SAVE/RESUME: named copies of the database and parameters, in memory
+    processor, base_dir, strict, record_only, recorded_solves
+              the deck context: processor commands, /INPUT folder, unknown commands as
+              errors (--strict), the solve-recording mode of `Session.read_window_deck`
 
 Command handlers take a `SessionState`; nothing here imports the commands or the session.
 """
@@ -89,6 +92,23 @@ class RunBudget:
 
 
 @dataclass
+class Listing:
+    """Where output goes: the log, or the file named by /OUT (in memory, by file name)."""
+
+    log: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    files: dict[str, list[str]] = field(default_factory=dict)
+    target: str | None = None  # /OUT file receiving output; None: the log
+    command_file: str | None = None  # *CFOPEN file receiving *CFWRITE lines
+
+    def write(self, text: str) -> None:
+        if self.target is None:
+            self.log.append(text)
+        else:
+            self.files[self.target].append(text)
+
+
+@dataclass
 class SessionState:
     """Everything a deck reads and writes (see the module docstring for the owners)."""
 
@@ -97,9 +117,11 @@ class SessionState:
     fem: FemCache = field(default_factory=FemCache)
     solution: Solution = field(default_factory=Solution)
     budget: RunBudget = field(default_factory=RunBudget)
+    listing: Listing = field(default_factory=Listing)
+    saved: dict[str, tuple[Database, dict]] = field(default_factory=dict)
     processor: str = "BEGIN"
-    log: list[str] = field(default_factory=list)
     base_dir: Path | None = None
+    strict: bool = False  # an unknown command is an error, not a warning
     record_only: bool = False  # SOLVE records what it would solve instead of solving
     recorded_solves: list[dict] = field(default_factory=list)
     model_functions: dict[str, Any] = field(init=False, repr=False)
@@ -111,8 +133,19 @@ class SessionState:
         }
 
     # ------------------------------------------------------------- messages
+    @property
+    def log(self) -> list[str]:
+        return self.listing.log
+
     def say(self, text: str) -> None:
-        self.log.append(text)
+        """A line of output: to the /OUT file when one is open, else to the log."""
+        self.listing.write(text)
+
+    def warn(self, warning: ApdlError) -> None:
+        """A located warning (an unknown command): kept, and shown in the log."""
+        text = f"warning: {warning}"
+        self.listing.warnings.append(text)
+        self.listing.log.append(text)
 
     def note_load(self, call) -> None:  # noqa: ANN001 - an apdl_like.call.Call
         """Remember the first load after the last SOLVE (a deck must not end there)."""
@@ -184,7 +217,9 @@ class SessionState:
 
     # -------------------------------------------------------------- outputs
     def scalar_parameters(self) -> dict[str, float]:
-        return {k.upper(): float(v) for k, v in sorted(self.params.items())}
+        """The numeric scalar parameters (arrays and character values left out)."""
+        return {k.upper(): float(v) for k, v in sorted(self.params.items())
+                if isinstance(v, float | int)}
 
     def contact_conductance(self) -> dict[str, float]:
         """Current TCC (W/m²K) per contact interface that has one."""

@@ -27,7 +27,7 @@ def test_fields_comments_and_case():
     assert st_.name == "NSEL"
     assert st_.fields == ("s", "LOC", "x", "", "0.1")
     assert lex_line("   ! only a comment", "f", 1) is None
-    assert lex_line("Ri = 0.02 ! m", "f", 1).fields == ("RI", "0.02")
+    assert lex_line("Ri = 0.02 ! m", "f", 1).fields == ("RI", "", "0.02")
     com = lex_line("/COM, keep ! this, text", "f", 1)
     assert com.name == "/COM" and com.fields == ("keep ! this, text",)
 
@@ -91,7 +91,6 @@ def test_nested_loops():
 
 @pytest.mark.parametrize("deck, line, message", [
     ("A = 1\nB = C + 1\n", 2, "undefined parameter C"),
-    ("/PREP7\nFROBNICATE,1\n", 2, "unknown or unsupported command FROBNICATE"),
     ("*DO,I,1,3\nA = I\n", 1, "never closed"),
     ("A = 1\n*ENDIF\n", 2, "does not close"),
     ("*ELSE\n", 1, "without an open"),
@@ -105,7 +104,10 @@ def test_nested_loops():
     ("/SOLU\nANTYPE,STATIC\nTIME,1\n", 3, "never solved"),
     ("/INPUT,../secret,inp\n", 1, "outside the deck's folder"),
     ("*IF,1,EQ,1,:LABEL\n", 1, "GO labels are not supported"),
-    ("A = 'text'\n", 1, "character parameters"),
+    ("A = 'text'\nB = A + 1\n", 2, "A is a character parameter"),
+    ("A = 1\nB = A(2)\n", 2, "A is not an array"),
+    ("*DIM,V,,2\nV(3) = 1\n", 2, "subscript 1 of V is 3, outside 1..2"),
+    ("A = 1\nB = (\nC = 2\n", 2, "unexpected end"),
 ])
 def test_bad_decks_name_file_line_and_command(deck, line, message, tmp_path):
     s = Session(base_dir=tmp_path)
@@ -114,6 +116,27 @@ def test_bad_decks_name_file_line_and_command(deck, line, message, tmp_path):
     assert info.value.file == "deck.inp"
     assert info.value.line == line
     assert str(info.value).startswith(f"deck.inp:{line}: ")
+
+
+def test_unknown_commands_warn_and_the_run_goes_on_strict_stops(tmp_path):
+    s = Session()
+    s.run_text("A = 1\nFROBNICATE,1\nB = A + 1\n", "deck.inp")
+    assert s.params["B"] == 2.0
+    assert s.state.listing.warnings == [
+        "warning: deck.inp:2: FROBNICATE: unknown or unsupported command FROBNICATE; ignored"]
+    strict = Session(strict=True)
+    with pytest.raises(ApdlError, match="deck.inp:2: FROBNICATE: unknown"):
+        strict.run_text("A = 1\nFROBNICATE,1\nB = A + 1\n", "deck.inp")
+    assert strict.params == {"A": 1.0}  # what came before the bad line has run
+
+
+def test_abbreviations_and_processor_rules():
+    s = Session()
+    s.run_text("/PREP7\nANTY,TRANS\nKBC,1\nDELTIM,1\nFINI\n/SOLUTION\n"
+               "NSUB,4\nALLS\nFINISH\n", "deck.inp")
+    settings = s.db.settings
+    assert settings.antype == "TRANS" and settings.kbc == 1
+    assert settings.nsubst == 4 and s.state.listing.warnings == []
 
 
 def test_runaway_loops_stop(tmp_path):
@@ -231,3 +254,42 @@ def test_parse_only_never_raises_other_errors():
             parse_deck(text)
         except ApdlError:
             pass
+
+
+TABLE_DECK = """C*** a results table as the Verification Manual writes it
+/COM,header line
+*DIM,VALUE,,3,3
+*DIM,LABEL,CHAR,3,2
+LABEL(1,1) = 'T,F(AT X','T (C) X=','q'
+LABEL(1,2) = '/L = 0.0','.2788 in','/hr'
+*VFILL,VALUE(1,1),DATA,1100,-.67037,5050
+_T2 = -0.6712
+*VFILL,VALUE(1,2),DATA,1100.4,_T2,4998.2
+*DO,I,1,3
+VALUE(I,3) = ABS(VALUE(I,2)/VALUE(I,1))
+*ENDDO
+SAVE,TABLE_1
+VALUE(1,1) = 0
+RESUME,TABLE_1
+/OUT,vm0,vrt
+/COM,table
+*VWRITE,LABEL(1,1),LABEL(1,2),VALUE(1,1),VALUE(1,2),VALUE(1,3)
+(1X,A8,A8,'   ',F10.0,'  ',F14.5,'   ',1F15.3)
+/OUT
+*LIST,vm0,vrt
+"""
+
+
+def test_results_table_idiom_writes_fortran_formatted_rows():
+    s = Session()
+    s.run_text(TABLE_DECK, "t.inp")
+    rows = s.state.listing.files["vm0.vrt"]
+    assert rows == [
+        "table",
+        " T,F(AT X/L = 0.0        1100.      1100.40000             1.000",
+        " T (C) X=.2788 in          -1.        -0.67120             1.001",
+        "        q     /hr        5050.      4998.20000             0.990",
+    ]
+    assert s.log[-4:] == rows  # *LIST copies the file into the output
+    assert "header line" in s.log[0]
+    assert s.params["_T2"] == -0.6712

@@ -241,7 +241,7 @@ PRNSOL,TEMP
 
 
 @pytest.mark.parametrize("text, where", [
-    ("/PREP7\nN,1,0,0\nBOGUS,1\n", "d.inp:3: BOGUS"),
+    ("/PREP7\nN,1,0,0\nET,1,PLANE55\nMP,KXX,1,-1\n", "d.inp:4: MP"),
     ("/SOLU\nSOLVE\n", "d.inp:2: SOLVE"),
     ("A = 1/0\n", "d.inp:1: A="),
 ])
@@ -253,3 +253,15 @@ def test_cli_bad_deck_exits_2_without_traceback(tmp_path, text, where):
     assert done.returncode == 2
     assert where in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "o" / "params.json").exists()
+
+
+def test_cli_warns_on_unknown_commands_and_strict_makes_them_errors(tmp_path):
+    deck = tmp_path / "d.inp"
+    deck.write_text("A = 2\nBOGUS,1\n")
+    run = [sys.executable, "-m", "apdl_like", "run", str(deck), "--out", str(tmp_path / "o")]
+    done = subprocess.run(run, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "d.inp:2: BOGUS: unknown or unsupported command BOGUS; ignored" in done.stderr
+    strict = subprocess.run([*run, "--strict"], capture_output=True, text=True, timeout=120)
+    assert strict.returncode == 2 and "d.inp:2: BOGUS" in strict.stderr
+    assert "Traceback" not in strict.stderr

@@ -31,21 +31,18 @@ def title(s: SessionState, c: Call) -> None:
 
 # output controls that archives and MAPDL decks carry; they change nothing here
 OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VERIFY",
-                   "/OUTPUT", "/NERR", "/SHOW", "/CONFIG", "/FILNAME", "/CLEAR")
-
-
-def star_set(s: SessionState, c: Call) -> None:
-    name = c.raw(1).upper()
-    if not is_parameter_name(name):
-        raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
-    if not c.given(2):
-        s.params.pop(name, None)
-        return
-    if c.raw(2).startswith("'"):
-        raise ApdlError("character parameters are not supported (numeric parameters only)")
-    if c.count() > 2:
-        raise ApdlError("array parameters are not supported (one value per *SET)")
-    s.params[name] = c.num(2, what="VALUE")
+                   "/NERR", "/SHOW", "/CONFIG", "/FILNAME", "/CLEAR", "/GRAPHICS", "/VIEW",
+                   "/PNUM", "/NUMBER", "/REPLOT", "/ESHAPE", "/TYPE", "/WINDOW", "/DEVICE",
+                   "/PLOPTS", "/TRIAD", "/AUTO", "/DIST", "/FOCUS", "/ANGLE", "/EDGE",
+                   "/CONTOUR", "/DSCALE", "/ERASE", "/NOERASE", "/HEADER", "/PAGE", "/FORMAT",
+                   "/RGB", "/COLOR", "/PSF", "/PBC", "/PSYMB", "/TRLCY", "/VSCALE", "/GFILE",
+                   "/GST", "/GLINE", "/UIS", "/MENU", "/WAIT", "/OUTOPT", "/ZOOM", "/USER",
+                   "EPLOT", "NPLOT", "KPLOT", "LPLOT", "APLOT", "GPLOT", "PLNSOL", "PLESOL",
+                   "PLVECT", "PLDISP", "PLPATH", "PLVAR", "NLIST", "ELIST", "KLIST", "LLIST",
+                   "ALIST", "DLIST", "SFLIST", "SFELIST", "BFLIST", "BFELIST", "CPLIST",
+                   "MPLIST", "ETLIST", "RLIST", "CMLIST", "PRETAB", "PRESOL", "PRRSOL",
+                   "PRERR", "ANTIME", "ANIM", "SMRTSIZE", "/PMACRO", "/MSTART", "PATH",
+                   "PPATH", "PDEF", "PRPATH")
 
 
 _STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
@@ -100,11 +97,11 @@ def star_get(s: SessionState, c: Call) -> None:
 COMMANDS = (
     CommandSpec("/COM", ANY, 1, com),
     CommandSpec("/TITLE", ANY, 1, title),
-    CommandSpec("*SET", ANY, 11, star_set),
     CommandSpec("*GET", ANY, 8, star_get),
     CommandSpec("/PREP7", ANY, 0, _enter("PREP7")),
     CommandSpec("/SOLU", ANY, 0, _enter("SOLU")),
     CommandSpec("/POST1", ANY, 0, _enter("POST1")),
+    CommandSpec("/POST26", ANY, 0, _enter("POST26")),
     CommandSpec("FINISH", ANY, 0, _enter("BEGIN")),
     CommandSpec("/STITLE", ANY, 1, ignored),
     *(CommandSpec(name, ANY, 10, ignored) for name in OUTPUT_CONTROLS),

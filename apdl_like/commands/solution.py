@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import SOLU, Call, CommandSpec, ignored
+from apdl_like.call import LOADS, SOLU, Call, CommandSpec, ignored
 from apdl_like.errors import ApdlError
 from apdl_like.solve import solve_structural, solve_thermal
 
@@ -46,19 +46,34 @@ def time(s: SessionState, c: Call) -> None:
 
 
 def deltim(s: SessionState, c: Call) -> None:
+    """DELTIM,DTIME,DTMIN,DTMAX: the (first) substep and, with AUTOTS, its bounds."""
     dt = c.num(1, what="DTIME")
     if not dt > 0.0:
         raise ApdlError(f"DTIME must be positive, got {dt!r}")
-    s.db.settings.deltim = dt
-    s.db.settings.nsubst = None
+    settings = s.db.settings
+    settings.deltim, settings.nsubst = dt, None
+    settings.dtmin = c.num(2, what="DTMIN") if c.given(2) else None
+    settings.dtmax = c.num(3, what="DTMAX") if c.given(3) else None
+    if settings.dtmin is not None and not 0.0 < settings.dtmin <= dt:
+        raise ApdlError(f"DTMIN must lie in (0, DTIME], got {settings.dtmin!r}")
+    if settings.dtmax is not None and settings.dtmax < dt:
+        raise ApdlError(f"DTMAX must be ≥ DTIME, got {settings.dtmax!r}")
 
 
 def nsubst(s: SessionState, c: Call) -> None:
+    """NSUBST,NSBSTP,NSBMX,NSBMN: substeps and, with AUTOTS, their bounds."""
     n = c.int(1, what="NSBSTP")
     if not 1 <= n <= 100_000:
         raise ApdlError(f"NSBSTP must lie in 1..100000, got {n}")
-    s.db.settings.nsubst = n
-    s.db.settings.deltim = None
+    settings = s.db.settings
+    settings.nsubst, settings.deltim = n, None
+    nmax = c.int(2, what="NSBMX") if c.given(2) else None
+    nmin = c.int(3, what="NSBMN") if c.given(3) else None
+    if nmax is not None and not n <= nmax <= 1_000_000:
+        raise ApdlError(f"NSBMX must lie in NSBSTP..1000000, got {nmax}")
+    if nmin is not None and not 1 <= nmin <= n:
+        raise ApdlError(f"NSBMN must lie in 1..NSBSTP, got {nmin}")
+    settings.nsub_max, settings.nsub_min = nmax, nmin
 
 
 def kbc(s: SessionState, c: Call) -> None:
@@ -77,6 +92,23 @@ def timint(s: SessionState, c: Call) -> None:
 
 def outres(s: SessionState, c: Call) -> None:
     s.db.settings.outres = c.label(2, "ALL")
+
+
+def autots(s: SessionState, c: Call) -> None:
+    """AUTOTS,ON|OFF (blank: ON): time steps chosen by an error estimate within bounds."""
+    key = c.label(1, "ON")
+    if key not in ("ON", "OFF", "1", "0", "PROG"):
+        raise ApdlError(f"field 1 must be ON or OFF, got {key!r}")
+    s.db.settings.autots = key in ("ON", "1", "PROG")
+
+
+def tintp(s: SessionState, c: Call) -> None:
+    """TINTP,,,,THETA: the transient integration parameter (1 backward Euler, 0.5 CN)."""
+    if c.given(4):
+        theta = c.num(4, what="THETA")
+        if not 0.5 <= theta <= 1.0:
+            raise ApdlError(f"THETA must lie in [0.5, 1], got {theta!r}")
+        s.db.settings.theta = theta
 
 
 # FULL is the only method here
@@ -127,15 +159,21 @@ def solve(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("ANTYPE", SOLU, 4, antype),
-    CommandSpec("TIME", SOLU, 1, time),
-    CommandSpec("DELTIM", SOLU, 4, deltim),
-    CommandSpec("NSUBST", SOLU, 4, nsubst),
-    CommandSpec("KBC", SOLU, 1, kbc),
-    CommandSpec("TIMINT", SOLU, 2, timint),
-    CommandSpec("OUTRES", SOLU, 3, outres),
+    # load-step options: MAPDL accepts them in /PREP7 too
+    CommandSpec("ANTYPE", LOADS, 4, antype),
+    CommandSpec("TIME", LOADS, 1, time),
+    CommandSpec("DELTIM", LOADS, 4, deltim),
+    CommandSpec("NSUBST", LOADS, 4, nsubst),
+    CommandSpec("KBC", LOADS, 1, kbc),
+    CommandSpec("TIMINT", LOADS, 2, timint),
+    CommandSpec("OUTRES", LOADS, 3, outres),
+    CommandSpec("AUTOTS", LOADS, 1, autots),
+    CommandSpec("TINTP", LOADS, 6, tintp),
     CommandSpec("LDREAD", SOLU, 8, ldread),
     CommandSpec("SOLVE", SOLU, 0, solve),
-    CommandSpec("TRNOPT", SOLU, 8, ignored),
-    CommandSpec("AUTOTS", SOLU, 1, ignored),
+    CommandSpec("TRNOPT", LOADS, 8, ignored),
+    # solver and output options: the direct solve and its listing need none of them
+    *(CommandSpec(name, LOADS, 10, ignored) for name in (
+        "OUTPR", "EQSLV", "NEQIT", "CNVTOL", "NROPT", "LNSRCH", "PRED", "ERESX", "RESCONTRL",
+        "NCNV", "SOLCONTROL", "THOPT")),
 )

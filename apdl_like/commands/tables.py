@@ -1,0 +1,220 @@
+"""Results tables and listings: *DIM, *VFILL, *VWRITE, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
+*LIST, *STATUS, SAVE and RESUME (valid in every processor).
+
+Files the deck writes are kept in memory by name (`SessionState.listing.files`) and written
+by the CLI inside its --out folder only: a name is a plain file name, never a path.  SAVE and
+RESUME keep named copies of the database and parameters in memory (no .db file).
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.call import ANY, Call, CommandSpec
+from apdl_like.errors import ApdlError
+from apdl_like.fortran_format import format_c_line, format_line, parse_format
+from apdl_like.params import column, dimension, split_target, store, subscripts, value_of
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+_FILE_PART = re.compile(r"[A-Za-z0-9_\-]+(\.[A-Za-z0-9_\-]+)*\Z")
+RESERVED_FILES = ("params.json", "log.txt")
+MAX_VWRITE_LINES = 1_000_000
+JOBNAME = "file"
+
+
+def file_name(c: Call, default_ext: str = "") -> str:
+    """`Fname.Ext` from fields 1 and 2: a plain name inside the output folder."""
+    fname, ext = c.raw(1), c.raw(2)
+    if not fname:
+        fname = JOBNAME
+    ext = ext or default_ext
+    name = f"{fname}.{ext}" if ext else fname
+    if not _FILE_PART.match(fname) or (ext and not _FILE_PART.match(ext)) or \
+            name.lower() in RESERVED_FILES or name.lower().startswith("result_"):
+        raise ApdlError(f"file {name!r}: files a deck writes are plain names (letters, digits, "
+                        f"_ - .) inside the output folder, not {', '.join(RESERVED_FILES)} or "
+                        "result_*")
+    return name
+
+
+def star_dim(s: SessionState, c: Call) -> None:
+    name, subs = split_target(c.raw(1))
+    if subs:
+        raise ApdlError("field 1: the array name without subscripts")
+    kind = c.label(2, "ARRAY")
+    if kind == "TABLE":
+        raise ApdlError("TABLE arrays are not supported (ARRAY, CHAR or STRING)")
+    shape = (c.int(3, 1, what="IMAX"), c.int(4, 1, what="JMAX"), c.int(5, 1, what="KMAX"))
+    if kind == "STRING":
+        shape = (shape[1], 1, 1)  # *DIM,Par,STRING,length,rows: rows of one string
+    dimension(s.params, name, kind, shape)
+
+
+def star_vfill(s: SessionState, c: Call) -> None:
+    """*VFILL,Par(i,j),DATA,v1,v2,... or RAMP,start,increment (down the column)."""
+    name, subs_text = split_target(c.raw(1))
+    params, funcs = s.params, s.model_functions
+    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    func = c.label(2, "DATA")
+    array = params.get(name)
+    if not isinstance(array, np.ndarray):
+        raise ApdlError(f"{name} is not an array (define it with *DIM first)")
+    if func == "DATA":
+        last = max((i for i in range(3, c.count() + 1) if c.given(i)), default=2)
+        values = [value_of(c.raw(i), params, funcs) if c.given(i) else 0.0
+                  for i in range(3, last + 1)]
+    elif func == "RAMP":
+        start, step = c.num(3, 0.0, what="start"), c.num(4, 0.0, what="increment")
+        rows = array.shape[0] - int(round(subs[0])) + 1
+        values = [start + k * step for k in range(rows)]
+    else:
+        raise ApdlError(f"field 2: *VFILL supports DATA and RAMP, got {func!r}")
+    store(params, name, subs, values)
+
+
+def star_vwrite(s: SessionState, c: Call) -> None:
+    """*VWRITE,Par1,...: one line per row of the array arguments, by the format line."""
+    params, funcs = s.params, s.model_functions
+    columns: list[list[float | str]] = []
+    arrays = []
+    for i in range(1, c.count() + 1):
+        text = c.raw(i)
+        if not text:
+            continue
+        if text.startswith("'"):
+            columns.append([value_of(text, params, funcs)])
+            continue
+        name, subs_text = split_target(text) if _is_reference(text) else ("", [])
+        if name and (subs_text or isinstance(params.get(name), np.ndarray | str)):
+            col = column(params, name, subscripts(subs_text, params, funcs))
+            if isinstance(params.get(name), np.ndarray):
+                arrays.append(len(col))
+            columns.append(col)
+        else:
+            columns.append([c.num(i)])
+    rows = min(arrays) if arrays else 1
+    if rows > MAX_VWRITE_LINES:
+        raise ApdlError(f"more than {MAX_VWRITE_LINES} lines")
+    fmt = c.statement.block[0] if c.statement.block else ""
+    c_style = "%" in fmt and not fmt.strip().startswith("(")
+    items = None if c_style else parse_format(fmt)
+    lines: list[str] = []
+    for r in range(rows):
+        values = [col[r] if len(col) > 1 or r < len(col) else col[0] for col in columns]
+        lines += format_c_line(fmt, values) if items is None else format_line(items, values)
+    listing = s.listing
+    target = listing.command_file
+    for line in lines:
+        if target is not None:
+            listing.files[target].append(line)
+        else:
+            s.say(line)
+
+
+def _is_reference(text: str) -> bool:
+    return bool(re.match(r"\s*[A-Za-z_][A-Za-z0-9_]*\s*(\(.*\))?\s*\Z", text, re.S))
+
+
+def out(s: SessionState, c: Call) -> None:
+    """/OUT,Fname,Ext,,APPEND: output to a file; /OUT alone (or TERM): back to the log."""
+    listing = s.listing
+    if not c.given(1) and not c.given(2) or c.label(1) == "TERM":
+        listing.target = None
+        return
+    name = file_name(c)
+    if c.label(4) != "APPEND" or name not in listing.files:
+        listing.files[name] = []
+    listing.target = name
+
+
+def cfopen(s: SessionState, c: Call) -> None:
+    name = file_name(c, "" if c.given(1) else "cmd")
+    if c.label(4) != "APPEND" or name not in s.listing.files:
+        s.listing.files[name] = []
+    s.listing.command_file = name
+
+
+def cfwrite(s: SessionState, c: Call) -> None:
+    if s.listing.command_file is None:
+        raise ApdlError("no command file is open (*CFOPEN first)")
+    text = c.statement.text.split(",", 1)[1] if "," in c.statement.text else ""
+    s.listing.files[s.listing.command_file].append(text.rstrip())
+
+
+def cfclos(s: SessionState, c: Call) -> None:
+    s.listing.command_file = None
+
+
+def star_list(s: SessionState, c: Call) -> None:
+    """*LIST,Fname,Ext: a file this deck wrote, copied into the output."""
+    name = file_name(c)
+    lines = s.listing.files.get(name)
+    if lines is None:
+        raise ApdlError(f"file {name!r} was not written by this run")
+    for line in list(lines):
+        s.say(line)
+
+
+def star_status(s: SessionState, c: Call) -> None:
+    """*STATUS[,Par]: parameters, their type and value or dimensions."""
+    wanted = c.raw(1).upper()
+    s.say("PARAMETER STATUS")
+    s.say(f"{'NAME':<32} {'VALUE':>20}  TYPE")
+    for name, value in sorted(s.params.items()):
+        if wanted and wanted != "ALL" and name != wanted:
+            continue
+        if isinstance(value, np.ndarray):
+            kind = "CHARACTER ARRAY" if value.dtype == object else "ARRAY"
+            dims = " x ".join(str(n) for n in value.shape)
+            s.say(f"{name:<32} {dims:>20}  {kind}")
+        elif isinstance(value, str):
+            s.say(f"{name:<32} {value:>20}  CHARACTER")
+        else:
+            s.say(f"{name:<32} {value:>20.10G}  SCALAR")
+
+
+def save(s: SessionState, c: Call) -> None:
+    """SAVE,Fname,Ext: a copy of the database and parameters, in memory."""
+    s.saved[file_name(c, "db")] = (copy.deepcopy(s.db), copy.deepcopy(s.params))
+
+
+def resume(s: SessionState, c: Call) -> None:
+    name = file_name(c, "db")
+    saved = s.saved.get(name)
+    if saved is None:
+        raise ApdlError(f"{name!r} was never saved in this run (SAVE first)")
+    s.db, s.params = copy.deepcopy(saved[0]), copy.deepcopy(saved[1])
+
+
+def star_set_values(s: SessionState, c: Call) -> None:
+    """*SET,Par,v1[,v2,...]: a scalar or character value, or values down an array column."""
+    name, subs_text = split_target(c.raw(1))
+    params, funcs = s.params, s.model_functions
+    if not c.given(2) and not subs_text:
+        params.pop(name, None)
+        return
+    values = [value_of(c.raw(i), params, funcs) for i in range(2, c.count() + 1)]
+    store(params, name, subscripts(subs_text, params, funcs) if subs_text else [], values)
+
+
+COMMANDS = (
+    CommandSpec("*DIM", ANY, 8, star_dim),
+    CommandSpec("*VFILL", ANY, 20, star_vfill),
+    CommandSpec("*VWRITE", ANY, 19, star_vwrite),
+    CommandSpec("/OUT", ANY, 4, out),
+    CommandSpec("/OUTPUT", ANY, 4, out),
+    CommandSpec("*CFOPEN", ANY, 4, cfopen),
+    CommandSpec("*CFWRITE", ANY, 40, cfwrite),
+    CommandSpec("*CFCLOS", ANY, 0, cfclos),
+    CommandSpec("*LIST", ANY, 3, star_list),
+    CommandSpec("*STATUS", ANY, 5, star_status),
+    CommandSpec("SAVE", ANY, 4, save),
+    CommandSpec("RESUME", ANY, 4, resume),
+    CommandSpec("*SET", ANY, 11, star_set_values),
+)

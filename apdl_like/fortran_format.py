@@ -1,0 +1,194 @@
+"""Fortran format lines of `*VWRITE`: `(1X,A8,A8,'   ',F10.5,'  ',1F15.3)`.
+
+Edit descriptors: `Aw` (text, right-justified in w, or its first w characters), `Fw.d`,
+`Ew.d`, `Gw.d`, `Iw`, `nX` (blanks), quoted literals, `/` (new line), repeat counts (`3F10.2`,
+`2(A8,F8.3)`).  A number too wide for its field prints as w asterisks, as Fortran does.
+Output stops at the first data descriptor with no value left.  A C-style line
+(`%14.5G %I %C`) is accepted too.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+
+from apdl_like.errors import ApdlError
+
+Item = tuple[str, int, int]  # (kind, width, decimals): kind in A F E G I X ' /
+
+_DESCRIPTOR = re.compile(r"(\d*)([AFEGIXD])(\d*)(?:\.(\d+))?\Z", re.I)
+_C_SPEC = re.compile(r"%(-?\d*)(?:\.(\d+))?([IGEFCSX/%])", re.I)
+
+
+def _split_top(text: str) -> list[str]:
+    parts, depth, start, quoted = [], 0, 0, False
+    for i, ch in enumerate(text):
+        if ch == "'":
+            quoted = not quoted
+        elif quoted:
+            continue
+        elif ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth -= 1
+        elif ch in ",/" and depth == 0:
+            parts.append(text[start:i])
+            if ch == "/":
+                parts.append("/")
+            start = i + 1
+    parts.append(text[start:])
+    return [p.strip() for p in parts if p.strip()]
+
+
+def parse_format(line: str) -> list[tuple[str, int, int, str]]:
+    """A format line -> items (kind, width, decimals, literal text)."""
+    text = line.strip()
+    if not (text.startswith("(") and text.endswith(")")):
+        raise ApdlError(f"format line must be a Fortran format in parentheses, got {text!r}")
+    return _items(text[1:-1])
+
+
+def _items(body: str) -> list[tuple[str, int, int, str]]:
+    out: list[tuple[str, int, int, str]] = []
+    for part in _split_top(body):
+        if part == "/":
+            out.append(("/", 0, 0, ""))
+        elif part.startswith("'") and part.endswith("'") and len(part) >= 2:
+            out.append(("'", 0, 0, part[1:-1].replace("''", "'")))
+        elif "(" in part:
+            m = re.match(r"(\d*)\((.*)\)\Z", part, re.S)
+            if m is None:
+                raise ApdlError(f"format item {part!r} is not understood")
+            out += _items(m.group(2)) * int(m.group(1) or 1)
+        else:
+            m = _DESCRIPTOR.match(part)
+            if m is None:
+                raise ApdlError(f"format item {part!r} is not understood")
+            repeat, kind = int(m.group(1) or 1), m.group(2).upper()
+            width, decimals = int(m.group(3) or 0), int(m.group(4) or 0)
+            if kind == "X":
+                out.append(("'", 0, 0, " " * (repeat if not m.group(3) else width)))
+                continue
+            kind = "E" if kind == "D" else kind
+            if kind in "FEG" and width == 0:
+                raise ApdlError(f"format item {part!r} needs a width")
+            out += [(kind, width, decimals, "")] * repeat
+    return out
+
+
+def _stars(text: str, width: int) -> str:
+    return text.rjust(width) if len(text) <= width else "*" * width
+
+
+def fixed(value: float, width: int, decimals: int) -> str:
+    """Fw.d: `1100.` for F6.0, `0.998` -> ` 1.00` for F5.2."""
+    if not math.isfinite(value):
+        return _stars("NaN" if math.isnan(value) else "Inf", width)
+    text = f"{value:.{decimals}f}"
+    if decimals == 0:
+        text += "."
+    if text.startswith("-") and float(text) == 0.0:
+        text = text[1:]
+    if len(text) > width and text.lstrip("-").startswith("0."):
+        text = text.replace("0.", ".", 1)  # Fortran's leading zero is optional
+    return _stars(text, width)
+
+
+def exponential(value: float, width: int, decimals: int) -> str:
+    """Ew.d: `0.12345E+03`."""
+    if not math.isfinite(value):
+        return _stars("NaN" if math.isnan(value) else "Inf", width)
+    if value == 0.0:
+        return _stars(f"0.{'0' * decimals}E+00", width)
+    exp = math.floor(math.log10(abs(value))) + 1
+    mant = round(abs(value) / 10.0**exp, decimals)
+    if mant >= 1.0:
+        mant, exp = mant / 10.0, exp + 1
+    sign = "-" if value < 0 else ""
+    text = f"{sign}{mant:.{decimals}f}E{exp:+03d}"
+    if len(text) > width and text.lstrip("-").startswith("0."):
+        text = text.replace("0.", ".", 1)
+    return _stars(text, width)
+
+
+def general(value: float, width: int, decimals: int) -> str:
+    """Gw.d: F editing with d significant digits for 0.1 ≤ |v| < 10^d, else E."""
+    if math.isfinite(value) and value != 0.0:
+        exp = math.floor(math.log10(abs(value))) + 1
+        if 0 <= exp <= decimals:
+            return fixed(value, width - 4, max(decimals - exp, 0)) + "    "
+    elif value == 0.0:
+        return fixed(0.0, width - 4, max(decimals - 1, 0)) + "    "
+    return exponential(value, width, decimals)
+
+
+def format_line(items: Sequence[tuple[str, int, int, str]],
+                values: Sequence[float | str]) -> list[str]:
+    """One record written by `items` with `values` (several lines if the format has `/`)."""
+    lines, current, k = [], "", 0
+    for kind, width, decimals, literal in items:
+        if kind == "'":
+            current += literal
+            continue
+        if kind == "/":
+            lines.append(current)
+            current = ""
+            continue
+        if k >= len(values):
+            break
+        value = values[k]
+        k += 1
+        if kind == "A":
+            text = str(value)
+            current += text if width == 0 else (text[:width] if len(text) >= width
+                                                  else text.rjust(width))
+            continue
+        if isinstance(value, str):
+            raise ApdlError(f"format item {kind}{width}: {value!r} is text, a number is needed")
+        if kind == "F":
+            current += fixed(value, width, decimals)
+        elif kind == "E":
+            current += exponential(value, width, decimals)
+        elif kind == "G":
+            current += general(value, width, decimals)
+        else:  # I
+            current += _stars(str(int(round(value))), width)
+    lines.append(current)
+    return lines
+
+
+def format_c_line(line: str, values: Sequence[float | str]) -> list[str]:
+    """A C-style *VWRITE line: %w.dG/E/F, %wI, %wC or %wS, %wX, %/ (new line)."""
+    out, k, pos = [""], 0, 0
+    for m in _C_SPEC.finditer(line):
+        out[-1] += line[pos:m.start()]
+        pos = m.end()
+        width, decimals, kind = m.group(1), m.group(2), m.group(3).upper()
+        if kind == "%":
+            out[-1] += "%"
+            continue
+        if kind == "/":
+            out.append("")
+            continue
+        if kind == "X":
+            out[-1] += " " * int(width or 1)
+            continue
+        if k >= len(values):
+            break
+        value = values[k]
+        k += 1
+        w = int(width) if width and width != "-" else 0
+        if kind in ("C", "S"):
+            text = str(value)
+            out[-1] += text.ljust(abs(w)) if width.startswith("-") else text.rjust(w)
+            continue
+        if isinstance(value, str):
+            raise ApdlError(f"%{kind}: {value!r} is text, a number is needed")
+        d = int(decimals) if decimals is not None else 6
+        spec = {"I": "d", "G": "g", "E": "E", "F": "f"}[kind]
+        number = int(round(value)) if kind == "I" else value
+        body = f"{number:{'' if kind == 'I' else '.' + str(d)}{spec}}".upper()
+        out[-1] += body.ljust(abs(w)) if width.startswith("-") else body.rjust(w)
+    out[-1] += line[pos:]
+    return out
