@@ -2,8 +2,8 @@
 
 A parameter is a float, a character value (str) or a numpy array of shape (I, J, K):
 float for ARRAY, object (str) for CHAR.  Subscripts are 1-based; `NAME(i,j) = v1, v2, ...`
-and `*VFILL,NAME(i,j),DATA,...` fill down the column from (i, j), as in APDL.  Character values are written in single
-quotes (`'T (C) X='`).
+and `*VFILL,NAME(i,j),DATA,...` fill down the column from (i, j), as in APDL.  Character
+values are written in single quotes (`'T (C) X='`).
 """
 
 from __future__ import annotations
