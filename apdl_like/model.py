@@ -336,9 +336,19 @@ class FaceLoads:
 
 @dataclass
 class Material:
-    """MP properties of one material number (APDL labels)."""
+    """MP properties of one material number (APDL labels).
+
+    props         C0 of each property (a constant property is just this)
+    coefficients  label -> (C0, C1, C2, C3, C4): the property is C0 + C1·T + ... + C4·T⁴
+    tables        label -> (temperatures, values) from MPTEMP/MPDATA
+    """
 
     props: dict[str, float] = field(default_factory=dict)
+    coefficients: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    tables: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    def temperature_dependent(self, label: str) -> bool:
+        return label in self.tables or len(self.coefficients.get(label, ())) > 1
 
 
 @dataclass
@@ -381,6 +391,7 @@ class Database:
     meshed_areas: set[int] = field(default_factory=set)
     esize: float | None = None
     title: str = ""
+    mp_temperatures: list[float] = field(default_factory=list)  # MPTEMP, for MPDATA
     csys: int = 0  # active coordinate system (0 Cartesian, 1 cylindrical: x = r, y = θ in °)
     # coupled DOF sets (CP): set number -> (label, node numbers)
     couplings: dict[int, tuple[str, np.ndarray]] = field(default_factory=dict)

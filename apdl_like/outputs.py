@@ -49,10 +49,9 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
 
     res = session.solution.results[result_index]
     fem = session.fem.model
-    assert fem is not None
     points = np.column_stack([session.db.nodes.xy, np.zeros(len(session.db.nodes.ids))])
-    data = {"TEMP": fem.thermal_nodal(res.temperature)}
-    if res.displacement is not None:
+    data = {"TEMP": res.nodal_temperature}
+    if res.displacement is not None and fem is not None:
         n = points.shape[0]
         u = np.zeros((n, 3))
         u[:, 0] = fem.glued_nodal(res.displacement[0])

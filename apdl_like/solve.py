@@ -21,6 +21,7 @@ import numpy as np
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
 from apdl_like.model import record_groups
+from apdl_like.plane_solve import deck_faces, solve_plane_thermal
 from apdl_like.state import TCC_LOCATION, StepResult
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
@@ -227,7 +228,17 @@ def initial_temperature(session: SessionState, fem: FemModel, n_dofs: int) -> np
     return fem.nodal_to_thermal(session.db.nodes.arrays["ic_temp"], base)
 
 
+def face_table(session: SessionState):  # noqa: ANN201 - FemModel | plane_solve.FaceTable
+    """The exterior faces SF/SFE load: the AxiMesh's (a twin session) or the deck mesh's."""
+    if session.fem.external_mesh:
+        return fem_model(session)
+    return deck_faces(session)
+
+
 def solve_thermal(session: SessionState) -> StepResult:
+    """A thermal load step: on twin.fem for a twin session, else on the deck's own mesh."""
+    if not session.fem.external_mesh:
+        return solve_plane_thermal(session)
     fem = fem_model(session)
     _check_axisymmetric(session, "thermal")
     problem = thermal_problem(session, fem)
@@ -274,7 +285,8 @@ def solve_thermal(session: SessionState) -> StepResult:
     sol.substep_times = steps_t
     sol.substep_temperatures = steps_T
     sol.previous_loads = _snapshot(session)
-    return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature)
+    return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature,
+                      nodal_temperature=fem.thermal_nodal(sol.temperature))
 
 
 def _constraints(session: SessionState, fem: FemModel) -> dict[str, str]:
@@ -327,10 +339,16 @@ def solve_structural(session: SessionState) -> StepResult:
     elastic = cache.elastic
     n_t = elastic.temperature_basis.N
     sol = session.solution
-    base = sol.body_temperature if sol.body_temperature is not None and \
-        sol.body_temperature.size == n_t else np.full(n_t, s.tunif)
+    base = np.full(n_t, s.tunif)
+    body = sol.body_temperature
+    if body is not None:
+        if cache.external_mesh and body.temperature.size == n_t:
+            base = body.temperature  # the same twin.fem dofs
+        else:
+            base = fem.nodal_to_thermal(body.nodal_temperature, base)
     T = fem.nodal_to_thermal(session.db.nodes.arrays["bf_temp"], base)
     u = elastic.solve(T)
     stress = elastic.stresses(u, T)
     sol.time = s.time if s.time is not None else sol.time + 1.0
-    return StepResult(len(sol.results) + 1, sol.time, "structural", T, u, stress)
+    return StepResult(len(sol.results) + 1, sol.time, "structural", T, u, stress,
+                      nodal_temperature=fem.thermal_nodal(T))

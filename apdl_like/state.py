@@ -48,6 +48,7 @@ class StepResult:
     temperature: np.ndarray  # thermal dofs, °C (structural: the body temperature used)
     displacement: np.ndarray | None = None  # (2, n glued scalar dofs), m
     stress: dict[str, np.ndarray] = field(default_factory=dict)  # glued scalar dofs, Pa
+    nodal_temperature: np.ndarray | None = None  # per APDL node, °C (NaN: no element)
 
 
 @dataclass
@@ -65,6 +66,13 @@ class FemCache:
     thermal_inputs: tuple | None = None  # the MP/ANTYPE inputs `thermal` was checked against
     elastic: ElasticProblem | None = None
     elastic_key: tuple | None = None
+    # a deck's own mesh (apdl_like.plane_solve): exterior faces, scikit-fem mesh, solver
+    faces: Any = None
+    faces_key: tuple | None = None
+    plane: Any = None
+    plane_key: tuple | None = None
+    plane_solver: tuple | None = None  # (key, PlaneThermal)
+    plane_inputs: Any = None  # the loads of the last thermal solve (reaction heats)
 
 
 @dataclass
@@ -75,7 +83,7 @@ class Solution:
     time: float = 0.0  # s
     fresh_start: bool = True  # the next thermal SOLVE starts from TUNIF/IC (ANTYPE, NEW)
     previous_loads: dict | None = None  # loads of the last load step (start of KBC,0 ramps)
-    body_temperature: np.ndarray | None = None  # LDREAD, thermal dofs, °C
+    body_temperature: StepResult | None = None  # LDREAD: the thermal result to apply
     substep_times: list[float] = field(default_factory=list)  # of the last load step, s
     substep_temperatures: list[np.ndarray] = field(default_factory=list)
     results: list[StepResult] = field(default_factory=list)
@@ -198,10 +206,8 @@ class SessionState:
         i = self.node_index(n)
         res = self.result()
         fem = self.fem.model
-        assert fem is not None
         if item == "TEMP":
-            d = fem.thermal_dof[i]
-            value = res.temperature[d] if d >= 0 else np.nan
+            value = res.nodal_temperature[i]
         elif res.displacement is None:
             raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
         else:

@@ -15,7 +15,7 @@ from apdl_like.call import LOADS, Call, CommandSpec
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import pair_keys
-from apdl_like.solve import fem_model
+from apdl_like.solve import face_table
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -110,7 +110,7 @@ def ddele(s: SessionState, c: Call) -> None:
 
 
 def _faces_on_nodes(s: SessionState, idx: np.ndarray) -> np.ndarray:
-    fem = fem_model(s)
+    fem = face_table(s)
     mask = np.zeros(len(s.db.nodes.ids), bool)
     mask[idx] = True
     return np.nonzero(mask[fem.face_nodes[0]] & mask[fem.face_nodes[1]])[0]
@@ -160,7 +160,7 @@ def sfdele(s: SessionState, c: Call) -> None:
 
 def _element_faces(s: SessionState, elems: np.ndarray, lkey: int) -> np.ndarray:
     db = s.db
-    fem = fem_model(s)
+    fem = face_table(s)
     nodes = db.elements.nodes[elems]
     tri6 = np.array([db.element_types[int(t)].triangle6 for t in db.elements.type[elems]], bool)
     corners = nodes[:, :4].copy()

@@ -45,14 +45,13 @@ def prnsol(s: SessionState, c: Call) -> None:
                         f"{','.join(k for k in key if k)!r}")
     res = s.result()
     fem = s.fem.model
-    assert fem is not None
     nodes = s.db.nodes
     sel = np.nonzero(nodes.selected)[0]
     columns = []
     for item in items:
         if item == "TEMP":
-            columns.append(fem.thermal_nodal(res.temperature)[sel])
-        elif res.displacement is None:
+            columns.append(res.nodal_temperature[sel])
+        elif res.displacement is None or fem is None:
             raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
         elif item in ("UX", "UY"):
             columns.append(fem.glued_nodal(res.displacement[0 if item == "UX" else 1])[sel])

@@ -14,8 +14,12 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 MAX_ENTITY_NUMBER = 2**31 - 1
-MP_LABELS = ("KXX", "DENS", "C", "EX", "PRXY", "NUXY", "ALPX")
-MP_POSITIVE = ("KXX", "DENS", "C", "EX")
+MP_LABELS = ("KXX", "KYY", "KZZ", "DENS", "C", "EX", "EY", "EZ", "PRXY", "NUXY", "ALPX", "ALPY",
+             "ALPZ", "EMIS", "HF", "ENTH")
+MP_POSITIVE = ("KXX", "KYY", "KZZ", "DENS", "C", "EX")
+# labels MAPDL reads whose values nothing here uses (3-D directions, radiation, enthalpy)
+MP_UNUSED = ("KZZ", "EY", "EZ", "ALPY", "ALPZ", "EMIS", "HF", "ENTH")
+MAX_TABLE_POINTS = 100
 CONTACT_TYPES = ("CONTA172", "TARGE169")
 
 
@@ -93,16 +97,66 @@ def mp(s: SessionState, c: Call) -> None:
     label = c.label(1)
     if label not in MP_LABELS:
         raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
-    mat = _entity_number(c, 2, "MAT")
-    value = c.num(3, what="C0")
-    for i in range(4, 8):
-        if c.given(i) and c.num(i) != 0.0:
-            raise ApdlError("temperature-dependent properties (C1..C4) are not supported")
-    if label in MP_POSITIVE and not value > 0.0:
+    mat = _entity_number(c, 2, "MAT") if c.given(2) else 1  # MAPDL: MAT defaults to 1
+    value = c.num(3, 0.0, what="C0")
+    coeffs = [value] + [c.num(i, 0.0, what=f"C{i - 3}") for i in range(4, 8)]
+    while len(coeffs) > 1 and coeffs[-1] == 0.0:
+        coeffs.pop()
+    if label in MP_POSITIVE and len(coeffs) == 1 and not value > 0.0:
         raise ApdlError(f"{label} must be positive, got {value!r}")
     if label in ("PRXY", "NUXY") and not -1.0 < value < 0.5:
         raise ApdlError(f"{label} must lie in (-1, 0.5), got {value!r}")
-    s.db.materials.setdefault(mat, Material()).props[label] = value
+    material = s.db.materials.setdefault(mat, Material())
+    material.props[label] = value
+    material.tables.pop(label, None)
+    if len(coeffs) > 1:
+        material.coefficients[label] = tuple(coeffs)
+    else:
+        material.coefficients.pop(label, None)
+
+
+def mptemp(s: SessionState, c: Call) -> None:
+    """MPTEMP,STLOC,T1..T6: the temperatures of the next MPDATA tables (blank: erase)."""
+    if c.count() == 0:
+        s.db.mp_temperatures = []
+        return
+    start = c.int(1, 1, what="STLOC")
+    temps = list(s.db.mp_temperatures)
+    for k in range(6):
+        if c.given(2 + k):
+            i = start - 1 + k
+            if not 0 <= i < MAX_TABLE_POINTS:
+                raise ApdlError(f"table location {i + 1} out of range 1..{MAX_TABLE_POINTS}")
+            temps += [float("nan")] * (i + 1 - len(temps))
+            temps[i] = c.num(2 + k, what=f"T{k + 1}")
+    s.db.mp_temperatures = temps
+
+
+def mpdata(s: SessionState, c: Call) -> None:
+    """MPDATA,Lab,MAT,STLOC,C1..C6: property values at the MPTEMP temperatures."""
+    label = c.label(1)
+    if label not in MP_LABELS:
+        raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
+    mat = _entity_number(c, 2, "MAT") if c.given(2) else 1
+    start = c.int(3, 1, what="STLOC")
+    material = s.db.materials.setdefault(mat, Material())
+    old = material.tables.get(label)
+    values = list(old[1]) if old is not None else []
+    for k in range(6):
+        if c.given(4 + k):
+            i = start - 1 + k
+            if not 0 <= i < MAX_TABLE_POINTS:
+                raise ApdlError(f"table location {i + 1} out of range 1..{MAX_TABLE_POINTS}")
+            values += [float("nan")] * (i + 1 - len(values))
+            values[i] = c.num(4 + k, what=f"C{k + 1}")
+    temps = s.db.mp_temperatures[: len(values)]
+    if len(temps) < len(values) or any(np.isnan(temps)) or any(np.isnan(values)):
+        raise ApdlError("MPDATA needs a temperature (MPTEMP) for each value, without gaps")
+    if len(values) > 1 and np.any(np.diff(temps) <= 0.0):
+        raise ApdlError("MPTEMP temperatures must increase")
+    material.tables[label] = (np.array(temps, float), np.array(values, float))
+    material.props[label] = float(values[0])
+    material.coefficients.pop(label, None)
 
 
 def _real_values(s: SessionState, nset: int, start: int, c: Call, first_field: int,
@@ -266,6 +320,8 @@ COMMANDS = (
     CommandSpec("KEYOPT", PREP7, 3, keyopt),
     CommandSpec("ETCHG", PREP7, 1, etchg),
     CommandSpec("MP", PREP7, 7, mp),
+    CommandSpec("MPTEMP", PREP7, 7, mptemp),
+    CommandSpec("MPDATA", PREP7, 9, mpdata),
     CommandSpec("R", PREP7, 7, r),
     CommandSpec("RMORE", PREP7, 6, rmore),
     CommandSpec("RMODIF", PREP7, 8, rmodif),

@@ -133,7 +133,7 @@ def ldread(s: SessionState, c: Call) -> None:
         chosen = match[0]
     else:
         chosen = thermal[-1]
-    s.solution.body_temperature = chosen.temperature.copy()
+    s.solution.body_temperature = chosen
     s.note_load(c)
 
 

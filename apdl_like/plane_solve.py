@@ -1,0 +1,380 @@
+"""Thermal SOLVE on a deck's own mesh: the database -> `apdl_like.plane_thermal`.
+
+A session that holds the spindle (`Session.from_mesh`, contact interfaces) solves on
+twin.fem (`apdl_like.solve`); a deck that builds its own mesh with N/E/FILL/AMESH solves
+here, on native quads, planar or axisymmetric, with MAPDL's material models.
+
+Exterior faces (what SF/SFE load) are the element edges used by exactly one element; they
+are keyed by their corner node numbers (`FaceTable`), so loads survive a rebuilt mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.errors import ApdlError
+from apdl_like.model import Database, record_groups
+from apdl_like.plane_thermal import (
+    PlaneMesh,
+    PlaneThermal,
+    Property,
+    ThermalInputs,
+    build_mesh,
+    march,
+    pair_keys,
+)
+from apdl_like.state import StepResult
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+THERMAL_PLANES = ("PLANE35", "PLANE55", "PLANE77")
+DEFAULT_DTMIN_FRACTION = 1e-3  # AUTOTS without DTMIN: DTIME/1000
+DEFAULT_DTMAX_FRACTION = 0.1  # AUTOTS without DTMAX: a tenth of the load step
+
+
+@dataclass
+class FaceTable:
+    """Exterior element edges: corner node indices, packed node-number keys."""
+
+    face_nodes: np.ndarray  # (2, n_faces) node indices
+    face_keys: np.ndarray  # (n_faces,) pair_keys of the corner node numbers
+
+    def face_index(self, keys: np.ndarray) -> np.ndarray:
+        """Positions of node-pair keys among the exterior faces; -1 where not one."""
+        order = np.argsort(self.face_keys)
+        sorted_keys = self.face_keys[order]
+        if not sorted_keys.size:
+            return np.full(np.shape(keys), -1)
+        pos = np.clip(np.searchsorted(sorted_keys, keys), 0, sorted_keys.size - 1)
+        return np.where(sorted_keys[pos] == keys, order[pos], -1)
+
+
+def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None]:
+    """Per element: corner node indices (m, 4; K = L for triangles) and mid-side node
+    indices (m, 4: I-J, J-K, K-L, L-I; -1 none) or None for a linear model."""
+    el = db.elements
+    el.flush()
+    if len(el.ids) == 0:
+        raise ApdlError("the model has no elements")
+    missing = [int(t) for t in np.unique(el.type) if int(t) not in db.element_types]
+    if missing:
+        raise ApdlError(f"element type {missing[0]} is used by elements but never defined (ET)")
+    nodes = el.nodes
+    idx = db.nodes.index(nodes.ravel()).reshape(nodes.shape)
+    idx[nodes == 0] = -1
+    tri6 = np.array([db.element_types[int(t)].triangle6 for t in el.type], bool)
+    quadratic = np.array([db.element_types[int(t)].quadratic for t in el.type], bool)
+    corners = idx[:, :4].copy()
+    corners[tri6, 3] = corners[tri6, 2]
+    corners[corners[:, 3] < 0, 3] = corners[corners[:, 3] < 0, 2]
+    if np.any(corners[:, :3] < 0):
+        bad = el.ids[np.nonzero(np.any(corners[:, :3] < 0, axis=1))[0][0]]
+        raise ApdlError(f"element {bad} refers to a node that does not exist")
+    if not quadratic.any():
+        return corners, None
+    if not quadratic.all():
+        raise ApdlError("mixing linear and quadratic elements is not supported")
+    mid = idx[:, 4:8].copy()
+    mid[tri6] = np.column_stack([idx[tri6, 3], idx[tri6, 4], np.full(tri6.sum(), -1),
+                                 idx[tri6, 5]])
+    collapsed = corners[:, 2] == corners[:, 3]
+    mid[collapsed & ~tri6, 2] = -1  # O of a degenerate 8-node quad sits on K = L
+    return corners, mid
+
+
+def exterior_faces(db: Database) -> FaceTable:
+    """The element edges used by exactly one element."""
+    corners, _ = corners_and_midside(db)
+    a = corners.ravel()
+    b = np.roll(corners, -1, axis=1).ravel()
+    keep = a != b
+    a, b = a[keep], b[keep]
+    ids = db.nodes.ids
+    keys = pair_keys(ids[a], ids[b])
+    unique, first, counts = np.unique(keys, return_index=True, return_counts=True)
+    once = first[counts == 1]
+    once.sort()
+    return FaceTable(np.vstack([a[once], b[once]]), keys[once])
+
+
+def plane_mesh(s: SessionState) -> PlaneMesh:
+    """The scikit-fem mesh of the deck's thermal elements (cached)."""
+    db = s.db
+    db.nodes.flush()
+    db.elements.flush()
+    key = (db.nodes.version, db.elements.version, _axisymmetric(db))
+    cache = s.fem
+    if cache.plane is None or cache.plane_key != key:
+        corners, mid = corners_and_midside(db)
+        mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2])
+        cache.plane, cache.plane_key = mesh, key
+        cache.plane_solver = None
+    return cache.plane  # type: ignore[return-value]
+
+
+def deck_faces(s: SessionState) -> FaceTable:
+    """The exterior faces of a deck's own mesh (cached); the face loads follow them."""
+    db = s.db
+    db.nodes.flush()
+    db.elements.flush()
+    key = (db.nodes.version, db.elements.version)
+    cache = s.fem
+    if cache.faces is None or cache.faces_key != key:
+        cache.faces, cache.faces_key = exterior_faces(db), key
+    db.faces.rekey(cache.faces.face_keys)
+    return cache.faces
+
+
+def _axisymmetric(db: Database) -> bool:
+    used = {int(t) for t in np.unique(db.elements.type)}
+    kinds = set()
+    for t in used:
+        et = db.element_types.get(t)
+        if et is None:
+            continue
+        if et.physics == "unsupported":
+            raise ApdlError(f"element type {t} ({et.name}) is not supported: use PLANE35, "
+                            "PLANE55, PLANE77, PLANE182 or PLANE183")
+        k3 = et.keyopt.get(3, 0)
+        if k3 not in (0, 1):
+            raise ApdlError(f"element type {t} ({et.name}): KEYOPT(3) = {k3} is not supported "
+                            "(0 planar, 1 axisymmetric)")
+        kinds.add(k3 == 1)
+    if len(kinds) > 1:
+        raise ApdlError("the model mixes planar and axisymmetric element types")
+    return kinds.pop() if kinds else False
+
+
+# ---------------------------------------------------------------- materials
+def material_property(db: Database, mat: int, label: str, why: str,
+                      default: float | None = None) -> Property:
+    """A property of material `mat` as a function of temperature: MP C0..C4 polynomial or
+    an MPTEMP/MPDATA table (linear between points, constant beyond them)."""
+    m = db.materials.get(mat)
+    if m is not None and label in m.tables:
+        temps, values = m.tables[label]
+        return lambda T: np.interp(T, temps, values)
+    if m is None or label not in m.props:
+        if default is not None:
+            return lambda T: np.full_like(T, default)
+        raise ApdlError(f"material {mat} has no {label} (MP,{label},{mat},...), needed {why}")
+    coeffs = m.coefficients.get(label, (m.props[label],))
+    if len(coeffs) == 1:
+        c0 = coeffs[0]
+        return lambda T: np.full_like(T, c0)
+    return lambda T: np.polynomial.polynomial.polyval(T, coeffs)
+
+
+def _is_nonlinear(db: Database, mats: list[int]) -> bool:
+    for mat in mats:
+        m = db.materials.get(mat)
+        if m is not None and (m.tables or any(len(c) > 1 for c in m.coefficients.values())):
+            return True
+    return False
+
+
+def _properties(db: Database, transient: bool) -> tuple[dict[str, list[Property]], list[int]]:
+    mats = sorted({int(m) for m in np.unique(db.elements.mat)})
+    size = max(mats) + 1
+    out: dict[str, list[Property]] = {"kxx": [None] * size, "kyy": [None] * size,  # type: ignore[list-item]
+                                      "rho_c": [None] * size}
+    for mat in mats:
+        if mat not in db.materials:
+            raise ApdlError(f"material {mat} is used by elements but has no MP properties")
+        kxx = material_property(db, mat, "KXX", "for heat conduction")
+        m = db.materials[mat]
+        kyy = material_property(db, mat, "KYY", "") if "KYY" in m.props or "KYY" in m.tables \
+            else kxx
+        if transient:
+            dens = material_property(db, mat, "DENS", "for a transient")
+            c = material_property(db, mat, "C", "for a transient")
+            rho_c = _product(dens, c)
+        else:
+            rho_c = material_property(db, mat, "C", "", default=1.0)
+        out["kxx"][mat], out["kyy"][mat], out["rho_c"][mat] = kxx, kyy, rho_c
+    return out, mats
+
+
+def _product(a: Property, b: Property) -> Property:
+    return lambda T: a(T) * b(T)
+
+
+# -------------------------------------------------------------------- loads
+@dataclass
+class _LoadState:
+    """The database's thermal loads on the plane mesh, as arrays to interpolate."""
+
+    hgen: np.ndarray  # per element, W/m³ (NaN: none)
+    conv_h: np.ndarray  # per exterior face
+    conv_bulk: np.ndarray
+    hflux: np.ndarray
+    d_temp: np.ndarray  # per node (NaN: free)
+
+    @classmethod
+    def of(cls, db: Database) -> _LoadState:
+        f = db.faces
+        return cls(db.elements.arrays["hgen"].copy(), f.conv_h.copy(), f.conv_bulk.copy(),
+                   f.hflux.copy(), db.nodes.arrays["d_temp"].copy())
+
+
+def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
+            now: _LoadState, before: _LoadState | None, fraction: float) -> ThermalInputs:
+    tunif = db.settings.tunif
+
+    def ramp(new: np.ndarray, old: np.ndarray | None, start: float) -> np.ndarray:
+        if old is None or fraction >= 1.0:
+            return new
+        old = np.where(np.isnan(old), start, old)
+        return old + fraction * (np.nan_to_num(new, nan=start) - old)
+
+    hgen = np.nan_to_num(ramp(now.hgen, None if before is None else before.hgen, 0.0))
+    order = np.argsort(mesh.facet_keys)
+    sorted_keys = mesh.facet_keys[order]
+    pos = np.clip(np.searchsorted(sorted_keys, faces.face_keys), 0, sorted_keys.size - 1)
+    face_facet = order[pos]
+    films, fluxes = [], []
+    h = ramp(now.conv_h, None if before is None else before.conv_h, 0.0)
+    tb = ramp(now.conv_bulk, None if before is None else before.conv_bulk, tunif)
+    rec = db.faces.conv_record
+    for idx in record_groups(rec, h if before is not None else None):
+        hv, tv = float(h[idx[0]]), float(tb[idx[0]])
+        if np.isnan(hv) or np.isnan(tv):
+            raise ApdlError("a face has CONV with only one of film coefficient and bulk "
+                            "temperature (SFE KVAL 1 and 2)")
+        if hv != 0.0:
+            for sub in _split_by(idx, tb):
+                films.append((face_facet[sub], hv, float(tb[sub[0]])))
+    q = ramp(now.hflux, None if before is None else before.hflux, 0.0)
+    for idx in record_groups(db.faces.hflux_record):
+        for sub in _split_by(idx, q):
+            if q[sub[0]] != 0.0:
+                fluxes.append((face_facet[sub], float(q[sub[0]])))
+    d = ramp(now.d_temp, None if before is None else before.d_temp, tunif)
+    nodes_fixed = np.nonzero(~np.isnan(now.d_temp) & (mesh.node_dof >= 0))[0]
+    fixed = (mesh.node_dof[nodes_fixed], d[nodes_fixed])
+    cell_hgen = hgen[mesh.cell_element]
+    return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], cell_hgen, films, fluxes,
+                         fixed)
+
+
+def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
+    """Index groups of equal value (a ramped record may hold several values)."""
+    v = values[idx]
+    if np.all(v == v[0]) or np.all(np.isnan(v)):
+        return [idx]
+    _, inverse = np.unique(v, return_inverse=True)
+    return [idx[inverse.ravel() == k] for k in range(inverse.max() + 1)]
+
+
+def initial_temperature(s: SessionState, mesh: PlaneMesh) -> np.ndarray:
+    """TUNIF everywhere, IC where given (mid-side dofs without IC: TUNIF)."""
+    T = np.full(mesh.n_dofs, s.db.settings.tunif)
+    ic = s.db.nodes.arrays["ic_temp"]
+    given = ~np.isnan(ic) & (mesh.node_dof >= 0)
+    T[mesh.node_dof[given]] = ic[given]
+    return T
+
+
+def _couplings(db: Database, mesh: PlaneMesh) -> list[np.ndarray]:
+    out = []
+    for label, numbers in db.couplings.values():
+        if label in ("TEMP", "ALL"):
+            idx = db.nodes.index(numbers)
+            out.append(mesh.node_dof[idx[idx >= 0]])
+    return out
+
+
+def solve_plane_thermal(s: SessionState) -> StepResult:
+    """One thermal load step (steady or transient) on the deck's mesh."""
+    db = s.db
+    mesh = plane_mesh(s)
+    faces = deck_faces(s)
+    settings = db.settings
+    transient = settings.antype == "TRANS" and settings.timint is not False
+    props, mats = _properties(db, settings.antype == "TRANS")
+    nonlinear = _is_nonlinear(db, mats)
+    cell_material = db.elements.mat[mesh.cell_element]
+    couplings = _couplings(db, mesh)
+    key = (id(mesh), tuple(np.unique(cell_material)), tuple(map(bytes, couplings)))
+    cache = s.fem
+    if cache.plane_solver is None or cache.plane_solver[0] != key:
+        cache.plane_solver = (key, PlaneThermal(mesh, cell_material, couplings))
+    model: PlaneThermal = cache.plane_solver[1]
+    sol = s.solution
+    if sol.fresh_start or sol.temperature is None or sol.temperature.size != mesh.n_dofs:
+        sol.temperature = initial_temperature(s, mesh)
+        sol.time = 0.0
+        sol.fresh_start = False
+        sol.previous_loads = None
+    now = _LoadState.of(db)
+    T0 = sol.temperature
+    if not transient:
+        inputs = _inputs(db, mesh, faces, props, now, None, 1.0)
+        end = settings.time if settings.time is not None else sol.time + 1.0
+        T = model.steady(inputs, T0, nonlinear)
+        times, temps = [end], [T]
+    else:
+        if settings.time is None:
+            raise ApdlError("a transient load step needs its end time (TIME)")
+        span = settings.time - sol.time
+        if not span > 0.0:
+            raise ApdlError(f"TIME {settings.time!r} is not after the current time {sol.time!r}")
+        ramped = settings.kbc == 0
+        before = sol.previous_loads if ramped else None
+        if ramped and before is None:
+            before = _LoadState(np.full_like(now.hgen, np.nan), np.full_like(now.conv_h, np.nan),
+                                np.full_like(now.conv_bulk, np.nan),
+                                np.full_like(now.hflux, np.nan), np.full_like(now.d_temp, np.nan))
+        start = sol.time
+        steady_inputs = _inputs(db, mesh, faces, props, now, None, 1.0)
+
+        def inputs_at(t: float) -> ThermalInputs:
+            if not ramped:
+                return steady_inputs
+            return _inputs(db, mesh, faces, props, now, before, (t - start) / span)
+
+        dt, adaptive, dt_min, dt_max = _substeps(settings, span)
+        scale = _temperature_scale(T0, steady_inputs)
+        times, temps = march(model, inputs_at, T0, start, settings.time, dt, settings.theta,
+                             nonlinear, adaptive, dt_min, dt_max, scale)
+    sol.temperature, sol.time = temps[-1], times[-1]
+    sol.substep_times, sol.substep_temperatures = times, temps
+    sol.previous_loads = now
+    s.fem.plane_inputs = steady_inputs if transient else inputs
+    return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature,
+                      nodal_temperature=mesh.nodal(sol.temperature))
+
+
+def _substeps(settings, span: float) -> tuple[float, bool, float, float]:  # noqa: ANN001
+    """(first substep, adaptive?, DTMIN, DTMAX) from DELTIM/NSUBST and AUTOTS."""
+    adaptive = bool(settings.autots)
+    if settings.deltim is not None:
+        dt = min(settings.deltim, span)
+        dt_min = settings.dtmin if settings.dtmin is not None else dt * DEFAULT_DTMIN_FRACTION
+        dt_max = settings.dtmax if settings.dtmax is not None else \
+            max(dt, span * DEFAULT_DTMAX_FRACTION)
+    else:
+        n = settings.nsubst or 1
+        dt = span / n
+        dt_max = span / settings.nsub_min if settings.nsub_min else \
+            max(dt, span * DEFAULT_DTMAX_FRACTION)
+        dt_min = span / settings.nsub_max if settings.nsub_max else \
+            dt * DEFAULT_DTMIN_FRACTION
+    if not adaptive:
+        n = max(1, int(np.ceil(span / dt - 1e-9)))
+        dt = span / n
+    return dt, adaptive, dt_min, dt_max
+
+
+def _temperature_scale(T0: np.ndarray, inputs: ThermalInputs) -> float:
+    """The temperature range the problem spans (initial field, fixed and bulk values)."""
+    values = [T0]
+    if inputs.fixed[1].size:
+        values.append(inputs.fixed[1])
+    values += [np.array([tb]) for _, _, tb in inputs.films]
+    allv = np.concatenate(values)
+    return float(np.ptp(allv)) if allv.size else 1.0
