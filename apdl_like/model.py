@@ -23,6 +23,7 @@ ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
     "PLANE77": ("thermal", 4, True),
     "PLANE182": ("structural", 4, False),
     "PLANE183": ("structural", 4, True),
+    "PLANE35": ("thermal", 3, True),
 }
 # ETCHG,TTS / STT pairs (thermal <-> structural)
 THERMAL_TO_STRUCTURAL = {"PLANE55": "PLANE182", "PLANE77": "PLANE183"}
@@ -50,7 +51,8 @@ class ElementType:
     @property
     def triangle6(self) -> bool:
         """PLANE183 with KEYOPT(1)=1: the 6-node triangle `E,I,J,K,L,M,N`."""
-        return self.name == "PLANE183" and self.keyopt.get(1, 0) == 1
+        return self.name == "PLANE35" or (self.name == "PLANE183" and
+                                           self.keyopt.get(1, 0) == 1)
 
 
 def _remap(
@@ -392,6 +394,7 @@ class Database:
     esize: float | None = None
     title: str = ""
     mp_temperatures: list[float] = field(default_factory=list)  # MPTEMP, for MPDATA
+    node_history: list[int] = field(default_factory=list)  # the last two nodes N defined
     csys: int = 0  # active coordinate system (0 Cartesian, 1 cylindrical: x = r, y = θ in °)
     # coupled DOF sets (CP): set number -> (label, node numbers)
     couplings: dict[int, tuple[str, np.ndarray]] = field(default_factory=dict)

@@ -123,9 +123,10 @@ def _lex(raw: str) -> tuple[str, tuple[str, ...]] | None:
     for text_cmd in _TEXT_COMMANDS:
         n = len(text_cmd)
         if upper.startswith(text_cmd) and (len(head) == n or head[n] in ", \t"):
-            rest = head[len(text_cmd) :].lstrip(" \t")
-            rest = rest[1:] if rest.startswith(",") else rest
-            return text_cmd, (rest.strip(),)
+            rest = head[len(text_cmd) :]
+            rest = rest.lstrip(" \t")[1:] if rest.lstrip(" \t").startswith(",") else \
+                rest.strip()
+            return text_cmd, (rest.rstrip(),)
     body = _strip_comment(raw).strip()
     if not body:
         return None

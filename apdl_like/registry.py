@@ -11,9 +11,19 @@ from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 
 from apdl_like.call import CommandSpec
-from apdl_like.commands import begin, blocks, loads, post1, prep7, selection, solution, tables
+from apdl_like.commands import (
+    begin,
+    blocks,
+    generate,
+    loads,
+    post1,
+    prep7,
+    selection,
+    solution,
+    tables,
+)
 
-FAMILIES = (begin, blocks, loads, post1, prep7, selection, solution, tables)
+FAMILIES = (begin, blocks, generate, loads, post1, prep7, selection, solution, tables)
 
 
 def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:

@@ -88,6 +88,7 @@ class Solution:
     substep_temperatures: list[np.ndarray] = field(default_factory=list)
     results: list[StepResult] = field(default_factory=list)
     post_index: int = -1  # result set shown in /POST1 (SET)
+    new_analysis: bool = True  # the next SOLVE starts a new results file (its load step 1)
 
 
 @dataclass

@@ -29,7 +29,7 @@ def test_fields_comments_and_case():
     assert lex_line("   ! only a comment", "f", 1) is None
     assert lex_line("Ri = 0.02 ! m", "f", 1).fields == ("RI", "", "0.02")
     com = lex_line("/COM, keep ! this, text", "f", 1)
-    assert com.name == "/COM" and com.fields == ("keep ! this, text",)
+    assert com.name == "/COM" and com.fields == (" keep ! this, text",)
 
 
 @pytest.mark.parametrize("text, value", [
@@ -285,7 +285,7 @@ def test_results_table_idiom_writes_fortran_formatted_rows():
     s.run_text(TABLE_DECK, "t.inp")
     rows = s.state.listing.files["vm0.vrt"]
     assert rows == [
-        "table",
+        " table",
         " T,F(AT X/L = 0.0        1100.      1100.40000             1.000",
         " T (C) X=.2788 in          -1.        -0.67120             1.001",
         "        q     /hr        5050.      4998.20000             0.990",

@@ -16,13 +16,15 @@ if TYPE_CHECKING:
 
 def _enter(processor: str):  # noqa: ANN202
     def enter(s: SessionState, c: Call) -> None:
+        if processor == "SOLU" and s.processor != "SOLU":
+            s.solution.new_analysis = True  # unless ANTYPE,,REST says otherwise
         s.processor = processor
 
     return enter
 
 
 def com(s: SessionState, c: Call) -> None:
-    s.say(c.raw(1))
+    s.say(" " + c.statement.fields[0])  # MAPDL prints comments one column in
 
 
 def title(s: SessionState, c: Call) -> None:

@@ -16,16 +16,20 @@ if TYPE_CHECKING:
 def set_(s: SessionState, c: Call) -> None:
     if not s.solution.results:
         raise ApdlError("there are no results (SOLVE first)")
+    results = s.solution.results
+    kind = results[-1].analysis  # the results file of the last analysis
+    steps = [i for i, r in enumerate(results) if r.analysis == kind]
     what = c.label(1, "LAST")
     if what in ("LAST", ""):
-        s.solution.post_index = len(s.solution.results) - 1
+        s.solution.post_index = steps[-1]
     elif what == "FIRST":
-        s.solution.post_index = 0
+        s.solution.post_index = steps[0]
     else:
         step = c.int(1, what="LSTEP")
-        if not 1 <= step <= len(s.solution.results):
-            raise ApdlError(f"load step {step} does not exist (1..{len(s.solution.results)})")
-        s.solution.post_index = step - 1
+        match = [i for i in steps if results[i].load_step == step]
+        if not match:
+            raise ApdlError(f"load step {step} does not exist (1..{len(steps)})")
+        s.solution.post_index = match[0]
 
 
 _ITEMS = {

@@ -8,6 +8,7 @@ import numpy as np
 
 from apdl_like.call import PREP7, Call, CommandSpec, ignored
 from apdl_like.errors import ApdlError
+from apdl_like.commands.generate import to_cartesian
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
 
 if TYPE_CHECKING:
@@ -44,7 +45,8 @@ def _element_name(c: Call) -> str:
     name = _BY_NUMBER.get(int(text), "") if text.isdigit() else text
     if name in CONTACT_TYPES or name in ELEMENT_TYPES or name in FOREIGN_TYPES.values():
         return name
-    raise ApdlError(f"element {text} is not supported (PLANE55, PLANE77, PLANE182, PLANE183)")
+    raise ApdlError(f"element {text} is not supported (PLANE35, PLANE55, PLANE77, PLANE182, "
+                    "PLANE183)")
 
 
 def et(s: SessionState, c: Call) -> None:
@@ -201,13 +203,16 @@ def n(s: SessionState, c: Call) -> None:
         nodes.flush()
         num = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
         num = max([num, *nodes.pending]) if nodes.pending else num
-    x, y = c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y")
+    x, y = to_cartesian(s.db.csys, c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
     if c.given(4) and c.num(4) != 0.0:
-        raise ApdlError("field 4 (Z) must be 0 in a 2-D axisymmetric model")
+        raise ApdlError("field 4 (Z) must be 0 in a 2-D model")
     nodes.add(num, x, y)
+    s.db.node_history = [*s.db.node_history[-1:], num]  # FILL's default pair
 
 
-_NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (8,), "PLANE183": (8,)}
+# node counts E accepts (quadratic elements without mid-side nodes get them from EMID)
+_NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (3, 4, 8),
+                "PLANE183": (3, 4, 8), "PLANE35": (3, 6)}
 
 
 def e(s: SessionState, c: Call) -> None:
@@ -219,7 +224,10 @@ def e(s: SessionState, c: Call) -> None:
     if given != list(range(1, len(given) + 1)):
         raise ApdlError("node fields must be given without gaps")
     nums = [_entity_number(c, i, "node") for i in given]
-    allowed = (6,) if et_.triangle6 else _NODE_COUNTS[et_.name]
+    if et_.name not in _NODE_COUNTS:
+        raise ApdlError(f"element type {db.active_type} ({et_.name}) is not supported: "
+                        "PLANE35, PLANE55, PLANE77, PLANE182 or PLANE183")
+    allowed = (3, 6) if et_.triangle6 else _NODE_COUNTS[et_.name]
     if len(nums) not in allowed:
         shape = "6-node triangle" if et_.triangle6 else et_.name
         raise ApdlError(f"{shape} takes {' or '.join(map(str, allowed))} nodes, got {len(nums)}")
@@ -228,7 +236,7 @@ def e(s: SessionState, c: Call) -> None:
         raise ApdlError(f"node {nums[int(np.nonzero(idx < 0)[0][0])]} does not exist")
     if len(set(nums[:3])) < 3:
         raise ApdlError("the first three nodes (I, J, K) must be distinct")
-    if len(nums) == 3:
+    if len(nums) == 3 and not et_.triangle6:
         nums.append(nums[2])  # the triangle is the quad with K = L
     el = db.elements
     el.flush()

@@ -9,6 +9,7 @@ import numpy as np
 
 from apdl_like.call import MODEL, Call, CommandSpec
 from apdl_like.errors import ApdlError
+from apdl_like.commands.generate import from_cartesian
 from apdl_like.model import Component
 from apdl_like.selection import combine, in_range, number_range
 
@@ -47,9 +48,10 @@ def nsel(s: SessionState, c: Call) -> None:
         comp = c.label(3)
         if comp not in ("X", "Y", "Z"):
             raise ApdlError(f"field 3: LOC takes X or Y (Z is 0 in a 2-D model), got {comp!r}")
-        vmin = c.num(4, what="VMIN")
+        vmin = c.num(4, 0.0, what="VMIN")  # MAPDL: a blank VMIN is 0
         vmax = c.num(5, vmin, what="VMAX")
-        values = np.zeros(len(nodes.ids)) if comp == "Z" else nodes.xy[:, "XY".index(comp)]
+        local = from_cartesian(s.db.csys, nodes.xy)
+        values = np.zeros(len(nodes.ids)) if comp == "Z" else local[:, "XY".index(comp)]
         picked = in_range(values, vmin, vmax)
     else:
         raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")

@@ -30,11 +30,13 @@ def antype(s: SessionState, c: Call) -> None:
         raise ApdlError("field 1 (analysis type) is required for a new analysis")
     if status == "NEW":
         s.solution.fresh_start = True
+        s.solution.new_analysis = True
         settings.time = None
     elif not s.solution.results and s.solution.temperature is None and not s.record_only:
         raise ApdlError("ANTYPE,,REST: there is no previous solution to continue from")
     else:
         s.solution.fresh_start = False
+        s.solution.new_analysis = False
 
 
 def time(s: SessionState, c: Call) -> None:
@@ -152,9 +154,16 @@ def solve(s: SessionState, c: Call) -> None:
     if len(types) != 1:
         raise ApdlError("the model mixes thermal and structural elements" if types else
                         "the model has no elements to solve")
-    result = solve_thermal(s) if types == {"thermal"} else solve_structural(s)
-    s.solution.results.append(result)
-    s.solution.post_index = -1
+    kind = "thermal" if types == {"thermal"} else "structural"
+    sol = s.solution
+    if sol.new_analysis:
+        # a new analysis writes a new results file: earlier load steps of this physics go
+        sol.results = [r for r in sol.results if r.analysis != kind]
+        sol.new_analysis = False
+    result = solve_thermal(s) if kind == "thermal" else solve_structural(s)
+    result.load_step = 1 + sum(r.analysis == kind for r in sol.results)
+    sol.results.append(result)
+    sol.post_index = -1
     s.say(f"load step {result.load_step}: {result.analysis} solution at time {result.time:g}")
 
 

@@ -1,0 +1,315 @@
+"""/PREP7 generation: CSYS, FILL, NGEN, EGEN, EMID, NUMMRG and coupled sets (CP, CPNGEN,
+CPSGEN).
+
+Coordinates are stored Cartesian (x = r, y = z for an axisymmetric model).  With CSYS,1 the
+fields of N, FILL and NGEN are cylindrical: X is the radius, Y the angle θ in degrees, and
+FILL interpolates in (r, θ), as MAPDL does.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.call import PREP7, Call, CommandSpec
+from apdl_like.errors import ApdlError
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+MAX_GENERATED = 1_000_000
+COUPLING_LABELS = ("TEMP", "UX", "UY", "ALL")
+
+
+def to_cartesian(csys: int, a: float, b: float) -> tuple[float, float]:
+    """(x, y) of a point given in coordinate system `csys` (1: r, θ in degrees)."""
+    if csys == 0:
+        return a, b
+    t = math.radians(b)
+    return a * math.cos(t), a * math.sin(t)
+
+
+def from_cartesian(csys: int, xy: np.ndarray) -> np.ndarray:
+    """Coordinates of points (n, 2) in `csys` (1: r, θ in degrees in (-180, 180])."""
+    if csys == 0:
+        return xy
+    return np.column_stack([np.hypot(xy[:, 0], xy[:, 1]),
+                            np.degrees(np.arctan2(xy[:, 1], xy[:, 0]))])
+
+
+def csys(s: SessionState, c: Call) -> None:
+    kcn = c.int(1, 0, what="KCN")
+    if kcn not in (0, 1):
+        raise ApdlError(f"field 1: coordinate system must be 0 (Cartesian) or 1 (cylindrical), "
+                        f"got {kcn}")
+    s.db.csys = kcn
+
+
+def _node_xy(s: SessionState, number: int) -> np.ndarray:
+    nodes = s.db.nodes
+    i = int(nodes.index(number)[0])
+    if i < 0:
+        raise ApdlError(f"node {number} does not exist")
+    return from_cartesian(s.db.csys, nodes.xy[i : i + 1])[0]
+
+
+def _spacing(n: int, space: float) -> np.ndarray:
+    """Fractions 0 < f_1 < ... < f_{n-1} < 1 of n intervals whose last/first ratio is space."""
+    if n < 1:
+        return np.zeros(0)
+    if space <= 0.0:
+        raise ApdlError(f"SPACE must be positive (a ratio), got {space!r}")
+    if n == 1 or space == 1.0:
+        lengths = np.ones(n)
+    else:
+        lengths = space ** (np.arange(n) / (n - 1))
+    return np.cumsum(lengths)[:-1] / lengths.sum()
+
+
+def fill(s: SessionState, c: Call) -> None:
+    """FILL,NODE1,NODE2,NFILL,NSTRT,NINC,ITIME,INC,SPACE: nodes between two nodes."""
+    history = s.db.node_history
+    if c.given(1):
+        n1 = c.int(1, what="NODE1")
+        n2 = c.int(2, what="NODE2")
+    elif len(history) >= 2:
+        n1, n2 = history[-2], history[-1]
+    else:
+        raise ApdlError("FILL without nodes needs two nodes defined before it (N)")
+    nfill = c.int(3, abs(n2 - n1) - 1, what="NFILL")
+    if nfill < 1:
+        return
+    ninc = c.int(5, (n2 - n1) // (nfill + 1) if n2 != n1 else 1, what="NINC")
+    nstrt = c.int(4, n1 + ninc, what="NSTRT")
+    itime, inc = c.int(6, 1, what="ITIME"), c.int(7, 1, what="INC")
+    space = c.num(8, 1.0, what="SPACE")
+    if nfill * itime > MAX_GENERATED:
+        raise ApdlError(f"FILL would make more than {MAX_GENERATED} nodes")
+    fractions = _spacing(nfill + 1, space)
+    for k in range(itime):
+        a, b = _node_xy(s, n1 + k * inc), _node_xy(s, n2 + k * inc)
+        for j, f in enumerate(fractions):
+            x, y = to_cartesian(s.db.csys, *(a + f * (b - a)))
+            s.db.nodes.add(nstrt + k * inc + j * ninc, x, y)
+
+
+def ngen(s: SessionState, c: Call) -> None:
+    """NGEN,ITIME,INC,NODE1,NODE2,NINC,DX,DY,DZ: copies of a node pattern, offset."""
+    itime = c.int(1, what="ITIME")
+    inc = c.int(2, what="INC")
+    nodes = s.db.nodes
+    nodes.flush()
+    if c.label(3) == "ALL" or not c.given(3):
+        pattern = nodes.ids[nodes.selected]
+    else:
+        n1 = c.int(3, what="NODE1")
+        n2 = c.int(4, n1, what="NODE2")
+        ninc = c.int(5, 1, what="NINC")
+        if ninc < 1:
+            raise ApdlError("field 5 (NINC) must be ≥ 1")
+        wanted = np.arange(n1, n2 + 1, ninc)
+        pattern = wanted[nodes.index(wanted) >= 0]
+    dx, dy = c.num(6, 0.0, what="DX"), c.num(7, 0.0, what="DY")
+    if c.given(8) and c.num(8) != 0.0:
+        raise ApdlError("field 8 (DZ) must be 0 in a 2-D model")
+    if pattern.size * max(itime - 1, 0) > MAX_GENERATED:
+        raise ApdlError(f"NGEN would make more than {MAX_GENERATED} nodes")
+    local = from_cartesian(s.db.csys, nodes.xy[nodes.index(pattern)])
+    for k in range(1, itime):
+        for num, (a, b) in zip(pattern.tolist(), local, strict=True):
+            x, y = to_cartesian(s.db.csys, a + k * dx, b + k * dy)
+            nodes.add(num + k * inc, x, y)
+
+
+def egen(s: SessionState, c: Call) -> None:
+    """EGEN,ITIME,NINC,IEL1,IEL2,IEINC,MINC,TINC,RINC: copies of an element pattern with
+    node numbers (and attributes) incremented."""
+    itime = c.int(1, what="ITIME")
+    ninc = c.int(2, what="NINC")
+    el = s.db.elements
+    el.flush()
+    if not len(el.ids):
+        raise ApdlError("there are no elements to generate from")
+    if c.label(3) == "ALL" or not c.given(3):
+        pattern = np.nonzero(el.selected)[0]
+    else:
+        first = c.int(3, what="IEL1")
+        if first < 0:
+            pattern = np.arange(len(el.ids) - min(-first, len(el.ids)), len(el.ids))
+        else:
+            last = c.int(4, first, what="IEL2")
+            step = c.int(5, 1, what="IEINC")
+            wanted = np.arange(first, last + 1, max(step, 1))
+            idx = el.index(wanted)
+            if np.any(idx < 0):
+                raise ApdlError(f"element {int(wanted[np.nonzero(idx < 0)[0][0]])} does not exist")
+            pattern = idx
+    minc, tinc, rinc = (c.int(i, 0, what=w) for i, w in ((6, "MINC"), (7, "TINC"), (8, "RINC")))
+    if pattern.size * max(itime - 1, 0) > MAX_GENERATED:
+        raise ApdlError(f"EGEN would make more than {MAX_GENERATED} elements")
+    number = int(el.ids.max()) + 1
+    rows = [(int(el.type[i]), int(el.mat[i]), int(el.real[i]), el.nodes[i].copy())
+            for i in pattern]
+    nodes = s.db.nodes
+    for k in range(1, itime):
+        for etype, mat, real, conn in rows:
+            new = np.where(conn > 0, conn + k * ninc, 0)
+            missing = new[(new > 0) & (nodes.index(np.maximum(new, 1)) < 0)]
+            if missing.size:
+                raise ApdlError(f"EGEN: node {int(missing[0])} does not exist")
+            if etype + k * tinc not in s.db.element_types:
+                raise ApdlError(f"EGEN: element type {etype + k * tinc} is not defined")
+            el.add(number, etype + k * tinc, mat + k * minc, real + k * rinc,
+                   tuple(int(v) for v in new))
+            number += 1
+
+
+def emid(s: SessionState, c: Call) -> None:
+    """EMID: mid-side nodes at the edge midpoints of quadratic elements that lack them."""
+    db = s.db
+    el, nodes = db.elements, db.nodes
+    el.flush()
+    nodes.flush()
+    if not len(el.ids):
+        return
+    next_number = int(nodes.ids.max()) + 1
+    made: dict[tuple[int, int], int] = {}
+    for row in range(len(el.ids)):
+        et = db.element_types.get(int(el.type[row]))
+        if et is None or not et.quadratic or et.triangle6:
+            continue
+        conn = el.nodes[row]
+        for col, (a, b) in zip(range(4, 8), ((0, 1), (1, 2), (2, 3), (3, 0)), strict=True):
+            if conn[col] > 0:
+                continue
+            na, nb = int(conn[a]), int(conn[b])
+            if na == nb:
+                conn[col] = na  # the collapsed edge of a triangle
+                continue
+            key = (min(na, nb), max(na, nb))
+            num = made.get(key)
+            if num is None:
+                ia, ib = nodes.index(np.array([na, nb]))
+                x, y = 0.5 * (nodes.xy[ia] + nodes.xy[ib])
+                num = made[key] = next_number
+                next_number += 1
+                nodes.add(num, float(x), float(y))
+            conn[col] = num
+    el.version += 1
+    s.say(f"EMID: {len(made)} mid-side nodes")
+
+
+def nummrg(s: SessionState, c: Call) -> None:
+    """NUMMRG,NODE|ALL[,TOLER]: elements use the lowest-numbered of coincident nodes."""
+    label = c.label(1, "ALL")
+    if label not in ("NODE", "ALL", "KP", "ELEM", "MAT", "TYPE", "REAL", "CP", "CE"):
+        raise ApdlError(f"field 1: NUMMRG label must be NODE or ALL, got {label!r}")
+    if label not in ("NODE", "ALL"):
+        return
+    from scipy.spatial import cKDTree
+
+    nodes, el = s.db.nodes, s.db.elements
+    nodes.flush()
+    el.flush()
+    if len(nodes.ids) < 2:
+        return
+    extent = float(np.ptp(nodes.xy, axis=0).max()) or 1.0
+    toler = c.num(2, 1e-4, what="TOLER") * extent
+    pairs = cKDTree(nodes.xy).query_pairs(toler, output_type="ndarray")
+    if not pairs.size:
+        return
+    keep = np.arange(len(nodes.ids))
+    for a, b in sorted(map(tuple, pairs)):
+        ra, rb = keep[a], keep[b]
+        keep[max(ra, rb)] = min(ra, rb)
+    keep = keep[keep]
+    new_number = nodes.ids[keep]
+    idx = nodes.index(np.maximum(el.nodes, 1))
+    el.nodes = np.where((el.nodes > 0) & (idx >= 0), new_number[np.maximum(idx, 0)], el.nodes)
+    el.version += 1
+    s.say(f"NUMMRG: {int(np.sum(keep != np.arange(keep.size)))} coincident nodes merged")
+
+
+def _coupling_label(c: Call, i: int) -> str:
+    label = c.label(i)
+    if label not in COUPLING_LABELS:
+        raise ApdlError(f"field {i}: coupled DOF must be one of {', '.join(COUPLING_LABELS)}, "
+                        f"got {label or '(empty)'!r}")
+    return label
+
+
+def _set_number(s: SessionState, c: Call) -> int:
+    sets = s.db.couplings
+    if not c.given(1) or c.label(1) in ("HIGH", "NEXT"):
+        return max(sets, default=0) + 1
+    return c.int(1, what="NSET")
+
+
+def cp(s: SessionState, c: Call) -> None:
+    """CP,NSET,Lab,NODE1,...,NODE17: the nodes share one value of Lab."""
+    nset = _set_number(s, c)
+    label = _coupling_label(c, 2)
+    nodes = s.db.nodes
+    if c.label(3) == "ALL":
+        numbers = nodes.ids[nodes.selected]
+    else:
+        numbers = np.array([c.int(i, what="NODE") for i in range(3, c.count() + 1)
+                            if c.given(i)], np.int64)
+    if np.any(nodes.index(np.abs(numbers)) < 0):
+        raise ApdlError(f"node {int(numbers[nodes.index(np.abs(numbers)) < 0][0])} does not "
+                        "exist")
+    _add_coupling(s, nset, label, numbers[numbers > 0])
+
+
+def _add_coupling(s: SessionState, nset: int, label: str, numbers: np.ndarray) -> None:
+    old = s.db.couplings.get(nset)
+    if old is not None and old[0] != label:
+        raise ApdlError(f"coupled set {nset} holds {old[0]}, not {label}")
+    merged = numbers if old is None else np.union1d(old[1], numbers)
+    s.db.couplings[nset] = (label, np.unique(merged))
+
+
+def cpngen(s: SessionState, c: Call) -> None:
+    """CPNGEN,NSET,Lab,NODE1,NODE2,NINC: nodes NODE1..NODE2 into one coupled set."""
+    nset = _set_number(s, c)
+    label = _coupling_label(c, 2)
+    n1 = c.int(3, what="NODE1")
+    n2 = c.int(4, n1, what="NODE2")
+    ninc = c.int(5, 1, what="NINC")
+    wanted = np.arange(n1, n2 + 1, max(ninc, 1))
+    _add_coupling(s, nset, label, wanted[s.db.nodes.index(wanted) >= 0])
+
+
+def cpsgen(s: SessionState, c: Call) -> None:
+    """CPSGEN,ITIME,INC,NSET1,NSET2,NINC: copies of coupled sets, node numbers + k·INC."""
+    itime, inc = c.int(1, what="ITIME"), c.int(2, what="INC")
+    first = c.int(3, what="NSET1")
+    last = c.int(4, first, what="NSET2")
+    step = c.int(5, 1, what="NINC")
+    sets = s.db.couplings
+    pattern = [n for n in range(first, last + 1, max(step, 1)) if n in sets]
+    if not pattern:
+        raise ApdlError(f"coupled set {first} does not exist")
+    nodes = s.db.nodes
+    for k in range(1, itime):
+        for n in pattern:
+            label, numbers = sets[n]
+            new = numbers + k * inc
+            new = new[nodes.index(new) >= 0]
+            if new.size:
+                sets[max(sets) + 1] = (label, new)
+
+
+COMMANDS = (
+    CommandSpec("CSYS", PREP7 | {"SOLU", "POST1", "BEGIN", "POST26"}, 1, csys),
+    CommandSpec("FILL", PREP7, 8, fill),
+    CommandSpec("NGEN", PREP7, 9, ngen),
+    CommandSpec("EGEN", PREP7, 14, egen),
+    CommandSpec("EMID", PREP7, 2, emid),
+    CommandSpec("NUMMRG", PREP7, 5, nummrg),
+    CommandSpec("CP", PREP7, 19, cp),
+    CommandSpec("CPNGEN", PREP7, 5, cpngen),
+    CommandSpec("CPSGEN", PREP7, 6, cpsgen),
+)

@@ -1,0 +1,45 @@
+"""MAPDL Verification Manual decks, run as published (tests/data/apdl_vm, MIT).
+
+Each deck writes its own results table with /OUT,vmNN,vrt and *VWRITE: a label, the
+published TARGET, the value apdl-like computed and their ratio.  Every computed value must
+lie within 2 % of its target.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DECKS = Path(__file__).parent / "data" / "apdl_vm"
+TOLERANCE = 0.02
+_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[EeDd][-+]?\d+)?")
+
+# the decks that run as published, and the rows of their results tables
+ROWS = {"vm102": 8}
+
+
+def results_table(path: Path) -> list[tuple[str, float, float]]:
+    """(label, target, computed) of each *VWRITE row: label in columns 2..17, then three
+    numbers (target, computed, ratio)."""
+    rows = []
+    for line in path.read_text().splitlines():
+        numbers = _NUMBER.findall(line[17:])
+        if len(line) > 17 and line[0] == " " and len(numbers) == 3 and "|" not in line:
+            rows.append((line[1:17].strip(), float(numbers[0]), float(numbers[1])))
+    return rows
+
+
+@pytest.mark.parametrize("deck", sorted(ROWS))
+def test_verification_deck_runs_as_published(deck, tmp_path):
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(DECKS / f"{deck}.dat"),
+                           "--out", str(out)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    rows = results_table(out / f"{deck}.vrt")
+    assert len(rows) == ROWS[deck], rows
+    for label, target, computed in rows:
+        assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), (deck, label)
