@@ -72,7 +72,7 @@ def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     params = out / "params.json"
     write_text(params, json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n")
     written.append(params)
-    for i, res in enumerate(session.solution.results):
+    for i in range(len(session.solution.results)):
         path = out / f"result_{i + 1:03d}.vtu"
         write_result_vtu(session, i, path)
         written.append(path)

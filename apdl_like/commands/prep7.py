@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import PREP7, Call, CommandSpec, ignored
-from apdl_like.errors import ApdlError
 from apdl_like.commands.generate import to_cartesian
+from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
 
 if TYPE_CHECKING:

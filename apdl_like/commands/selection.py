@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import MODEL, Call, CommandSpec
-from apdl_like.errors import ApdlError
 from apdl_like.commands.generate import from_cartesian
+from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 from apdl_like.selection import combine, in_range, number_range
 
