@@ -232,10 +232,7 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
         return old + fraction * (np.nan_to_num(new, nan=start) - old)
 
     hgen = np.nan_to_num(ramp(now.hgen, None if before is None else before.hgen, 0.0))
-    order = np.argsort(mesh.facet_keys)
-    sorted_keys = mesh.facet_keys[order]
-    pos = np.clip(np.searchsorted(sorted_keys, faces.face_keys), 0, sorted_keys.size - 1)
-    face_facet = order[pos]
+    face_key = faces.face_keys
     films, fluxes = [], []
     h = ramp(now.conv_h, None if before is None else before.conv_h, 0.0)
     tb = ramp(now.conv_bulk, None if before is None else before.conv_bulk, tunif)
@@ -247,18 +244,16 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
                             "temperature (SFE KVAL 1 and 2)")
         if hv != 0.0:
             for sub in _split_by(idx, tb):
-                films.append((face_facet[sub], hv, float(tb[sub[0]])))
+                films.append((face_key[sub], hv, float(tb[sub[0]])))
     q = ramp(now.hflux, None if before is None else before.hflux, 0.0)
     for idx in record_groups(db.faces.hflux_record):
         for sub in _split_by(idx, q):
             if q[sub[0]] != 0.0:
-                fluxes.append((face_facet[sub], float(q[sub[0]])))
+                fluxes.append((face_key[sub], float(q[sub[0]])))
     d = ramp(now.d_temp, None if before is None else before.d_temp, tunif)
     nodes_fixed = np.nonzero(~np.isnan(now.d_temp) & (mesh.node_dof >= 0))[0]
     fixed = (mesh.node_dof[nodes_fixed], d[nodes_fixed])
-    cell_hgen = hgen[mesh.cell_element]
-    return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], cell_hgen, films, fluxes,
-                         fixed)
+    return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed)
 
 
 def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
@@ -297,12 +292,12 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
     transient = settings.antype == "TRANS" and settings.timint is not False
     props, mats = _properties(db, settings.antype == "TRANS")
     nonlinear = _is_nonlinear(db, mats)
-    cell_material = db.elements.mat[mesh.cell_element]
+    element_material = db.elements.mat
     couplings = _couplings(db, mesh)
-    key = (id(mesh), tuple(np.unique(cell_material)), tuple(map(bytes, couplings)))
+    key = (id(mesh), element_material.tobytes(), tuple(c.tobytes() for c in couplings))
     cache = s.fem
     if cache.plane_solver is None or cache.plane_solver[0] != key:
-        cache.plane_solver = (key, PlaneThermal(mesh, cell_material, couplings))
+        cache.plane_solver = (key, PlaneThermal(mesh, element_material, couplings))
     model: PlaneThermal = cache.plane_solver[1]
     sol = s.solution
     if sol.fresh_start or sol.temperature is None or sol.temperature.size != mesh.n_dofs:

@@ -59,19 +59,29 @@ def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 @dataclass
-class PlaneMesh:
-    """The scikit-fem view of a deck's elements and the node -> dof map."""
+class Part:
+    """The elements of one shape (quads or triangles) as a scikit-fem basis."""
 
     basis: Basis
-    node_dof: np.ndarray  # node index -> dof, -1 for nodes outside the elements
-    cell_element: np.ndarray  # cell -> element index
-    vertex_node: np.ndarray  # mesh vertex -> node index
+    to_global: sp.csr_matrix  # (n_global, n_local) selection: global = to_global @ local
+    local_dofs: np.ndarray  # local dof -> global dof
+    elements: np.ndarray  # cell -> element index of the deck's element table
     facet_keys: np.ndarray  # mesh facet -> packed corner node-number pair
-    axisymmetric: bool
 
-    @property
-    def n_dofs(self) -> int:
-        return self.basis.N
+
+@dataclass
+class PlaneMesh:
+    """A deck's elements as scikit-fem parts (quads, triangles) sharing one dof numbering.
+
+    Global dofs: the corner nodes, then (quadratic) one per element edge; a mid-side node
+    is the dof of its edge.
+    """
+
+    parts: list[Part]
+    n_dofs: int
+    node_dof: np.ndarray  # node index -> dof, -1 for nodes outside the elements
+    axisymmetric: bool
+    lumped: bool  # linear elements: MAPDL diagonalizes their specific heat matrix
 
     def nodal(self, T: np.ndarray) -> np.ndarray:
         """Per-node values (NaN outside the elements)."""
@@ -85,56 +95,86 @@ def build_mesh(xy: np.ndarray, node_ids: np.ndarray, corners: np.ndarray,
                midside: np.ndarray | None, axisymmetric: bool) -> PlaneMesh:
     """corners (m, 4) node indices (K = L for a triangle); midside (m, 4) node indices of
     the mid-side nodes I-J, J-K, K-L, L-I (-1 none) for quadratic elements, else None."""
+    vertex_node = np.unique(corners)
+    if axisymmetric:
+        x = xy[vertex_node, 0]
+        if np.any(x < -1e-9 * max(1.0, float(np.abs(xy[vertex_node]).max()))):
+            bad = node_ids[vertex_node[np.argmin(x)]]
+            raise ApdlError(f"node {bad} lies at negative X (radius) in an axisymmetric model")
+    node_dof = np.full(len(node_ids), -1, np.int64)
+    node_dof[vertex_node] = np.arange(vertex_node.size)
+    n_global = vertex_node.size
+    edge_dof: dict[int, int] = {}
     tri = corners[:, 2] == corners[:, 3]
+    parts = []
+    for is_tri in (False, True):
+        elements = np.nonzero(tri == is_tri)[0]
+        if not elements.size:
+            continue
+        part_corners = corners[elements][:, :3] if is_tri else corners[elements]
+        part_mid = None if midside is None else midside[elements]
+        part, n_global = _part(xy, node_ids, node_dof, part_corners, part_mid, elements,
+                               is_tri, edge_dof, n_global)
+        parts.append(part)
+    for part in parts:
+        part.to_global = sp.csr_matrix(
+            (np.ones(part.local_dofs.size), (part.local_dofs, np.arange(part.local_dofs.size))),
+            shape=(n_global, part.local_dofs.size))
+    return PlaneMesh(parts, n_global, node_dof, axisymmetric, midside is None)
+
+
+def _part(xy: np.ndarray, node_ids: np.ndarray, node_dof: np.ndarray, corners: np.ndarray,
+          midside: np.ndarray | None, elements: np.ndarray, is_tri: bool,
+          edge_dof: dict[int, int], n_global: int) -> tuple[Part, int]:
     vertex_node = np.unique(corners)
     vertex_of = np.full(len(node_ids), -1, np.int64)
     vertex_of[vertex_node] = np.arange(vertex_node.size)
     p = xy[vertex_node].T
-    if axisymmetric and np.any(p[0] < -1e-9 * max(1.0, float(np.abs(p).max()))):
-        bad = node_ids[vertex_node[np.argmin(p[0])]]
-        raise ApdlError(f"node {bad} lies at negative X (radius) in an axisymmetric model")
-    all_tri = bool(tri.all())
-    if all_tri:
-        t = vertex_of[corners[:, :3]].T.copy()
-    else:
-        t = vertex_of[corners].T.copy()
-    # counter-clockwise cells: the signed area from the corner polygon
-    pts = p[:, t]
-    x, y = pts[0], pts[1]
+    t = vertex_of[corners].T.copy()
+    # counter-clockwise cells: the signed area of the corner polygon
+    x, y = p[0][t], p[1][t]
     area2 = (x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y).sum(axis=0)
     scale = max(float(np.ptp(p, axis=1).max()), 1e-300) ** 2
     if np.any(np.abs(area2) <= 1e-12 * scale):
-        raise ApdlError(f"element with zero area (cell {int(np.argmin(np.abs(area2)))}: check "
-                        "its node order and coordinates)")
+        bad = int(node_ids[corners[int(np.argmin(np.abs(area2))), 0]])
+        raise ApdlError(f"an element at node {bad} has zero area (check its node order and "
+                        "coordinates)")
     flip = area2 < 0
-    t[:, flip] = t[::-1][:, flip] if all_tri else t[[0, 3, 2, 1]][:, flip]
-    if all_tri:
+    t[:, flip] = t[::-1][:, flip]
+    if is_tri:
         mesh = MeshTri1(p, t, validate=False, sort_t=False)
         element = ElementTriP2() if midside is not None else ElementTriP1()
     else:
         mesh = MeshQuad1(p, t, validate=False, sort_t=False)
         element = ElementQuadS2() if midside is not None else ElementQuad1()
     basis = Basis(mesh, element)
-    node_dof = np.full(len(node_ids), -1, np.int64)
-    node_dof[vertex_node] = basis.nodal_dofs[0]
+    local = np.full(basis.N, -1, np.int64)
+    local[basis.nodal_dofs[0]] = node_dof[vertex_node]
     facet_keys = pair_keys(node_ids[vertex_node[mesh.facets[0]]],
                            node_ids[vertex_node[mesh.facets[1]]])
     if midside is not None:
-        order = np.argsort(facet_keys)
-        edges = ((0, 1), (1, 2), (2, 3), (3, 0))
-        for col, (i, j) in enumerate(edges):
+        for f, key in enumerate(facet_keys.tolist()):
+            dof = edge_dof.get(key)
+            if dof is None:
+                dof = edge_dof[key] = n_global
+                n_global += 1
+            local[basis.facet_dofs[0, f]] = dof
+        # the mid-side nodes: the dofs of their edges, found by the corner pair
+        edges = ((0, 1, 0), (1, 2, 1), (2, 0, 3)) if is_tri else \
+            ((0, 1, 0), (1, 2, 1), (2, 3, 2), (3, 0, 3))
+        for i, j, col in edges:
             has = midside[:, col] >= 0
-            if all_tri and col == 2:
-                continue  # the collapsed edge K-L of a degenerate quad
-            if all_tri and col == 3:
-                i, j = 2, 0
             keys = pair_keys(node_ids[corners[has, i]], node_ids[corners[has, j]])
-            pos = np.clip(np.searchsorted(facet_keys[order], keys), 0, facet_keys.size - 1)
-            if not np.array_equal(facet_keys[order][pos], keys):
-                raise ApdlError("a mid-side node does not sit on an element edge")
-            node_dof[midside[has, col]] = basis.facet_dofs[0, order[pos]]
-    return PlaneMesh(basis, node_dof, np.arange(corners.shape[0]), vertex_node, facet_keys,
-                     axisymmetric)
+            for node, key in zip(midside[has, col].tolist(), keys.tolist(), strict=True):
+                dof = edge_dof.get(key)
+                if dof is None:
+                    raise ApdlError(f"mid-side node {int(node_ids[node])} does not sit on an "
+                                    "element edge")
+                node_dof[node] = dof
+    if np.any(local < 0):
+        raise ApdlError("internal numbering error of the element dofs")  # pragma: no cover
+    placeholder = sp.csr_matrix((0, 0))
+    return Part(basis, placeholder, local, elements, facet_keys), n_global
 
 
 # ----------------------------------------------------------------- the forms
@@ -174,12 +214,12 @@ def face_load(v, w):  # noqa: ANN001, ANN201
 
 @dataclass
 class ThermalInputs:
-    """One load state of the model on a `PlaneMesh` (see `plane_loads` in apdl_like.solve).
+    """One load state of the model on a `PlaneMesh` (see apdl_like.plane_solve).
 
-    kxx, kyy, rho_c  per cell: property(T at quadrature points) callables
-    hgen             per cell, W/m³
-    films            (facets, h W/m²K, T_bulk °C) groups
-    fluxes           (facets, q W/m²) groups
+    kxx, kyy, rho_c  per material number: property(T at quadrature points) callables
+    hgen             per element of the deck's table, W/m³
+    films            (face keys, h W/m²K, T_bulk °C) groups; keys: packed corner node numbers
+    fluxes           (face keys, q W/m²) groups
     fixed            (dofs, values °C)
     """
 
@@ -193,54 +233,80 @@ class ThermalInputs:
 
 
 class PlaneThermal:
-    """Assembly and solves on one `PlaneMesh` with per-cell material properties."""
+    """Assembly and solves on one `PlaneMesh` with per-element material numbers."""
 
-    def __init__(self, mesh: PlaneMesh, cell_material: np.ndarray,
+    def __init__(self, mesh: PlaneMesh, element_material: np.ndarray,
                  couplings: list[np.ndarray]) -> None:
         self.mesh = mesh
-        self.basis = mesh.basis
-        self.cell_material = cell_material
-        self.groups = {int(m): np.nonzero(cell_material == m)[0]
-                       for m in np.unique(cell_material)}
-        self._facet_bases: dict[bytes, FacetBasis] = {}
-        self._reduce = _coupling_map(self.basis.N, couplings)
+        self.groups = []  # per part: material -> cells
+        for part in mesh.parts:
+            mats = element_material[part.elements]
+            self.groups.append({int(m): np.nonzero(mats == m)[0] for m in np.unique(mats)})
+        self._facet_bases: dict[tuple[int, bytes], FacetBasis] = {}
+        self._reduce = _coupling_map(mesh.n_dofs, couplings)
+        self._linear_cache: tuple[ThermalInputs, tuple] | None = None
 
     # ---------------------------------------------------------------- pieces
-    def _cell_field(self, props: list[Property], T: np.ndarray) -> np.ndarray:
-        """A per-cell property at the quadrature points, evaluated at temperature T."""
-        Tq = self.basis.interpolate(T).value
+    def _cell_field(self, k: int, props: list[Property], T_local: np.ndarray) -> np.ndarray:
+        """A per-cell property at the quadrature points of part k, at temperature T."""
+        Tq = self.mesh.parts[k].basis.interpolate(T_local).value
         out = np.empty_like(Tq)
-        for m, cells in self.groups.items():
+        for m, cells in self.groups[k].items():
             out[cells] = props[m](Tq[cells])
         return out
 
-    def operators(self, inputs: ThermalInputs, T: np.ndarray) -> tuple[sp.csr_matrix,
-                                                                          sp.csr_matrix,
-                                                                          np.ndarray]:
-        """(K conduction + films, C capacity, f loads) at temperature T."""
-        b = self.basis
-        ax = self.mesh.axisymmetric
-        K = conduction.assemble(b, kxx=self._cell_field(inputs.kxx, T),
-                                kyy=self._cell_field(inputs.kyy, T), axisymmetric=ax)
-        C = capacity.assemble(b, rho_c=self._cell_field(inputs.rho_c, T), axisymmetric=ax)
-        q = np.repeat(inputs.hgen[:, None], b.X.shape[-1], axis=1)
-        f = source.assemble(b, q=q, axisymmetric=ax) if np.any(inputs.hgen) else \
-            np.zeros(b.N)
-        for facets, h, tb in inputs.films:
-            fb = self._facet_basis(facets)
-            K = K + film.assemble(fb, h=h, axisymmetric=ax)
-            f = f + face_load.assemble(fb, g=h * tb, axisymmetric=ax)
-        for facets, flux in inputs.fluxes:
-            f = f + face_load.assemble(self._facet_basis(facets), g=flux, axisymmetric=ax)
-        return K.tocsr(), C.tocsr(), f
+    def operators(self, inputs: ThermalInputs, T: np.ndarray,
+                  nonlinear: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix, np.ndarray]:
+        """(K conduction + films, C capacity, f loads) at temperature T.
 
-    def _facet_basis(self, facets: np.ndarray) -> FacetBasis:
-        key = np.ascontiguousarray(facets).tobytes()
-        fb = self._facet_bases.get(key)
-        if fb is None:
-            fb = FacetBasis(self.basis.mesh, self.basis.elem, facets=facets)
-            self._facet_bases[key] = fb
-        return fb
+        Without temperature dependence they are assembled once per `inputs` object."""
+        cached = self._linear_cache
+        if not nonlinear and cached is not None and cached[0] is inputs:
+            return cached[1]  # type: ignore[return-value]
+        ax = self.mesh.axisymmetric
+        n = self.mesh.n_dofs
+        K = sp.csr_matrix((n, n))
+        C = sp.csr_matrix((n, n))
+        f = np.zeros(n)
+        for k, part in enumerate(self.mesh.parts):
+            b, S = part.basis, part.to_global
+            T_local = T[part.local_dofs]
+            Kp = conduction.assemble(b, kxx=self._cell_field(k, inputs.kxx, T_local),
+                                     kyy=self._cell_field(k, inputs.kyy, T_local),
+                                     axisymmetric=ax)
+            Cp = capacity.assemble(b, rho_c=self._cell_field(k, inputs.rho_c, T_local),
+                                   axisymmetric=ax)
+            K = K + S @ Kp @ S.T
+            C = C + S @ Cp @ S.T
+            q = inputs.hgen[part.elements]
+            if np.any(q):
+                qq = np.repeat(q[:, None], b.X.shape[-1], axis=1)
+                f = f + S @ source.assemble(b, q=qq, axisymmetric=ax)
+            for keys, h, tb in inputs.films:
+                fb = self._facet_basis(k, keys)
+                if fb is not None:
+                    K = K + S @ film.assemble(fb, h=h, axisymmetric=ax) @ S.T
+                    f = f + S @ face_load.assemble(fb, g=h * tb, axisymmetric=ax)
+            for keys, flux in inputs.fluxes:
+                fb = self._facet_basis(k, keys)
+                if fb is not None:
+                    f = f + S @ face_load.assemble(fb, g=flux, axisymmetric=ax)
+        if self.mesh.lumped:
+            C = sp.diags(np.asarray(C.sum(axis=1)).ravel()).tocsr()
+        out = (K.tocsr(), C.tocsr(), f)
+        if not nonlinear:
+            self._linear_cache = (inputs, out)
+        return out
+
+    def _facet_basis(self, k: int, keys: np.ndarray) -> FacetBasis | None:
+        """The facets of part k with these node-pair keys (None if it has none)."""
+        cache_key = (k, np.ascontiguousarray(keys).tobytes())
+        if cache_key not in self._facet_bases:
+            part = self.mesh.parts[k]
+            facets = np.nonzero(np.isin(part.facet_keys, keys))[0]
+            self._facet_bases[cache_key] = FacetBasis(part.basis.mesh, part.basis.elem,
+                                                      facets=facets) if facets.size else None
+        return self._facet_bases[cache_key]
 
     def _solve(self, A: sp.csr_matrix, rhs: np.ndarray,
                fixed: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -275,7 +341,7 @@ class PlaneThermal:
         """K(T) T = f(T), Picard iteration from T0 when properties depend on T."""
         T = T0
         for _ in range(PICARD_ITERATIONS if nonlinear else 1):
-            K, _, f = self.operators(inputs, T)
+            K, _, f = self.operators(inputs, T, nonlinear)
             T_new = self._solve(K, f, inputs.fixed)
             change = float(np.max(np.abs(T_new - T))) if T.size else 0.0
             T = T_new
@@ -287,11 +353,11 @@ class PlaneThermal:
     def step(self, inputs_old: ThermalInputs, inputs_new: ThermalInputs, T: np.ndarray,
              dt: float, theta: float, nonlinear: bool) -> np.ndarray:
         """One θ-step: (C/dt + θK) T1 = (C/dt − (1−θ)K) T0 + θ f1 + (1−θ) f0."""
-        K0, C0, f0 = self.operators(inputs_old, T)
+        K0, C0, f0 = self.operators(inputs_old, T, nonlinear)
         T1 = T
         for _ in range(PICARD_ITERATIONS if nonlinear else 1):
-            K1, C1, f1 = self.operators(inputs_new, T1) if nonlinear or inputs_new is not \
-                inputs_old else (K0, C0, f0)
+            K1, C1, f1 = self.operators(inputs_new, T1, nonlinear) if nonlinear or \
+                inputs_new is not inputs_old else (K0, C0, f0)
             C = 0.5 * (C0 + C1) if nonlinear else C0
             A = C / dt + theta * K1
             rhs = C @ T / dt - (1.0 - theta) * (K0 @ T) + theta * f1 + (1.0 - theta) * f0
@@ -303,9 +369,51 @@ class PlaneThermal:
         raise ApdlError(f"the nonlinear thermal step did not converge in {PICARD_ITERATIONS} "
                         "Picard iterations")
 
+    def element_heat(self, inputs: ThermalInputs, T: np.ndarray, element: int) -> np.ndarray:
+        """Heat flow (W) at the global dofs of one element, steady: its conduction and film
+        matrices times T less its loads; the sum over the elements at a node with a fixed
+        temperature is that node's reaction heat."""
+        for k, part in enumerate(self.mesh.parts):
+            cells = np.nonzero(part.elements == element)[0]
+            if cells.size:
+                break
+        else:
+            raise ApdlError("the element is not part of the thermal mesh")
+        ax = self.mesh.axisymmetric
+        b = Basis(part.basis.mesh, part.basis.elem, elements=cells)
+        T_local = T[part.local_dofs]
+        mats = {m: np.nonzero(np.isin(cells, c))[0] for m, c in self.groups[k].items()}
+        Tq = b.interpolate(T_local).value
+
+        def field(props: list[Property]) -> np.ndarray:
+            out = np.empty_like(Tq)
+            for m, idx in mats.items():
+                out[idx] = props[m](Tq[idx])
+            return out
+
+        r = conduction.assemble(b, kxx=field(inputs.kxx), kyy=field(inputs.kyy),
+                                axisymmetric=ax) @ T_local
+        q = inputs.hgen[part.elements[cells]]
+        if np.any(q):
+            r = r - source.assemble(b, q=np.repeat(q[:, None], b.X.shape[-1], axis=1),
+                                    axisymmetric=ax)
+        own = part.basis.mesh.t2f[:, cells].ravel()
+        for keys, h, tb in inputs.films:
+            facets = own[np.isin(part.facet_keys[own], keys)]
+            if facets.size:
+                fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
+                r = r + film.assemble(fb, h=h, axisymmetric=ax) @ T_local \
+                    - face_load.assemble(fb, g=h * tb, axisymmetric=ax)
+        for keys, flux in inputs.fluxes:
+            facets = own[np.isin(part.facet_keys[own], keys)]
+            if facets.size:
+                fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
+                r = r - face_load.assemble(fb, g=flux, axisymmetric=ax)
+        return part.to_global @ r
+
     def reaction(self, inputs: ThermalInputs, T: np.ndarray) -> np.ndarray:
         """Heat flow into the model at each dof (W; nonzero at fixed temperatures), steady."""
-        K, _, f = self.operators(inputs, T)
+        K, _, f = self.operators(inputs, T, nonlinear=True)
         return K @ T - f
 
 

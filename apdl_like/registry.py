@@ -17,13 +17,14 @@ from apdl_like.commands import (
     generate,
     loads,
     post1,
+    post26,
     prep7,
     selection,
     solution,
     tables,
 )
 
-FAMILIES = (begin, blocks, generate, loads, post1, prep7, selection, solution, tables)
+FAMILIES = (begin, blocks, generate, loads, post1, post26, prep7, selection, solution, tables)
 
 
 def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:

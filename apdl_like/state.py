@@ -131,6 +131,9 @@ class SessionState:
     processor: str = "BEGIN"
     base_dir: Path | None = None
     strict: bool = False  # an unknown command is an error, not a warning
+    # /POST26 variables: number -> (name, times s, values); FSUM's last total heat, W
+    variables: dict[int, tuple[str, np.ndarray, np.ndarray]] = field(default_factory=dict)
+    fsum_heat: float | None = None
     record_only: bool = False  # SOLVE records what it would solve instead of solving
     recorded_solves: list[dict] = field(default_factory=list)
     model_functions: dict[str, Any] = field(init=False, repr=False)

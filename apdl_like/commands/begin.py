@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import ANY, Call, CommandSpec, ignored
+from apdl_like.commands.post26 import get_variable
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
 
@@ -58,6 +59,16 @@ def star_get(s: SessionState, c: Call) -> None:
     entity = c.label(2)
     item, sub = c.label(4), c.label(5)
     db = s.db
+    if entity == "VARI":
+        s.params[name] = get_variable(s, c.int(3, what="variable"), item, sub)
+        return
+    if entity == "FSUM":
+        if s.fsum_heat is None:
+            raise ApdlError("FSUM has not been run")
+        if item not in ("ITEM", "") or sub not in ("HEAT", ""):
+            raise ApdlError("FSUM supports *GET,Par,FSUM,,ITEM,HEAT")
+        s.params[name] = s.fsum_heat
+        return
     if entity not in ("NODE", "ELEM"):
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
     if item == "NUM":

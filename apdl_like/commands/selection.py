@@ -42,7 +42,9 @@ def nsel(s: SessionState, c: Call) -> None:
         nodes.selected = combine(mode, current, current)
         return
     item = c.label(2, "NODE")
-    if item == "NODE":
+    if item == "NODE" and c.label(4) == "ALL":
+        picked = np.ones(len(nodes.ids), bool)  # NSEL,S,NODE,,ALL: every node
+    elif item == "NODE":
         picked = number_range(nodes.ids, *_range(c))
     elif item == "LOC":
         comp = c.label(3)

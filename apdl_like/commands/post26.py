@@ -1,0 +1,162 @@
+"""/POST26 time-history variables (NSOL, ESOL, STORE, PRVAR, *GET,,VARI) and reaction heat
+in /POST1 (PRNLD, FSUM).
+
+A variable is a nodal temperature (NSOL,,,TEMP) or an element's nodal heat flow
+(ESOL,,,,HEAT) at every stored time of the last thermal analysis: the substeps of its last
+load step and the end of each earlier one.  Variable 1 is TIME.  Element heat flows and
+reactions come from the deck-mesh solver (apdl_like.plane_thermal), steady conduction:
+element matrices times the temperatures less the element's loads.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.call import POST, POST26, Call, CommandSpec, ignored
+from apdl_like.errors import ApdlError
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+MAX_VARIABLE = 200
+
+
+def _history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
+    """(times, thermal dof vectors) of the stored results of the last thermal analysis."""
+    sol = s.solution
+    thermal = [r for r in sol.results if r.analysis == "thermal"]
+    if not thermal:
+        raise ApdlError("there is no thermal result (SOLVE a thermal analysis first)")
+    times, temps = [], []
+    for r in thermal[:-1]:
+        times.append(r.time)
+        temps.append(r.temperature)
+    last = thermal[-1]
+    if sol.substep_temperatures and sol.substep_times and sol.substep_times[-1] == last.time:
+        times += list(sol.substep_times)
+        temps += list(sol.substep_temperatures)
+    else:
+        times.append(last.time)
+        temps.append(last.temperature)
+    return np.array(times), temps
+
+
+def _plane(s: SessionState):  # noqa: ANN202 - (PlaneThermal, ThermalInputs)
+    solver = s.fem.plane_solver
+    if solver is None or s.fem.plane_inputs is None:
+        raise ApdlError("element heat flows need a thermal solution of the deck's own mesh")
+    return solver[1], s.fem.plane_inputs
+
+
+def _variable(c: Call) -> int:
+    n = c.int(1, what="NVAR")
+    if not 2 <= n <= MAX_VARIABLE:
+        raise ApdlError(f"field 1 (NVAR) must lie in 2..{MAX_VARIABLE} (1 is TIME)")
+    return n
+
+
+def nsol(s: SessionState, c: Call) -> None:
+    """NSOL,NVAR,NODE,TEMP,,Name."""
+    nvar = _variable(c)
+    i = s.node_index(c.int(2, what="NODE"))
+    if c.label(3, "TEMP") != "TEMP":
+        raise ApdlError(f"field 3: NSOL supports TEMP, got {c.label(3)!r}")
+    times, temps = _history(s)
+    model, _ = _plane(s)
+    dof = model.mesh.node_dof[i]
+    if dof < 0:
+        raise ApdlError(f"node {c.raw(2)} is not attached to an element")
+    s.variables[nvar] = (c.label(5, "TEMP"), times, np.array([T[dof] for T in temps]))
+
+
+def esol(s: SessionState, c: Call) -> None:
+    """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes."""
+    nvar = _variable(c)
+    el = s.db.elements
+    e = int(el.index(c.int(2, what="ELEM"))[0])
+    if e < 0:
+        raise ApdlError(f"element {c.raw(2)} does not exist")
+    node = c.int(3, what="NODE")
+    if node not in el.nodes[e]:
+        raise ApdlError(f"node {node} is not a node of element {c.raw(2)}")
+    if c.label(4) != "HEAT":
+        raise ApdlError(f"field 4: ESOL supports HEAT, got {c.label(4) or '(empty)'!r}")
+    model, inputs = _plane(s)
+    dof = model.mesh.node_dof[s.node_index(node)]
+    times, temps = _history(s)
+    values = np.array([model.element_heat(inputs, T, e)[dof] for T in temps])
+    s.variables[nvar] = (c.label(6, "HEAT"), times, values)
+
+
+def prvar(s: SessionState, c: Call) -> None:
+    """PRVAR,NV1,...,NV6: the variables against TIME."""
+    chosen = [c.int(i, what="NVAR") for i in range(1, c.count() + 1) if c.given(i)]
+    for n in chosen:
+        if n not in s.variables:
+            raise ApdlError(f"variable {n} is not defined (NSOL or ESOL first)")
+    if not chosen:
+        return
+    times = s.variables[chosen[0]][1]
+    s.say("        TIME" + "".join(f"{s.variables[n][0]:>16}" for n in chosen))
+    for k, t in enumerate(times):
+        s.say(f"{t:12.5G}" + "".join(f"{s.variables[n][2][k]:16.6E}" for n in chosen))
+
+
+def get_variable(s: SessionState, n: int, what: str, sub: str) -> float:
+    """*GET,Par,VARI,n,EXTREM,VMAX|VMIN|TMAX|TMIN|VLAST."""
+    if n not in s.variables:
+        raise ApdlError(f"variable {n} is not defined (NSOL or ESOL first)")
+    _, times, values = s.variables[n]
+    if what != "EXTREM":
+        raise ApdlError(f"field 4: VARI supports EXTREM, got {what or '(empty)'!r}")
+    k_max, k_min = int(np.argmax(values)), int(np.argmin(values))
+    table = {"VMAX": values[k_max], "VMIN": values[k_min], "TMAX": times[k_max],
+             "TMIN": times[k_min], "VLAST": values[-1], "TLAST": times[-1]}
+    if sub not in table:
+        raise ApdlError(f"field 5: EXTREM takes VMAX, VMIN, TMAX, TMIN, VLAST or TLAST, "
+                        f"got {sub!r}")
+    return float(table[sub])
+
+
+def reactions(s: SessionState) -> tuple[np.ndarray, np.ndarray]:
+    """(node indices with a fixed temperature, their reaction heat flow, W) of the result
+    shown in /POST1 (steady conduction with the last solve's loads)."""
+    model, inputs = _plane(s)
+    res = s.result()
+    if res.analysis != "thermal":
+        raise ApdlError("reaction heats need a thermal result")
+    r = model.reaction(inputs, res.temperature)
+    fixed = np.nonzero(~np.isnan(s.db.nodes.arrays["d_temp"]) & (model.mesh.node_dof >= 0))[0]
+    return fixed, r[model.mesh.node_dof[fixed]]
+
+
+def prnld(s: SessionState, c: Call) -> None:
+    """PRNLD,HEAT: reaction heat at the selected nodes with a fixed temperature."""
+    if c.label(1, "HEAT") not in ("HEAT", "ALL"):
+        raise ApdlError(f"field 1: PRNLD supports HEAT, got {c.label(1)!r}")
+    nodes, heat = reactions(s)
+    selected = s.db.nodes.selected[nodes]
+    s.say("    NODE            HEAT")
+    for i, q in zip(nodes[selected], heat[selected], strict=True):
+        s.say(f"{int(s.db.nodes.ids[i]):8d} {q:16.6E}")
+    s.say(f"   TOTAL {float(heat[selected].sum()):16.6E}")
+
+
+def fsum(s: SessionState, c: Call) -> None:
+    """FSUM: the total reaction heat of the selected nodes (*GET,Par,FSUM,,ITEM,HEAT)."""
+    nodes, heat = reactions(s)
+    total = float(heat[s.db.nodes.selected[nodes]].sum())
+    s.fsum_heat = total
+    s.say(f"FSUM: HEAT = {total:.6E}")
+
+
+COMMANDS = (
+    CommandSpec("NSOL", POST26, 7, nsol),
+    CommandSpec("ESOL", POST26, 7, esol),
+    CommandSpec("STORE", POST26, 2, ignored),  # variables are computed when defined
+    CommandSpec("PRVAR", POST26, 6, prvar),
+    CommandSpec("PRNLD", POST, 6, prnld),
+    CommandSpec("FSUM", POST, 2, fsum),
+)
