@@ -373,12 +373,12 @@ class PlaneThermal:
         """Heat flow (W) at the global dofs of one element, steady: its conduction and film
         matrices times T less its loads; the sum over the elements at a node with a fixed
         temperature is that node's reaction heat."""
-        for k, part in enumerate(self.mesh.parts):
-            cells = np.nonzero(part.elements == element)[0]
-            if cells.size:
-                break
-        else:
+        owner = [k for k, part in enumerate(self.mesh.parts) if np.any(part.elements == element)]
+        if not owner:
             raise ApdlError("the element is not part of the thermal mesh")
+        k = owner[0]
+        part = self.mesh.parts[k]
+        cells = np.nonzero(part.elements == element)[0]
         ax = self.mesh.axisymmetric
         b = Basis(part.basis.mesh, part.basis.elem, elements=cells)
         T_local = T[part.local_dofs]
