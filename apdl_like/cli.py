@@ -16,6 +16,7 @@ import typer
 
 from twin.errors import InputError, report_errors
 from twin.io.destinations import check_out_dir, check_out_file
+from twin.log import send_warnings_to_log
 
 app = typer.Typer(
     name="apdl-like",
@@ -98,6 +99,7 @@ def export_cdb(
 
 
 def main() -> None:
+    send_warnings_to_log()
     app(prog_name="apdl-like")
 
 

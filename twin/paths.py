@@ -8,7 +8,9 @@ A fifo, a device or a folder given where a file is expected would block a reader
 from __future__ import annotations
 
 import os
+import re
 import stat
+import tomllib
 from pathlib import Path
 
 from twin.errors import InputError
@@ -57,3 +59,25 @@ def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
+
+
+def parse_toml(text: str, file: str, column: str | None = None) -> dict:
+    """TOML text as a dict; a syntax error names its line, and nesting too deep for the
+    parser (thousands of `[`) is refused instead of exhausting the stack."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        match = re.search(r"line (\d+)", str(exc))
+        row = int(match.group(1)) if match else None
+        if row is None and "end of document" in str(exc):
+            row = text.rstrip("\n").count("\n") + 1
+        raise InputError(f"not valid TOML: {exc}", file=file, row=row, column=column) from None
+    except RecursionError:
+        raise InputError("not valid TOML: nested too deeply", file=file, column=column) from None
+
+
+def read_toml(path: str | os.PathLike[str], *, column: str | None = None,
+              max_bytes: int = 2**20) -> dict:
+    """A checked input file (at most 1 MiB: a spec or scenario is a page) parsed as TOML."""
+    return parse_toml(read_input_text(path, column=column, max_bytes=max_bytes), str(path),
+                      column)

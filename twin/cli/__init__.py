@@ -21,6 +21,7 @@ from twin.cli.snapshot import snapshot
 from twin.cli.synth import synth
 from twin.cli.train import train
 from twin.errors import report_errors
+from twin.log import send_warnings_to_log
 
 COMMANDS = (
     ("replay", replay),
@@ -54,5 +55,6 @@ app = build_app()
 
 
 def main() -> None:
+    send_warnings_to_log()
     app(prog_name="twin")
 

@@ -14,7 +14,8 @@ def synth(
                              "RUN.parquet); the truth goes to RUN.truth.csv beside it."),
     minutes: float = typer.Option(..., "--minutes", help="Run length, minutes."),
     ambient: float = typer.Option(..., "--ambient", help="Ambient temperature at the start, °C."),
-    seed: int = typer.Option(..., "--seed", help="Seed of every random choice (deterministic)."),
+    seed: int = typer.Option(..., "--seed", min=0,
+                             help="Seed of every random choice (deterministic), ≥ 0."),
     speed: float | None = typer.Option(None, "--speed", help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C])."),
@@ -31,6 +32,10 @@ def synth(
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
     from twin.plant.scenario import load_scenario
+    from twin.runs import check_replayable
+    from twin.runs.validate import FAHRENHEIT_AIR_RANGE_C
+    from twin.spindle.conditions import check_operating_point
+    from twin.spindle.spec import load_spec
 
     if (speed is None) == (profile is None):
         raise InputError("give exactly one of --speed and --profile", column="--speed")
@@ -39,8 +44,19 @@ def synth(
     if not 2.0 <= minutes <= 24 * 60.0:
         raise InputError(f"minutes must lie in 2..1440 (two 60 s windows at least), "
                          f"got {minutes:g}", column="--minutes")
-    if not -30.0 <= ambient <= 60.0:
-        raise InputError(f"ambient must lie in -30..60 °C, got {ambient:g}", column="--ambient")
+    # replay reads an air or coolant temperature from 45 °C up as Fahrenheit: synth must not
+    # write what replay refuses
+    fahrenheit = FAHRENHEIT_AIR_RANGE_C[0]
+    if not -30.0 <= ambient < fahrenheit:
+        raise InputError(f"ambient must lie in -30..{fahrenheit:g} °C (replay reads warmer air "
+                         f"as Fahrenheit), got {ambient:g}", column="--ambient")
+    if coolant is not None and not coolant < fahrenheit:
+        raise InputError(f"coolant must be below {fahrenheit:g} °C (replay reads warmer "
+                         f"coolant as Fahrenheit), got {coolant:g}", column="--coolant")
+    try:
+        check_operating_point(load_spec(None), speed or 0.0, ambient, coolant)
+    except InputError as exc:
+        raise InputError(exc.reason, column=f"--{exc.column.split('_')[0]}") from None
     if not 0.1 <= rate <= 10.0:
         raise InputError(f"rate must lie in 0.1..10 Hz, got {rate:g}", column="--rate")
     if out.suffix.lower() not in (".csv", ".parquet"):
@@ -57,6 +73,13 @@ def synth(
         scenario_name=None if scenario is None else str(scenario),
         profile_name=None if profile is None else str(profile),
     )
+    source = scenario or profile
+    try:
+        check_replayable(run.columns, str(out), load_spec(None).spindle.max_speed_rpm)
+    except InputError as exc:
+        raise InputError(f"the emulated run would be refused by replay: {exc.reason}",
+                         file=None if source is None else str(source),
+                         column=exc.column) from None
     run_path, truth_path = write_synth(run, out)
     if not quiet:
         typer.echo(f"wrote {run_path} ({run.n_samples} samples, {run.elapsed_s:.1f} s) "

@@ -4,8 +4,14 @@ Tensors `<output>.<part>` (output in OUTPUTS; part in PARTS) in float64, and in 
 safetensors header one metadata entry `spindle_twin` holding JSON: format and version,
 the configuration, input names and units, hidden sizes, training runs, R², seed, and a
 SHA-256 of the tensor data.  Loading reads only tensors and JSON (no unpickling), checks
-every name, shape, value and the checksum, and raises `InputError` naming the file and
-what is wrong.
+every name, shape, value, the metadata's types and the checksum, and raises `InputError`
+naming the file and what is wrong.
+
+The checksum detects corruption, not forgery: it is a plain SHA-256 of the tensors
+stored in the same file, so whoever edits the weights can recompute it and the file
+loads.  A model file is trusted like code you install; keep it where only you write.
+Loading never unpickles or executes anything, so a forged file can give wrong
+corrections but cannot run foreign code.
 """
 
 from __future__ import annotations
@@ -18,11 +24,13 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+from pydantic import BaseModel, ConfigDict, ValidationError
 
 from twin.correction.features import HIDDEN_SIZES, INPUT_NAMES, OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.network import CONFIGS, TrainedNet
 from twin.errors import InputError
 from twin.io.atomic import write_bytes
+from twin.paths import read_input_bytes
 
 FORMAT = "spindle-twin-correction"
 VERSION = 1
@@ -45,6 +53,23 @@ class CorrectionModel:
     @property
     def config_name(self) -> str:
         return self.nets[OUTPUTS[0]].config.name
+
+
+class _Metadata(BaseModel):
+    """Types of the metadata fields the twin reads (others are kept as they are)."""
+
+    model_config = ConfigDict(extra="allow", strict=True)
+    version: int
+    config: str
+    outputs: list[str]
+    hidden_sizes: dict[str, int]
+    r2: dict[str, dict[str, float | None]] | None = None
+    training_runs: list[str] = []
+    runs: list[str] = []
+    samples: int | None = None
+    seed: int | None = None
+    targets: str | None = None
+    sha256: str
 
 
 def _expected_shape(part: str, hidden: int) -> tuple[int, ...]:
@@ -96,24 +121,28 @@ def load_model(path: str | Path) -> CorrectionModel:
     from safetensors.numpy import load
 
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read the model file: {exc.strerror}", file=str(path)) from None
+    raw = read_input_bytes(path, column="--model", max_bytes=64 * 2**20)
     try:
         tensors = load(raw)
         header_len = int.from_bytes(raw[:8], "little")
         header = json.loads(raw[8 : 8 + header_len])
-    except (SafetensorError, ValueError, UnicodeDecodeError) as exc:
+    except (SafetensorError, ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise InputError(f"not a readable safetensors model file ({exc})", file=str(path)) from None
     try:
         meta = json.loads(header.get("__metadata__", {})[METADATA_KEY])
-    except (KeyError, TypeError, json.JSONDecodeError):
+    except (KeyError, TypeError, AttributeError, json.JSONDecodeError, RecursionError):
         raise InputError(
             f"no '{METADATA_KEY}' metadata: not a spindle-twin correction model", file=str(path)
         ) from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError(f"metadata format is not {FORMAT!r}", file=str(path))
+    try:
+        _Metadata.model_validate(meta)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        field = ".".join(str(k) for k in err["loc"])
+        raise InputError(f"metadata field {field}: {err['msg']}", file=str(path),
+                         column=field) from None
     if meta.get("version") != VERSION:
         raise InputError(
             f"model version {meta.get('version')!r} is not supported (expected {VERSION})",

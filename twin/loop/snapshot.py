@@ -33,6 +33,10 @@ def render_snapshot(
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
 
+    from twin.log import send_vtk_messages_to_log
+
+    send_vtk_messages_to_log()
+
     from twin.io.atomic import atomic_target
     from twin.spindle.fields import field_arrays
 

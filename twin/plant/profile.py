@@ -6,16 +6,17 @@ row's values hold.  `#` lines are comments.  Rows are numbered as lines in an ed
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from twin.errors import InputError
+from twin.paths import read_input_text
 from twin.plant.timetable import StepTable
+from twin.runs.csv_format import csv_records
+from twin.runs.table import parse_cell
 
 
 @dataclass(frozen=True)
@@ -27,17 +28,14 @@ class SpeedProfile:
 def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
     """Read a speed profile; errors name the file, line and column."""
     file = str(path)
-    try:
-        lines = Path(path).read_text(encoding="utf-8-sig").split("\n")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read speed profile: {exc}", file=file) from None
+    lines = read_input_text(path, column="--profile").split("\n")
     header: list[str] | None = None
     header_line = 0
     rows: list[tuple[int, list[str]]] = []
     for number, line in enumerate(lines, start=1):
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        fields = [f.strip() for f in next(csv.reader([line]))]
+        fields = [f.strip() for f in next(csv_records([line], file, [number]))]
         if header is None:
             header, header_line = fields, number
         else:
@@ -57,11 +55,7 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
                              row=number)
         for j, name in enumerate(wanted):
             cell = fields[header.index(name)]
-            try:
-                value = float(cell)
-            except ValueError:
-                raise InputError(f"cannot read {cell!r} as a number", file=file, row=number,
-                                 column=name) from None
+            value = parse_cell(cell, file, number, name)
             if not math.isfinite(value):
                 raise InputError(f"{cell!r} is not a finite number", file=file, row=number,
                                  column=name)

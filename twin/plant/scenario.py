@@ -23,13 +23,12 @@ from __future__ import annotations
 
 import os
 import re
-import tomllib
-from pathlib import Path
 from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from twin.errors import InputError
+from twin.paths import parse_toml, read_input_text
 from twin.plant.timetable import TimeTable
 
 SENSOR_COLUMNS = {
@@ -49,7 +48,8 @@ def sensor_column(name: str) -> str:
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # inf and nan are no times, factors or temperatures (TOML spells them `inf`, `nan`)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 Times = Annotated[list[Annotated[float, Field(ge=0.0)]], Field(min_length=1)]
@@ -152,7 +152,11 @@ class Dropout(_SensorRef):
 
 class Spike(_SensorRef):
     time_s: Annotated[float, Field(ge=0.0)]
-    size: float = 5.0
+    size: Annotated[float, Field(ge=-MAX_SPIKE, le=MAX_SPIKE)] = 5.0
+
+
+MAX_SPIKE = 100.0
+"""Largest spike (°C or µm): a glitch a logger writes, still a short number in the file."""
 
 
 class Faults(_Strict):
@@ -208,14 +212,7 @@ def _line_of(text: str, loc: tuple) -> int | None:
 
 def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
     """Parse scenario TOML text; errors name the file, line and dotted key."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        match = re.search(r"line (\d+)", str(exc))
-        row = getattr(exc, "lineno", None) or (int(match.group(1)) if match else None)
-        if row is None and "end of document" in str(exc):
-            row = text.rstrip("\n").count("\n") + 1
-        raise InputError(f"not valid TOML: {exc}", file=file, row=row) from None
+    data = parse_toml(text, file)
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
@@ -232,8 +229,5 @@ def load_scenario(path: str | os.PathLike[str] | None) -> Scenario:
     """Read a scenario file (None: every default)."""
     if path is None:
         return Scenario()
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read scenario: {exc}", file=str(path)) from None
-    return parse_scenario(text, str(path))
+    return parse_scenario(read_input_text(path, column="--scenario", max_bytes=2**20),
+                          str(path))

@@ -16,6 +16,7 @@ from twin.runs.quality import QualityConfig
 from twin.runs.run import (
     RecordedRun,
     Samples,
+    check_replayable,
     read_run,
     read_table,
     run_from_table,
@@ -41,6 +42,7 @@ __all__ = [
     "QualityConfig",
     "RecordedRun",
     "Samples",
+    "check_replayable",
     "read_run",
     "read_table",
     "run_from_table",

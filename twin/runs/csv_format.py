@@ -50,7 +50,7 @@ def read_csv_table(path: str | os.PathLike[str],
                     metadata[key.strip()] = value.strip()
             continue
         if header is None:
-            header = [name.strip() for name in next(_records([line], file, [number]))]
+            header = [name.strip() for name in next(csv_records([line], file, [number]))]
             header_line = number
             continue
         data_lines.append(line)
@@ -73,7 +73,7 @@ def read_csv_table(path: str | os.PathLike[str],
     known = [(i, name) for i, name in enumerate(header) if keep(name)]
     ignored = [name for name in header if not keep(name)]
     values = np.full((len(data_lines), len(known)), np.nan)
-    for k, fields in enumerate(_records(data_lines, file, data_numbers)):
+    for k, fields in enumerate(csv_records(data_lines, file, data_numbers)):
         line = data_numbers[k]
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields as in the header, found "
@@ -87,9 +87,10 @@ def read_csv_table(path: str | os.PathLike[str],
                     ignored_columns=ignored)
 
 
-def _records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
-    """CSV records of `lines`, one per line: a quoted cell may not span lines (the csv
-    module would join `"1` and `2"` into 12), and csv's own errors name their line."""
+def csv_records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
+    """CSV records of `lines` (`numbers`: their lines in `file`), one per line: a quoted
+    cell may not span lines (the csv module would join `"1` and `2"` into 12), and csv's
+    own errors name their line."""
     reader = csv.reader(lines)
     k = 0
     while True:

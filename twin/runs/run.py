@@ -196,6 +196,16 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
         max_gap_s=config.max_gap_s)
 
 
+def check_replayable(columns: Mapping[str, np.ndarray], file: str,
+                     max_speed_rpm: float = math.inf) -> None:
+    """InputError if `read_run` would refuse a run of these columns (checked before such a
+    run is written: whatever `twin synth` writes, replay reads)."""
+    n = len(next(iter(columns.values())))
+    table = RawTable(file=file, metadata={}, rows=np.arange(1, n + 1),
+                     columns={k: np.asarray(v, dtype=float) for k, v in columns.items()})
+    run_from_table(table, max_speed_rpm=max_speed_rpm)
+
+
 def write_run(path: str | os.PathLike[str], columns: Mapping[str, np.ndarray],
               metadata: Mapping[str, object] | None = None) -> None:
     """Write a recorded run (CSV or Parquet by suffix), atomically.

@@ -19,13 +19,13 @@ field (e.g. `parts[3].r_outer_mm`).
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from twin.errors import InputError
+from twin.paths import read_toml
 
 DEFAULT_SPEC_PATH = Path(__file__).resolve().parents[2] / "meshes" / "reference_spindle.toml"
 
@@ -404,11 +404,4 @@ def parse_spec(data: dict, source: str = "<spec>") -> SpindleSpec:
 def load_spec(path: str | Path | None = None) -> SpindleSpec:
     """Read and validate a spindle spec TOML (None: the bundled reference spindle)."""
     path = Path(path) if path is not None else DEFAULT_SPEC_PATH
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise InputError("spec file not found", file=str(path)) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"not valid TOML: {exc}", file=str(path)) from None
-    return parse_spec(data, str(path))
+    return parse_spec(read_toml(path), str(path))

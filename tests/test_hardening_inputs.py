@@ -1,0 +1,124 @@
+"""Issue 14 regressions on exit codes and messages (defects 6, 12, 15): bad input is an
+`InputError` (exit 2) naming the file, row and field; synth writes only what replay reads;
+warnings go to the log."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from twin.cli import app
+from twin.correction.modelfile import load_model
+from twin.errors import InputError
+from twin.plant.scenario import parse_scenario
+from twin.spindle.spec import load_spec
+
+MODEL = Path(__file__).resolve().parent.parent / "examples" / "correction_model.safetensors"
+
+
+def cli(*args):
+    result = CliRunner().invoke(app, [str(a) for a in args])
+    assert "Traceback" not in result.output
+    return result
+
+
+def with_metadata(tmp_path, change):
+    raw = MODEL.read_bytes()
+    n = int.from_bytes(raw[:8], "little")
+    header = json.loads(raw[8:8 + n])
+    meta = json.loads(header["__metadata__"]["spindle_twin"])
+    change(meta)
+    header["__metadata__"]["spindle_twin"] = json.dumps(meta)
+    text = json.dumps(header).encode()
+    text += b" " * (-len(text) % 8)
+    path = tmp_path / "m.safetensors"
+    path.write_bytes(len(text).to_bytes(8, "little") + text + raw[8 + n:])
+    return path
+
+
+@pytest.mark.parametrize(("key", "value"), [("hidden_sizes", 5), ("r2", {"heat_front": 5}),
+                                            ("training_runs", 7), ("config", [])])
+def test_defect6_model_metadata_of_wrong_type(tmp_path, key, value):
+    path = with_metadata(tmp_path, lambda m: m.__setitem__(key, value))
+    with pytest.raises(InputError, match=f"metadata field {key}") as info:
+        load_model(path)
+    assert info.value.file == str(path)
+    result = cli("model-info", path)
+    assert result.exit_code == 2 and "m.safetensors" in result.output
+
+
+def test_defect15_model_checksum_is_documented_as_corruption_not_forgery():
+    import twin.correction.modelfile as modelfile
+
+    assert "detects corruption, not forgery" in modelfile.__doc__
+
+
+@pytest.mark.parametrize("args", [
+    ["--speed", "inf"], ["--speed", "nan"], ["--speed", "20000"], ["--coolant", "nan"],
+    ["--coolant", "150"], ["--coolant", "50"], ["--seed=-1"], ["--ambient", "50"],
+    ["--ambient", "nan"], ["--minutes", "nan"],
+])
+def test_defect6_and_12_synth_arguments_refused_before_any_work(tmp_path, args):
+    base = {"--speed": "9000", "--minutes": "3", "--ambient": "25", "--seed": "1"}
+    given = args[0].split("=")[0]
+    argv = ["synth", "--out", tmp_path / "r.csv", *args]
+    for key, value in base.items():
+        if key != given:
+            argv += [key, value]
+    result = cli(*argv)
+    assert result.exit_code == 2, result.output
+    assert given in result.output or "seed" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("toml", "where"), [
+    ("[coolant]\ntime_s = [0, inf]\ninlet_C = [22, 23]\n", "coolant.time_s"),
+    ("[faults]\nspikes = [{sensor = \"T1\", time_s = 60, size = inf}]\n", "faults.spikes"),
+    ("[faults]\nspikes = [{sensor = \"T1\", time_s = 60, size = 1e300}]\n", "faults.spikes"),
+    ("a = " + "[" * 5000 + "]" * 5000 + "\n", None),
+])
+def test_defect6_and_12_scenario_values_synth_cannot_write(toml, where):
+    with pytest.raises(InputError) as info:
+        parse_scenario(toml, "s.toml")
+    assert info.value.file == "s.toml"
+    assert where is None or info.value.column.startswith(where)
+
+
+def test_deeply_nested_spec_toml_refused(tmp_path):
+    spec = tmp_path / "spec.toml"
+    spec.write_text("a = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(InputError, match="nested too deeply"):
+        load_spec(spec)
+
+
+def test_defect12_synth_refuses_a_dropout_that_empties_a_sensor(tmp_path):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('[faults]\ndropouts = [{sensor = "T4", start_s = 0, end_s = 100000}]\n')
+    result = cli("synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
+                 "--scenario", scenario, "--out", tmp_path / "r.csv", "--quiet")
+    assert result.exit_code == 2 and "s.toml" in result.output and "T4_C" in result.output
+    assert "refused by replay" in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_defect15_warnings_go_to_the_log_not_the_terminal(tmp_path):
+    code = ("import warnings, numpy as np\n"
+            "from twin.log import send_warnings_to_log, send_vtk_messages_to_log\n"
+            "send_warnings_to_log()\n"
+            "np.mean(np.array([]))\n"
+            "send_vtk_messages_to_log()\n"
+            "from vtkmodules.vtkCommonCore import vtkLogger\n"
+            "vtkLogger.Log(vtkLogger.VERBOSITY_WARNING, 'x.cxx', 1, 'bad X server connection')\n")
+    env = {**os.environ, "TWIN_LOG_DIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    log = (tmp_path / "twin.log").read_text()
+    assert "Mean of empty slice" in log and "bad X server connection" in log
