@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from meshes.spindle import build_mesh, mesh_quality
 from twin.fem import AxiMesh
+from twin.spindle.mesher import build_mesh, mesh_quality
 from twin.spindle.model import DEFAULT_MESH_PATH
 from twin.spindle.spec import BOUNDARY_NAMES, load_spec
 

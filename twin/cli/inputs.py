@@ -5,23 +5,27 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from twin.data import bundled_path
 from twin.errors import InputError
 
-EXAMPLES_DIR = Path(__file__).resolve().parent.parent.parent / "examples"
 METHOD_NAMES = ("open_loop", "ratio", "bpnn", "estimator")
+
+
+def bundled_runs_dir() -> Path:
+    """Where the example recorded runs shipped with the twin are (package data)."""
+    return bundled_path("runs").resolve()
 
 
 def bundled_runs() -> list[Path]:
     """The example recorded runs shipped with the twin (their `.truth.csv` left out)."""
-    runs = sorted((EXAMPLES_DIR / "runs").glob("*.csv"))
+    runs = sorted(bundled_runs_dir().glob("*.csv"))
     return [r for r in runs if not r.name.endswith(".truth.csv")]
 
 
 def bundled_model() -> Path | None:
     """The default correction model shipped with the twin, if any."""
-    for candidate in sorted(EXAMPLES_DIR.glob("*.safetensors")):
-        return candidate
-    return None
+    model = bundled_path("correction_model.safetensors").resolve()
+    return model if model.is_file() else None
 
 
 def parse_methods(text: str) -> list[str]:

@@ -18,9 +18,9 @@ def mesh(
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
     """Mesh the axisymmetric spindle (regions, boundaries, contact interfaces)."""
-    from meshes.spindle import build_mesh, mesh_quality, write_msh
     from twin.errors import InputError
     from twin.io.destinations import check_out_file
+    from twin.spindle.mesher import build_mesh, mesh_quality, write_msh
     from twin.spindle.spec import load_spec
 
     if not (size_factor > 0 and size_factor < 100):

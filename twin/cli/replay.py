@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import EXAMPLES_DIR, bundled_runs, checked_model, parse_methods
+from twin.cli.inputs import bundled_runs, bundled_runs_dir, checked_model, parse_methods
 from twin.errors import InputError
 from twin.io.destinations import check_out_dir
 
@@ -47,7 +47,7 @@ def replay(
     paths = list(runs) if runs else bundled_runs()
     if not paths:
         raise InputError(
-            "no runs given and no bundled example runs found", file=str(EXAMPLES_DIR / "runs")
+            "no runs given and no bundled example runs found", file=str(bundled_runs_dir())
         )
     check_out_dir(out, inputs=[*paths, model], owned=[
         *(Path(p).stem for p in paths), "summary.json", "report.html"])

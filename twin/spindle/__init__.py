@@ -8,6 +8,7 @@
     result = simulate(model, 9000, minutes=30, ambient_C=25.3)
 
 spec        SpindleSpec, load_spec (TOML → validated pydantic models, InputError)
+mesher      build_mesh, write_msh: spec → gmsh mesh with named regions and boundaries
 model       SpindleModel (mesh, thermal, elastic, sensor_matrix, probe_vectors)
 conditions  BoundaryConditions, nominal_conditions, check_operating_point
 simulate    simulate → SimulationResult (key points, nose drift, energy balance)

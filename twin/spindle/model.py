@@ -27,7 +27,7 @@ from twin.fem import AxiMesh, ElasticProblem, Material, ThermalProblem
 from twin.spindle.spec import DEFAULT_SPEC_PATH, PROBE_NAMES, SENSOR_NAMES, SpindleSpec, load_spec
 
 DEFAULT_MESH_PATH = DEFAULT_SPEC_PATH.with_suffix(".msh")
-#: bump when meshes/spindle.py changes what it produces, to invalidate cached meshes
+#: bump when twin/spindle/mesher.py changes what it produces, to invalidate cached meshes
 MESHER_VERSION = "1"
 
 
@@ -67,7 +67,7 @@ def ensure_mesh(spec: SpindleSpec, spec_path: Path, size_factor: float) -> Path:
     """The mesh file for (spec, size factor), generated with gmsh if not there yet."""
     path = mesh_path_for(spec_path, size_factor)
     if not path.exists():
-        from meshes.spindle import build_mesh, write_msh
+        from twin.spindle.mesher import build_mesh, write_msh
 
         write_msh(build_mesh(spec, size_factor), path)
     return path

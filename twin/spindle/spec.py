@@ -24,12 +24,14 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from twin.data import bundled_path
 from twin.errors import InputError
 from twin.paths import read_toml
 
-DEFAULT_SPEC_PATH = Path(__file__).resolve().parents[2] / "meshes" / "reference_spindle.toml"
+DEFAULT_SPEC_PATH = bundled_path("meshes", "reference_spindle.toml").resolve()
+"""The bundled reference spindle (package data, `twin.data`)."""
 
-#: every boundary facet of the mesh gets one of these names (see meshes/spindle.py)
+#: every boundary facet of the mesh gets one of these names (see twin/spindle/mesher.py)
 BOUNDARY_NAMES = (
     "axis",
     "coolant",
