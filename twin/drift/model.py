@@ -41,9 +41,10 @@ class DriftModel:
                        segment_starts: np.ndarray | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(mean, lo, hi), each (n, p) in µm, for temperatures T_C of `spec.sensors`."""
-        X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
-        mean, std = METHODS[self.method].predict(self.params, X)
-        lo, hi = apply_interval(self.interval, mean, std)
+        with one_blas_thread():
+            X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
+            mean, std = METHODS[self.method].predict(self.params, X)
+            lo, hi = apply_interval(self.interval, mean, std)
         return mean, lo, hi
 
     def predict(self, data: DriftData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -89,10 +90,28 @@ def measured_rows(data: DriftData) -> np.ndarray:
     return rows
 
 
+def one_blas_thread():
+    """Run numpy/scipy/scikit-learn linear algebra on one thread.
+
+    Bit-for-bit repeatable results (threaded BLAS reductions may sum in another order)
+    and, on a machine whose cores are busy, far faster: threaded OpenBLAS spins waiting
+    for a core (a least-squares solve took 20× longer with two threads under load).
+    """
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1)
+
+
 def fit_drift_model(data: DriftData, method: str | None = None, sensors: str = "auto",
                     seed: int = 0, progress: Progress = None,
                     candidates: Sequence[str] | None = None) -> DriftModel:
     """Fit a drift model; `method` None picks the best of `candidates` (default: all)."""
+    with one_blas_thread():
+        return _fit_drift_model(data, method, sensors, seed, progress, candidates)
+
+
+def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: int,
+                     progress: Progress, candidates: Sequence[str] | None) -> DriftModel:
     if method is not None:
         method_named(method)
     ranking = sensor_ranking(data)
