@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import typer
 
+from twin.cli.drift import drift_app
 from twin.cli.mesh import mesh
 from twin.cli.model_info import model_info
 from twin.cli.replay import replay
@@ -48,6 +49,8 @@ def build_app() -> typer.Typer:
     )
     for name, function in COMMANDS:
         app.command(name)(report_errors(function))
+    # a command group: its sub-commands carry report_errors themselves
+    app.add_typer(drift_app, name="drift")
     return app
 
 

@@ -1,0 +1,131 @@
+"""`twin drift`: fit → predict → report → select on a small synthetic machine; exit codes."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from tests.drift_synthetic import synthetic_columns, write_csv
+from twin.cli import app
+
+
+def run(*args: str):
+    return CliRunner().invoke(app, ["drift", *args])
+
+
+@pytest.fixture(scope="module")
+def machine(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("drift_cli")
+    data = folder / "machine.csv"
+    write_csv(data, synthetic_columns(hours=3.0))
+    model = folder / "model.safetensors"
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(model),
+                 "--method", "ridge_dynamic", "--sensors", "all", "--seed", "3")
+    assert result.exit_code == 0, result.output
+    return folder, data, model
+
+
+def test_fit_predict_report_select(machine):
+    folder, data, model = machine
+    assert "ridge_dynamic" in result_text(run("fit", "--help"))
+    pred = folder / "pred.csv"
+    result = run("predict", str(model), str(data), "--out", str(pred))
+    assert result.exit_code == 0, result.output
+    with open(pred) as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["time_s", "drift_um", "drift_um_lo", "drift_um_hi"]
+    lo, mid, hi = (np.array([float(r[k]) for r in rows])
+                   for k in ("drift_um_lo", "drift_um", "drift_um_hi"))
+    assert np.all(lo < mid) and np.all(mid < hi)
+
+    result = run("report", str(model), str(data), "--out", str(folder / "report"))
+    assert result.exit_code == 0, result.output
+    metrics = json.loads((folder / "report" / "metrics.json").read_text())
+    m = metrics["targets"]["drift_um"]
+    assert set(m) >= {"rmse_um", "mae_um", "max_abs_um", "r2", "coverage_90_pct"}
+    assert m["r2"] > 0.95 and 70.0 <= m["coverage_90_pct"] <= 100.0
+    html = (folder / "report" / "report.html").read_text()
+    assert html.count("data:image/png;base64,") == 2          # drift and sensor ranking
+    assert "<script" not in html and "src='http" not in html
+
+    result = run("select", str(data), "--target", "drift_um", "--out",
+                 str(folder / "ranking.json"))
+    assert result.exit_code == 0, result.output
+    ranking = json.loads((folder / "ranking.json").read_text())
+    assert {r["sensor"] for r in ranking["sensors"]} == {"A_C", "B_C", "C_C"}
+
+
+def result_text(result) -> str:
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def test_fit_is_deterministic_for_a_seed(machine, tmp_path):
+    _, data, model = machine
+    again = tmp_path / "again.safetensors"
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(again),
+                 "--method", "ridge_dynamic", "--sensors", "all", "--seed", "3", "--quiet")
+    assert result.exit_code == 0, result.output
+    assert again.read_bytes() == model.read_bytes()
+
+
+def _bad(tmp_path, change):
+    columns = synthetic_columns(hours=0.5)
+    change(columns)
+    path = tmp_path / "bad.csv"
+    write_csv(path, columns)
+    return path
+
+
+@pytest.mark.parametrize(("change", "target", "expected"), [
+    (lambda c: None, "nope_um", "bad.csv, row 1, column 'nope_um'"),
+    (lambda c: [c.pop(k) for k in ("A_C", "B_C", "C_C")], "drift_um",
+     "bad.csv, row 1: no temperature columns"),
+    (lambda c: c["time_s"].__setitem__(5, 0.0), "drift_um", "bad.csv, row 7, column 'time_s'"),
+    (lambda c: c["C_C"].__setitem__(slice(None), np.nan), "drift_um",
+     "bad.csv, row 2, column 'C_C'"),
+])
+def test_bad_data_exits_2_naming_file_row_and_column(tmp_path, change, target, expected):
+    data = _bad(tmp_path, change)
+    result = run("fit", str(data), "--target", target, "--out", str(tmp_path / "m.safetensors"))
+    assert result.exit_code == 2, result.output
+    assert expected in result.output
+    assert "Traceback" not in result.output
+    assert not (tmp_path / "m.safetensors").exists()
+
+
+def test_predict_needs_the_models_sensors(machine, tmp_path):
+    _, _, model = machine
+    data = _bad(tmp_path, lambda c: c.pop("B_C"))
+    result = run("predict", str(model), str(data), "--out", str(tmp_path / "p.csv"))
+    assert result.exit_code == 2 and "column 'B_C'" in result.output
+
+
+def test_out_refuses_an_input_and_a_folder(machine, tmp_path):
+    _, data, _ = machine
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(tmp_path))
+    assert result.exit_code == 2 and "--out" in result.output
+    result = run("select", str(data), "--target", "drift_um", "--out", str(data))
+    assert result.exit_code == 2 and "replace an input" in result.output
+
+
+def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):
+    _, data, _ = machine
+    out = str(tmp_path / "m.safetensors")
+    result = run("fit", str(data), "--target", "drift_um", "--out", out, "--method", "magic")
+    assert result.exit_code == 2 and "unknown method" in result.output
+    result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", "Z_C")
+    assert result.exit_code == 2 and "--sensors" in result.output
+
+
+def test_drift_group_is_listed_with_its_commands():
+    result = CliRunner().invoke(app, ["--help"])
+    assert result.exit_code == 0 and "drift" in result.output
+    result = run("--help")
+    assert result.exit_code == 0
+    for name in ("fit", "predict", "report", "select"):
+        assert name in result.output

@@ -1,0 +1,203 @@
+"""`twin drift fit | predict | report | select`: data-driven drift models (no FEM).
+
+A typer sub-app; `twin/cli/__init__.py` adds it under the name `drift`.  Heavy imports
+(torch, scikit-learn, matplotlib) stay inside the commands.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import typer
+
+from twin.errors import InputError, report_errors
+
+drift_app = typer.Typer(
+    name="drift",
+    help="Data-driven thermal-drift models fitted on measured temperatures (no FEM): "
+    "fit, predict, report, select sensors.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+def _targets(text: str) -> list[str]:
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
+    if not names:
+        raise InputError("name at least one displacement column", column="--target")
+    return names
+
+
+def _check_out_file(out: Path, inputs: Sequence[Path], suffixes: Sequence[str]) -> None:
+    """Refuse an --out that is a folder, a special file or one of the inputs (exit 2)."""
+    if out.exists() and not out.is_file():
+        raise InputError("--out must be a regular file, not a folder or a special file",
+                         file=str(out), column="--out")
+    if any(out.resolve() == Path(p).resolve() for p in inputs):
+        raise InputError("--out would replace an input file", file=str(out), column="--out")
+    if suffixes and out.suffix.lower() not in suffixes:
+        raise InputError(f"--out must end in {' or '.join(suffixes)}", file=str(out),
+                         column="--out")
+
+
+def _check_out_dir(out: Path) -> None:
+    if out.exists() and not out.is_dir():
+        raise InputError("--out must be a folder", file=str(out), column="--out")
+
+
+def _check_inputs(paths: Sequence[Path]) -> None:
+    from twin.paths import check_input_file
+
+    for path in paths:
+        check_input_file(path)
+
+
+def _progress(quiet: bool):
+    start = time.perf_counter()
+
+    def tell(message: str) -> None:
+        if not quiet:
+            typer.echo(f"[{time.perf_counter() - start:6.1f} s] {message}", err=True)
+
+    return tell
+
+
+def _report_findings(findings: list[dict], quiet: bool) -> None:
+    if quiet:
+        return
+    for f in findings:
+        typer.echo(f"note: {f['file']}, column {f['column']!r}, rows {f['first_row']}–"
+                   f"{f['last_row']}: {f['repair']}", err=True)
+
+
+@drift_app.command("fit")
+@report_errors
+def fit(
+    data: list[Path] = typer.Argument(..., help="Data files (CSV or Parquet): time_s, "
+                                      "optional speed_rpm, *_C temperatures, *_um drifts."),
+    target: str = typer.Option(..., "--target", help="Displacement column(s) to model, "
+                               "comma-separated (e.g. ch1_um,ch2_um)."),
+    out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
+    method: str | None = typer.Option(
+        None, "--method", help="Force a method: mlr, ridge_lagged, ridge_dynamic, bp, bayes, "
+        "stack. Default: the best of all by time-blocked validation."),
+    sensors: str = typer.Option(
+        "auto", "--sensors", help="auto (best of every correlation cluster), K (best K of "
+        "those), all, or a comma-separated list of temperature columns."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the network weights and k-means."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
+) -> None:
+    """Fit a drift model; validation leaves one time block out at a time (never shuffled)."""
+    from twin.drift.data import read_drift_data
+    from twin.drift.methods import method_named
+    from twin.drift.model import fit_drift_model
+    from twin.drift.modelfile import save_drift_model
+
+    _check_out_file(out, data, (".safetensors",))
+    _check_inputs(data)
+    if method is not None:
+        method_named(method)
+    targets = _targets(target)
+    tell = _progress(quiet)
+    tell(f"reading {len(data)} file(s)")
+    drift_data = read_drift_data(data, targets=targets)
+    _report_findings(drift_data.findings, quiet)
+    model = fit_drift_model(drift_data, method=method, sensors=sensors, seed=seed,
+                            progress=tell)
+    save_drift_model(model, out)
+    if not quiet:
+        validation = model.metadata["validation"]["methods"]
+        typer.echo(f"time-blocked validation ({model.metadata['validation']['blocks']} "
+                   "blocks), RMSE µm per target / mean:")
+        for name, v in validation.items():
+            per = " ".join(f"{v['rmse_um'][t]:6.2f}" for t in targets)
+            mark = "  <- chosen" if name == model.method else ""
+            typer.echo(f"  {name:14s} {per}   mean {v['mean_rmse_um']:6.2f}{mark}")
+        typer.echo(f"sensors: {', '.join(model.spec.sensors)}")
+        typer.echo(f"wrote {out}")
+
+
+@drift_app.command("predict")
+@report_errors
+def predict(
+    model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
+    data: Path = typer.Argument(..., help="Data file: time_s, speed_rpm (if the model uses "
+                                "it) and the model's temperature columns."),
+    out: Path = typer.Option(..., "--out", help="PRED.csv to write: time_s and per target "
+                             "<target>, <target>_lo, <target>_hi (90 % interval)."),
+    quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
+) -> None:
+    """Predict the drift, causally (a row's prediction uses rows up to it only)."""
+    from twin.drift.data import read_drift_data
+    from twin.drift.modelfile import load_drift_model
+    from twin.drift.output import write_predictions
+
+    _check_out_file(out, [model_file, data], (".csv",))
+    _check_inputs([model_file, data])
+    model = load_drift_model(model_file)
+    drift_data = read_drift_data([data], sensors=model.spec.sensors, targets=model.targets,
+                                 require_targets=False, require_speed=model.spec.uses_speed)
+    _report_findings(drift_data.findings, quiet)
+    mean, lo, hi = model.predict(drift_data)
+    write_predictions(out, model, drift_data, mean, lo, hi)
+    if not quiet:
+        typer.echo(f"wrote {out} ({drift_data.n_samples} rows)")
+
+
+@drift_app.command("report")
+@report_errors
+def report(
+    model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
+    data: list[Path] = typer.Argument(..., help="Data files holding the model's targets."),
+    out: Path = typer.Option(..., "--out", help="Folder for metrics.json and report.html."),
+    quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
+) -> None:
+    """Write metrics.json and a self-contained report.html (measured vs predicted)."""
+    from twin.drift.data import read_drift_data
+    from twin.drift.modelfile import load_drift_model
+    from twin.drift.report import write_drift_report
+
+    _check_out_dir(out)
+    _check_inputs([model_file, *data])
+    model = load_drift_model(model_file)
+    drift_data = read_drift_data(data, sensors=model.spec.sensors, targets=model.targets,
+                                 require_targets=True, require_speed=model.spec.uses_speed)
+    _report_findings(drift_data.findings, quiet)
+    metrics, metrics_path, html_path = write_drift_report(out, model, drift_data,
+                                                          model_file.name)
+    if not quiet:
+        for t, m in metrics["targets"].items():
+            typer.echo(f"{t:12s} RMSE {m['rmse_um']:.2f} µm, 90 % interval coverage "
+                       f"{m['coverage_90_pct']:.1f} %")
+        typer.echo(f"wrote {metrics_path} and {html_path}")
+
+
+@drift_app.command("select")
+@report_errors
+def select(
+    data: list[Path] = typer.Argument(..., help="Data files (CSV or Parquet)."),
+    target: str = typer.Option(..., "--target", help="Displacement column(s), comma-separated."),
+    top: int | None = typer.Option(None, "--top", min=1, help="Show only the best K."),
+    out: Path | None = typer.Option(None, "--out", help="Also write the ranking as JSON."),
+) -> None:
+    """Rank the temperature sensors: grey relational grade (ρ = 0.5), correlation clusters."""
+    from twin.drift.data import read_drift_data
+    from twin.drift.model import sensor_ranking
+    from twin.io.atomic import write_json
+
+    if out is not None:
+        _check_out_file(out, data, (".json",))
+    _check_inputs(data)
+    drift_data = read_drift_data(data, targets=_targets(target))
+    ranking = sensor_ranking(drift_data)
+    rows = ranking.to_json()["sensors"][: top or None]
+    typer.echo(f"{'sensor':12s} {'grade':>6s} {'cluster':>7s}  kept")
+    for r in rows:
+        kept = "yes" if r["representative"] else "collinear"
+        typer.echo(f"{r['sensor']:12s} {r['mean_grade']:6.3f} {r['cluster']:7d}  {kept}")
+    if out is not None:
+        write_json(out, {"targets": drift_data.targets, "sensors": rows})
+        typer.echo(f"wrote {out}")

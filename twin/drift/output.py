@@ -1,0 +1,60 @@
+"""Drift outputs: PRED.csv (DESIGN.md) and metrics.json, written atomically."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from twin.drift.data import DriftData
+from twin.drift.metrics import target_metrics
+from twin.drift.model import DriftModel
+from twin.io.atomic import write_csv, write_json
+
+
+def prediction_columns(targets: list[str]) -> list[str]:
+    """`time_s`, then `<target>`, `<target>_lo`, `<target>_hi` per target."""
+    return ["time_s"] + [f"{t}{s}" for t in targets for s in ("", "_lo", "_hi")]
+
+
+def write_predictions(path: str | os.PathLike[str], model: DriftModel, data: DriftData,
+                      mean: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> Path:
+    """PRED.csv: time and, per target, the prediction and its 90 % interval (µm)."""
+    parts = [data.time_s[:, None]]
+    for j in range(len(model.targets)):
+        parts.append(np.stack([mean[:, j], lo[:, j], hi[:, j]], axis=1))
+    table = np.hstack(parts)
+    return write_csv(path, prediction_columns(model.targets), table.tolist())
+
+
+def _finite_or_none(value: object) -> object:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite_or_none(v) for v in value]
+    return value
+
+
+def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
+                  hi: np.ndarray) -> dict:
+    """metrics.json: per target rmse_um, mae_um, max_abs_um, r2, coverage_90_pct."""
+    if data.targets_um is None:
+        raise ValueError("the data hold no targets")
+    per_target = {t: target_metrics(data.targets_um[:, j], mean[:, j], lo[:, j], hi[:, j])
+                  for j, t in enumerate(model.targets)}
+    keys = ("rmse_um", "mae_um", "max_abs_um", "r2", "coverage_90_pct")
+    mean_of = {k: float(np.nanmean([m[k] for m in per_target.values()])) for k in keys}
+    validation = model.metadata.get("validation", {})
+    return _finite_or_none({
+        "method": model.method, "files": list(data.files), "n_rows": data.n_samples,
+        "sensors": list(model.spec.sensors), "targets": per_target, "mean": mean_of,
+        "interval": model.interval, "data_findings": data.findings,
+        "validation": validation})
+
+
+def write_metrics(path: str | os.PathLike[str], metrics: dict) -> Path:
+    return write_json(path, metrics)

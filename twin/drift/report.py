@@ -1,0 +1,95 @@
+"""The drift report: measured vs predicted with the 90 % band, residuals, sensor ranking.
+
+One self-contained HTML page (`report.html`, figures embedded as PNG data URIs) beside
+`metrics.json` in the output folder.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+import numpy as np
+
+from twin.drift.data import DriftData
+from twin.drift.model import DriftModel
+from twin.drift.output import drift_metrics, write_metrics
+from twin.io.atomic import write_text
+from twin.io.html_pages import png_data_uri, render_page
+
+
+def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    return buf.getvalue()
+
+
+def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
+             hi: np.ndarray) -> list[dict]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    hours = (data.time_s - data.time_s[0]) / 3600.0
+    segments = data.segment_ids()
+    images = []
+    for j, target in enumerate(model.targets):
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True,
+                                          height_ratios=[2, 1])
+        y = data.targets_um[:, j]
+        for s in np.unique(segments):
+            rows = segments == s
+            top.fill_between(hours[rows], lo[rows, j], hi[rows, j], color="tab:blue",
+                             alpha=0.25, lw=0, label="90 % interval" if s == 0 else None)
+            top.plot(hours[rows], y[rows], color="k", lw=1,
+                     label="measured" if s == 0 else None)
+            top.plot(hours[rows], mean[rows, j], color="tab:blue", lw=1,
+                     label=f"predicted ({model.method})" if s == 0 else None)
+            bottom.plot(hours[rows], mean[rows, j] - y[rows], color="tab:red", lw=0.8)
+        top.set_ylabel(f"{target} [µm]")
+        top.legend(loc="best", fontsize=8)
+        bottom.axhline(0.0, color="k", lw=0.5)
+        bottom.set_ylabel("residual [µm]")
+        bottom.set_xlabel("time from the first row [h]" if segments.max() == 0
+                          else "time [h] (files back to back)")
+        fig.tight_layout()
+        images.append({"title": f"{target}: measured and predicted, residuals",
+                       "src": png_data_uri(_png(fig))})
+        plt.close(fig)
+    ranking = model.metadata.get("ranking", {}).get("sensors", [])
+    if ranking:
+        fig, ax = plt.subplots(figsize=(10, 3.2))
+        names = [r["sensor"] for r in ranking]
+        grades = [r["mean_grade"] for r in ranking]
+        colours = ["tab:green" if r["sensor"] in model.spec.sensors else "tab:gray"
+                   for r in ranking]
+        ax.bar(names, grades, color=colours)
+        ax.set_ylim(min(grades) - 0.05, 1.0)
+        ax.set_ylabel("grey relational grade")
+        ax.set_title("sensor ranking (green: used by the model)")
+        ax.tick_params(axis="x", rotation=60, labelsize=8)
+        fig.tight_layout()
+        images.append({"title": "Sensor ranking", "src": png_data_uri(_png(fig))})
+        plt.close(fig)
+    return images
+
+
+def write_drift_report(out_dir: str | os.PathLike[str], model: DriftModel, data: DriftData,
+                       model_name: str) -> tuple[dict, Path, Path]:
+    """Write metrics.json and report.html into `out_dir`: (metrics, their paths)."""
+    mean, lo, hi = model.predict(data)
+    metrics = drift_metrics(model, data, mean, lo, hi)
+    out = Path(out_dir)
+    metrics_path = write_metrics(out / "metrics.json", metrics)
+    validation = model.metadata.get("validation", {}).get("methods", {})
+    html = render_page(
+        "drift_report.html.j2", model_name=model_name, metrics=metrics,
+        uses_speed=model.spec.uses_speed,
+        targets=model.targets, validation=validation,
+        chosen=model.metadata.get("validation", {}).get("chosen", model.method),
+        ranking=model.metadata.get("ranking", {}).get("sensors", []),
+        images=_figures(model, data, mean, lo, hi))
+    html_path = write_text(out / "report.html", html)
+    return metrics, metrics_path, html_path
