@@ -5,7 +5,7 @@ BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.installed
 export PYVISTA_OFF_SCREEN := true
 
-.PHONY: install run test test-fast bench lint model examples clean
+.PHONY: install run test test-fast bench lint model examples drift-example clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -36,6 +36,15 @@ model: $(STAMP)
 
 examples: $(STAMP)
 	$(BIN)/python examples/make_runs.py
+
+# data-driven drift model on the bundled real step-test data (examples/real/, MIT)
+DRIFT_DATA    := examples/real/train.csv
+DRIFT_TARGETS := ch1_um,ch2_um,ch3_um,ch4_um,ch5_um
+drift-example: $(STAMP)
+	$(BIN)/twin drift select $(DRIFT_DATA) --target $(DRIFT_TARGETS) --out out/drift/sensors.json
+	$(BIN)/twin drift fit $(DRIFT_DATA) --target $(DRIFT_TARGETS) --seed 0 --out out/drift/model.safetensors
+	$(BIN)/twin drift predict out/drift/model.safetensors $(DRIFT_DATA) --out out/drift/pred.csv
+	$(BIN)/twin drift report out/drift/model.safetensors $(DRIFT_DATA) --out out/drift/report
 
 clean:
 	rm -rf out bench/*.json .pytest_cache

@@ -23,6 +23,7 @@ MODULES = [
     "bench.correction",
     "bench.loop",
     "bench.estimator",
+    "bench.drift",
 ]
 
 
