@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from twin.correction import training_data
 from twin.correction.modelfile import load_model
 from twin.correction.toy_plant import ToyPlant
 from twin.correction.training_data import SimulatedRun
+from twin.loop import training
 from twin.runs import write_run
 
 PLANT = ToyPlant()
@@ -27,7 +27,7 @@ def _toy_simulator(run):
 
 @pytest.fixture
 def runs(tmp_path, monkeypatch):
-    monkeypatch.setattr(training_data, "default_simulator", lambda targets="fit": _toy_simulator)
+    monkeypatch.setattr(training, "training_simulator", lambda rule="fit": _toy_simulator)
     paths = []
     for i, speed in enumerate((6000.0, 8000.0, 11000.0)):
         t = np.arange(0, 901, 5.0)
@@ -78,7 +78,7 @@ def test_train_writes_model_and_report(runs, tmp_path):
 
 
 def test_train_bad_run_exits_2(tmp_path, monkeypatch):
-    monkeypatch.setattr(training_data, "default_simulator", lambda targets="fit": _toy_simulator)
+    monkeypatch.setattr(training, "training_simulator", lambda rule="fit": _toy_simulator)
     bad = tmp_path / "bad.csv"
     bad.write_text("time_s,speed_rpm\n0,9000\n")
     result = _invoke(["train", str(bad), "--out", str(tmp_path / "m.safetensors")])

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import typer
 
+from twin.loop.target_rules import TargetRule
+
 
 def train(
     runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on."),
@@ -17,8 +19,8 @@ def train(
         help="Save the paper's configuration (linear hidden, logistic output, logistic "
         "scaling of X/1e6) instead of the default (tanh hidden, standardised factors).",
     ),
-    targets: str = typer.Option(
-        "fit", "--targets",
+    targets: TargetRule = typer.Option(
+        TargetRule.FIT, "--targets",
         help="Target rule: 'fit' (each window's values fitted to the measured window by the "
         "twin, with two passes driven off the fit) or 'ratio' (the paper's Eq. 2/5/6 on "
         "fitted curves of a ratio-corrected simulation).",
@@ -35,16 +37,14 @@ def train(
     from twin.correction.report import report_paths, write_report
     from twin.correction.samples import SampleSet, samples_for
     from twin.correction.training import train_model
-    from twin.correction.training_data import TARGET_RULES, default_simulator, run_curves
-    from twin.errors import InputError
+    from twin.correction.training_data import run_curves
     from twin.io.destinations import check_out_file
+    from twin.loop.training import training_simulator
     from twin.runs import read_run
     from twin.spindle.spec import load_spec
 
-    if targets not in TARGET_RULES:
-        raise InputError(f"--targets must be one of {', '.join(TARGET_RULES)}, not {targets!r}")
     check_out_file(out, inputs=runs, also=report_paths(out))
-    simulator = default_simulator(targets)
+    simulator = training_simulator(targets)
     limit_rpm = load_spec(None).spindle.max_speed_rpm  # the networks train on that spindle
     sets = []
     for path in runs:
@@ -56,7 +56,7 @@ def train(
     chosen = PAPER if paper_config else DEFAULT
     # file names only: the model file must not depend on where the runs were kept
     meta = {"runs": [p.name for p in runs], "simulation": getattr(simulator, "__name__", ""),
-            "targets": targets}
+            "targets": targets.value}
     results = {}
     for config in (DEFAULT, PAPER):
         if not quiet:

@@ -1,9 +1,9 @@
 """From recorded runs to `RunCurves`: the measured curves and the same run simulated.
 
-Simulating a training run is the twin loop's job (`twin.loop.training`):
+Simulating a training run is the twin loop's job, so the simulator is an argument here
+(this package never imports `twin.loop`):
 
-    twin.loop.simulate_for_training(run) -> list[SimulatedRun]   # window fit (targets "fit")
-    twin.loop.simulate_with_ratio(run) -> list[SimulatedRun]     # the paper's way ("ratio")
+    run_curves(run, twin.loop.training.training_simulator("fit"))   # or "ratio"
 
 A `Simulator` is any callable RecordedRun -> list[SimulatedRun] (one entry per simulated
 pass), so tests and other tools can plug in their own.
@@ -40,24 +40,11 @@ class SimulatedRun:
 
 Simulator = Callable[[object], list[SimulatedRun]]
 
-TARGET_RULES = ("fit", "ratio")
-"""How training targets are made: the window fit (default) or the paper's ratio law."""
 
-
-def default_simulator(targets: str = "fit") -> Simulator:
-    """The twin loop's simulation of a training run for a target rule (see TARGET_RULES)."""
-    from twin.loop import training
-
-    if targets == "fit":
-        return training.simulate_for_training
-    if targets == "ratio":
-        return training.simulate_with_ratio
-    raise ValueError(f"unknown target rule {targets!r}; expected one of {', '.join(TARGET_RULES)}")
-
-
-def run_curves(run: object, simulator: Simulator | None = None) -> list[RunCurves]:
-    """RunCurves of a `twin.runs.RecordedRun`, one per simulated pass; invalid samples → NaN."""
-    return [_curves(run, sim) for sim in (simulator or default_simulator())(run)]
+def run_curves(run: object, simulator: Simulator) -> list[RunCurves]:
+    """RunCurves of a `twin.runs.RecordedRun`, one per pass `simulator` makes of it;
+    invalid samples → NaN."""
+    return [_curves(run, sim) for sim in simulator(run)]
 
 
 def _curves(run: object, sim: SimulatedRun) -> RunCurves:

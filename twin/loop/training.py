@@ -6,6 +6,9 @@ scattered around it; each pass carries the fitted values per window (the targets
 
 `simulate_with_ratio` (the paper's way, `twin train --targets ratio`): the run replayed
 with the online ratio correction; the targets then come from Eq. 2/5/6 on fitted curves.
+
+`training_simulator(rule)` picks one of them for a `TargetRule`; `twin.correction` takes
+the simulator as an argument (`run_curves(run, simulator)`) and never imports the loop.
 """
 
 from __future__ import annotations
@@ -13,9 +16,10 @@ from __future__ import annotations
 import numpy as np
 
 from twin.correction.methods import make_corrector
-from twin.correction.training_data import SimulatedRun
+from twin.correction.training_data import SimulatedRun, Simulator
 from twin.loop.replay import MethodReplay, replay_method
 from twin.loop.runfiles import default_spindle
+from twin.loop.target_rules import TargetRule
 from twin.loop.windowfit import WindowFit
 
 DRIVEN_PASSES = (0.05, 0.05)
@@ -37,6 +41,16 @@ def simulate_with_ratio(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.run
     """The run replayed with the online ratio correction (the paper's training simulation)."""
     result = replay_method(run, default_spindle(), make_corrector("ratio"), keep_fields=False)
     return [_simulated(run, result, None)]
+
+
+def training_simulator(rule: TargetRule | str = TargetRule.FIT) -> Simulator:
+    """The twin's simulation of a training run for a target rule."""
+    simulators = {TargetRule.FIT: simulate_for_training, TargetRule.RATIO: simulate_with_ratio}
+    try:
+        return simulators[TargetRule(rule)]
+    except ValueError:
+        rules = ", ".join(r.value for r in TargetRule)
+        raise ValueError(f"unknown target rule {rule!r}; expected one of {rules}") from None
 
 
 def _simulated(run, result: MethodReplay, fitted: np.ndarray | None) -> SimulatedRun:  # noqa: ANN001
