@@ -114,3 +114,65 @@ def _bundled_model():
     model = bundled_model()
     assert model is not None
     return model
+
+
+def test_cli_choices_match_the_modules_that_act_on_them():
+    from twin.cli.inputs import Field, Method, Snapshots
+    from twin.correction.methods import METHODS
+    from twin.loop.runfiles import SNAPSHOT_CHOICES
+    from twin.loop.snapshot import FIELDS
+
+    assert tuple(Method) == METHODS
+    assert tuple(Snapshots) == SNAPSHOT_CHOICES
+    assert tuple(Field) == tuple(FIELDS)
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["replay", "--out", "OUT", "--methods", "open_loop,magic"], "--methods"),
+        (["replay", "--out", "OUT", "--methods", " , "], "--methods"),
+        (["replay", "--out", "OUT", "--snapshots", "sometimes"], "--snapshots"),
+        (["replay", "--out", "OUT", "--jobs", "0"], "--jobs"),
+        (["snapshot", "RUN.csv", "--time", "60", "--out", "OUT.png", "--field", "stress"],
+         "--field"),
+        (["snapshot", "RUN.csv", "--time", "60", "--out", "OUT.png", "--method", "magic"],
+         "--method"),
+        (["snapshot", "RUN.csv", "--time", "-1", "--out", "OUT.png"], "--time"),
+        (["train", "RUN.csv", "--out", "OUT.safetensors", "--targets", "guess"], "--targets"),
+        (["train", "RUN.csv", "--out", "OUT.safetensors", "--seed", "-1"], "--seed"),
+        (["train", "RUN.csv", "--out", "OUT.safetensors", "--epochs", "0"], "--epochs"),
+        (["synth", "--speed", "9000", "--minutes", "1", "--ambient", "25", "--seed", "1",
+          "--out", "OUT.csv"], "--minutes"),
+        (["synth", "--speed", "9000", "--minutes", "nan", "--ambient", "25", "--seed", "1",
+          "--out", "OUT.csv"], "--minutes"),
+        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "-40", "--seed", "1",
+          "--out", "OUT.csv"], "--ambient"),
+        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "-2",
+          "--out", "OUT.csv"], "--seed"),
+        (["synth", "--speed", "-5", "--minutes", "3", "--ambient", "25", "--seed", "1",
+          "--out", "OUT.csv"], "--speed"),
+        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1",
+          "--rate", "0.01", "--out", "OUT.csv"], "--rate"),
+        (["simulate", "--speed", "9000", "--minutes", "0", "--ambient", "25", "--out", "OUT"],
+         "--minutes"),
+        (["simulate", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--out", "OUT",
+          "--field-every", "-1"], "--field-every"),
+        (["simulate", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--out", "OUT",
+          "--size-factor", "100"], "--size-factor"),
+        (["mesh", "--out", "OUT.msh", "--size-factor", "0"], "--size-factor"),
+    ],
+)
+def test_bad_choice_or_bound_exits_2_naming_the_option(argv, option, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # nothing may be written, and nowhere but here
+    result = CliRunner().invoke(app, argv)
+    assert result.exit_code == 2, result.output
+    assert f"Invalid value for '{option}'" in result.output
+    assert "Traceback" not in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_methods_are_normalised_before_the_command_runs():
+    from twin.cli.inputs import method_list
+
+    assert method_list(" ratio,open_loop ,ratio") == "ratio,open_loop"

@@ -1,14 +1,48 @@
-"""Inputs several `twin` commands share: the bundled examples, the correction methods
-and the correction model check.  Light on purpose: `twin --help` imports it."""
+"""Inputs several `twin` commands share: the bundled examples, the choices and bounds
+typer checks (an unknown choice or a value out of range exits 2 naming the option), and
+the correction model check.  Light on purpose: `twin --help` imports it, so the choices
+are spelled here and tests/test_cli.py checks them against the modules that act on them.
+"""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+from enum import StrEnum
 from pathlib import Path
+
+import typer
 
 from twin.data import bundled_path
 from twin.errors import InputError
 
-METHOD_NAMES = ("open_loop", "ratio", "bpnn", "estimator")
+
+class Method(StrEnum):
+    """A correction method (`twin.correction.methods.METHODS`)."""
+
+    OPEN_LOOP = "open_loop"
+    RATIO = "ratio"
+    BPNN = "bpnn"
+    ESTIMATOR = "estimator"
+
+
+class Snapshots(StrEnum):
+    """Which field pictures a replay draws (`twin.loop.runfiles.SNAPSHOT_CHOICES`)."""
+
+    NONE = "none"
+    END = "end"
+    EVERY = "every"
+
+
+class Field(StrEnum):
+    """The field a snapshot shows (`twin.loop.snapshot.FIELDS`)."""
+
+    TEMPERATURE = "temperature"
+    DISPLACEMENT = "displacement"
+
+
+MAX_SIZE_FACTOR = 100.0
+"""Mesh element size multiplier: above this the spindle is no longer resolved at all."""
 
 
 def bundled_runs_dir() -> Path:
@@ -28,16 +62,30 @@ def bundled_model() -> Path | None:
     return model if model.is_file() else None
 
 
-def parse_methods(text: str) -> list[str]:
-    """`open_loop,ratio` → ["open_loop", "ratio"], each known and listed once."""
+def method_list(text: str) -> str:
+    """typer callback of `--methods`: `open_loop, ratio,ratio` → `open_loop,ratio`, each
+    method known (`Method`) and listed once."""
     methods = [m.strip() for m in text.split(",") if m.strip()]
-    bad = [m for m in methods if m not in METHOD_NAMES]
-    if bad or not methods:
-        raise InputError(
-            f"unknown method {bad[0] if bad else text!r}; choose from {', '.join(METHOD_NAMES)}",
-            column="--methods",
-        )
-    return list(dict.fromkeys(methods))
+    choices = ", ".join(Method)
+    if not methods:
+        raise typer.BadParameter(f"no method given; choose from {choices}")
+    for m in methods:
+        if m not in {method.value for method in Method}:
+            raise typer.BadParameter(f"unknown method {m!r}; choose from {choices}")
+    return ",".join(dict.fromkeys(methods))
+
+
+def between(low: float, high: float = math.inf) -> Callable[[float], float]:
+    """typer callback: the value must lie strictly between `low` and `high` (typer's own
+    `min`/`max` bounds are closed)."""
+
+    def check(value: float) -> float:
+        if not low < value < high:
+            upper = "" if high == math.inf else f" and below {high:g}"
+            raise typer.BadParameter(f"must be above {low:g}{upper}, got {value:g}")
+        return value
+
+    return check
 
 
 def checked_model(methods: list[str], model: Path | None) -> str | None:

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import typer
 
+from twin.cli.inputs import MAX_SIZE_FACTOR, between
+
 
 def mesh(
     out: Path = typer.Option(..., "--out", help="Mesh file to write (.msh, gmsh 2.2)."),
@@ -13,7 +15,8 @@ def mesh(
         None, "--spec", help="Spindle spec TOML (default: the bundled reference spindle)."
     ),
     size_factor: float = typer.Option(
-        1.0, "--size-factor", help="Element size multiplier (< 1 refines)."
+        1.0, "--size-factor", callback=between(0.0, MAX_SIZE_FACTOR),
+        help="Element size multiplier (< 1 refines).",
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
@@ -23,9 +26,6 @@ def mesh(
     from twin.spindle.mesher import build_mesh, mesh_quality, write_msh
     from twin.spindle.spec import load_spec
 
-    if not (size_factor > 0 and size_factor < 100):
-        raise InputError(f"must be a positive number below 100, got {size_factor}",
-                         column="--size-factor")
     if out.suffix != ".msh":
         raise InputError("the mesh file must end in .msh", file=str(out))
     check_out_file(out, inputs=[spec])

@@ -6,7 +6,13 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import bundled_runs, bundled_runs_dir, checked_model, parse_methods
+from twin.cli.inputs import (
+    Snapshots,
+    bundled_runs,
+    bundled_runs_dir,
+    checked_model,
+    method_list,
+)
 from twin.errors import InputError
 from twin.io.destinations import check_out_dir
 
@@ -18,15 +24,16 @@ def replay(
     out: Path = typer.Option(..., "--out", help="output folder"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
     methods: str = typer.Option(
-        "open_loop,ratio,bpnn,estimator",
-        "--methods",
+        "open_loop,ratio,bpnn,estimator", "--methods", callback=method_list,
         help="comma-separated: open_loop, ratio, bpnn, estimator",
     ),
     jobs: int = typer.Option(1, "--jobs", min=1, help="local worker processes"),
     dask: str | None = typer.Option(
         None, "--dask", help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     ),
-    snapshots: str = typer.Option("end", "--snapshots", help="none | end | every"),
+    snapshots: Snapshots = typer.Option(
+        Snapshots.END, "--snapshots", help="field pictures: none, at the end, every window"
+    ),
     resume: bool = typer.Option(False, "--resume", help="skip runs already finished"),
     quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
 ) -> None:
@@ -35,15 +42,9 @@ def replay(
 
     from twin.loop.batch import replay_batch
     from twin.loop.report import build_report
-    from twin.loop.runfiles import SNAPSHOT_CHOICES
-
-    if snapshots not in SNAPSHOT_CHOICES:
-        raise InputError(
-            f"must be one of {', '.join(SNAPSHOT_CHOICES)}, got {snapshots!r}", column="--snapshots"
-        )
     if dask and jobs > 1:
         raise InputError("use either --jobs or --dask, not both", column="--dask")
-    method_list = parse_methods(methods)
+    chosen = methods.split(",")
     paths = list(runs) if runs else bundled_runs()
     if not paths:
         raise InputError(
@@ -51,9 +52,9 @@ def replay(
         )
     check_out_dir(out, inputs=[*paths, model], owned=[
         *(Path(p).stem for p in paths), "summary.json", "report.html"])
-    model_path = checked_model(method_list, model)
+    model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
-    console.print(f"replaying {len(paths)} run(s) with {', '.join(method_list)} → {out}")
+    console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -73,11 +74,11 @@ def replay(
         result = replay_batch(
             paths,
             out,
-            method_list,
+            chosen,
             model_path,
             jobs=jobs,
             dask_address=dask,
-            snapshots=snapshots,
+            snapshots=snapshots.value,
             resume=resume,
             progress=tell,
         )

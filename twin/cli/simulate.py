@@ -6,19 +6,24 @@ from pathlib import Path
 
 import typer
 
+from twin.cli.inputs import MAX_SIZE_FACTOR, between
+
 
 def simulate_command(
     speed: float = typer.Option(..., "--speed", help="Spindle speed, rpm."),
-    minutes: float = typer.Option(..., "--minutes", help="Duration, minutes."),
+    minutes: float = typer.Option(..., "--minutes", callback=between(0.0),
+                                  help="Duration, minutes."),
     ambient: float = typer.Option(..., "--ambient", help="Ambient temperature, °C."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
     coolant: float | None = typer.Option(
         None, "--coolant", help="Coolant inlet temperature, °C (default: the ambient)."
     ),
     spec: Path | None = typer.Option(None, "--spec", help="Spindle spec TOML."),
-    size_factor: float = typer.Option(1.0, "--size-factor", help="Mesh size multiplier."),
+    size_factor: float = typer.Option(1.0, "--size-factor",
+                                      callback=between(0.0, MAX_SIZE_FACTOR),
+                                      help="Mesh size multiplier."),
     field_every: float = typer.Option(
-        60.0, "--field-every", help="Seconds between field snapshots (0: only the end)."
+        60.0, "--field-every", min=0.0, help="Seconds between field snapshots (0: only the end)."
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
@@ -26,17 +31,11 @@ def simulate_command(
 
     Writes keypoints.csv, fields.pvd + fields/*.vtu and summary.json to OUT.
     """
-    from twin.errors import InputError
     from twin.io.destinations import check_out_dir
     from twin.spindle import SpindleModel, simulate, write_simulation
     from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
 
-    if not (size_factor > 0 and size_factor < 100):
-        raise InputError(f"must be a positive number below 100, got {size_factor}",
-                         column="--size-factor")
-    if not field_every >= 0:
-        raise InputError(f"must be >= 0, got {field_every}", column="--field-every")
     check_out_dir(out, inputs=[spec],
                   owned=["keypoints.csv", "fields.pvd", "fields", "summary.json"])
     # validate the operating point before the (slower) model build

@@ -6,17 +6,17 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import checked_model, parse_methods
+from twin.cli.inputs import Field, Method, checked_model
 from twin.errors import InputError
 from twin.io.destinations import check_out_file
 
 
 def snapshot(
     run: Path = typer.Argument(..., help="recorded run (CSV/Parquet)"),
-    time_s: float = typer.Option(..., "--time", help="run time of the picture, s"),
+    time_s: float = typer.Option(..., "--time", min=0.0, help="run time of the picture, s"),
     out: Path = typer.Option(..., "--out", help="PNG file"),
-    field: str = typer.Option("temperature", "--field", help="temperature | displacement"),
-    method: str = typer.Option("bpnn", "--method", help="open_loop | ratio | bpnn | estimator"),
+    field: Field = typer.Option(Field.TEMPERATURE, "--field", help="the field shown"),
+    method: Method = typer.Option(Method.BPNN, "--method", help="correction method"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
     section: bool = typer.Option(False, "--section", help="flat r–z section, not 3-D"),
 ) -> None:
@@ -24,12 +24,10 @@ def snapshot(
     from twin.correction.methods import make_corrector
     from twin.loop.replay import replay_method
     from twin.loop.runfiles import default_spindle
-    from twin.loop.snapshot import FIELDS, render_snapshot
+    from twin.loop.snapshot import render_snapshot
     from twin.runs import read_run
 
-    if field not in FIELDS:
-        raise InputError(f"must be one of {', '.join(FIELDS)}, got {field!r}", column="--field")
-    (method_name,) = parse_methods(method)
+    method_name = method.value
     model_path = checked_model([method_name], model)
     if out.suffix.lower() != ".png":
         raise InputError("the picture must be a .png file", file=str(out), column="--out")
@@ -51,7 +49,7 @@ def snapshot(
         spindle,
         T,
         out,
-        field=field,
+        field=field.value,
         section=section,
         T_initial_C=r.T_initial_C,
         title=f"{recorded.name} · {method_name} · t = {t:.0f} s",

@@ -13,7 +13,7 @@ def train(
     runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
     epochs: int = typer.Option(5000, "--epochs", min=1, help="Maximum Rprop epochs."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the 80/20 split and the weights."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed of the 80/20 split and the weights."),
     paper_config: bool = typer.Option(
         False, "--paper-config",
         help="Save the paper's configuration (linear hidden, logistic output, logistic "
