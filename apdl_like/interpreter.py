@@ -108,6 +108,7 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
     stmts = program.statements
     n = len(stmts)
     loops: dict[int, list[float]] = {}  # *DO index -> [value, increment, remaining]
+    previous: Statement | None = None  # the last command run, for *REPEAT
     i = 0
     while i < n:
         st = stmts[i]
@@ -152,8 +153,11 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
                 raise _Exit(program.enclosing_do[i], name == "*CYCLE")
             elif name == "/INPUT":
                 _input(session, st, depth)
+            elif name == "*REPEAT":
+                _repeat(session, previous, st)
             else:
                 _dispatch(session, st)
+                previous = st
         except _Exit as jump:
             end = program.block_end[jump.do_index]
             if jump.cycle:
@@ -246,6 +250,30 @@ def _input(session: SessionState, st: Statement, depth: int) -> None:
         raise st.error(f"/INPUT file {name!r} not found in {str(base)!r}")
     shown = str(Path(st.file).parent / name) if st.file and not st.file.startswith("<") else name
     execute(session, read_deck(target, shown), depth + 1)
+
+
+def _repeat(session: SessionState, previous: Statement | None, st: Statement) -> None:
+    """*REPEAT,NTOT,VINC1,...,VINC11: the previous command NTOT-1 more times, field j
+    increased by k·VINCj in the k-th repetition."""
+    if previous is None:
+        raise st.error("*REPEAT needs a command before it")
+    total = int(round(_value(session, st, 1, "NTOT")))
+    if not 1 <= total <= MAX_LOOP_ITERATIONS:
+        raise st.error(f"field 1 (NTOT) must lie in 1..{MAX_LOOP_ITERATIONS}")
+    incs = [_value(session, st, j + 2, "VINC") if j + 2 <= len(st.fields) and
+            st.fields[j + 1] else 0.0 for j in range(11)]
+    for k in range(1, total):
+        fields = list(previous.fields)
+        for j, inc in enumerate(incs):
+            if inc == 0.0:
+                continue
+            base = _value(session, previous, j + 1, "repeated field") if j < len(fields) \
+                and fields[j] else 0.0
+            fields += [""] * (j + 1 - len(fields))
+            fields[j] = repr(base + k * inc)
+        _count_iteration(session, st)
+        _dispatch(session, Statement(previous.file, st.line, previous.name, tuple(fields),
+                                     previous.text, previous.block))
 
 
 def _dispatch(session: SessionState, st: Statement) -> None:

@@ -128,3 +128,111 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
         el.add(first + k, db.active_type, db.active_mat, db.active_real, conn)
     el.flush()
     s.say(f"AMESH: {len(tri)} elements, {int(fresh.sum())} new nodes (size {size:g})")
+
+
+def side_fractions(n: int, space: float) -> np.ndarray:
+    """0 = f_0 < ... < f_n = 1 for n divisions whose last/first length ratio is `space`."""
+    lengths = np.ones(n) if n == 1 or space == 1.0 else space ** (np.arange(n) / (n - 1))
+    return np.concatenate([[0.0], np.cumsum(lengths) / lengths.sum()])
+
+
+def _side(s: SessionState, a: int, b: int, size: float) -> np.ndarray:
+    """Fractions along the area side from keypoint a to b: its line's LESIZE (divisions,
+    spacing in the line's own direction) or ESIZE."""
+    db = s.db
+    for line in db.lines.values():
+        if {line.k1, line.k2} == {a, b}:
+            length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
+            n = line.ndiv or (db.esize_divisions or max(1, int(np.ceil(length / size - 1e-9))))
+            f = side_fractions(n, line.space)
+            return f if line.k1 == a else 1.0 - f[::-1]
+    length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
+    n = db.esize_divisions or max(1, int(np.ceil(length / size - 1e-9)))
+    return side_fractions(n, 1.0)
+
+
+def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
+    """Node coordinates (nv+1, nu+1, 2) of a mapped mesh of a 4-sided area whose opposite
+    sides have as many divisions, by transfinite interpolation; None if it cannot map."""
+    db = s.db
+    kps = db.areas[area]
+    if len(kps) != 4:
+        return None
+    k0, k1, k2, k3 = kps
+    bottom, top = _side(s, k0, k1, size), _side(s, k3, k2, size)
+    left, right = _side(s, k0, k3, size), _side(s, k1, k2, size)
+    if bottom.size != top.size or left.size != right.size:
+        return None
+    p0, p1, p2, p3 = (np.array(db.keypoints[k], float) for k in kps)
+    u = 0.5 * (bottom + top)[None, :, None]
+    v = 0.5 * (left + right)[:, None, None]
+    b = p0 + bottom[None, :, None] * (p1 - p0)
+    t = p3 + top[None, :, None] * (p2 - p3)
+    lft = p0 + left[:, None, None] * (p3 - p0)
+    rgt = p1 + right[:, None, None] * (p2 - p1)
+    corner = (1 - u) * (1 - v) * p0 + u * (1 - v) * p1 + u * v * p2 + (1 - u) * v * p3
+    return (1 - v) * b + v * t + (1 - u) * lft + u * rgt - corner
+
+
+def place_nodes(s: SessionState, xy: np.ndarray, extent: float) -> np.ndarray:
+    """Node numbers for points (n, 2): an existing coincident node, else a new number."""
+    nodes = s.db.nodes
+    nodes.flush()
+    numbers = np.zeros(xy.shape[0], np.int64)
+    fresh = np.ones(xy.shape[0], bool)
+    if len(nodes.ids):
+        dist, near = cKDTree(nodes.xy).query(xy)
+        hit = dist <= 1e-9 * max(extent, 1e-300)
+        numbers[hit] = nodes.ids[near[hit]]
+        fresh = ~hit
+    start = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
+    numbers[fresh] = np.arange(start, start + int(fresh.sum()))
+    for num, (x, y) in zip(numbers[fresh], xy[fresh], strict=True):
+        nodes.add(int(num), float(x), float(y))
+    nodes.flush()
+    return numbers
+
+
+def mesh_mapped(s: SessionState, area: int, grid: np.ndarray) -> int:
+    """Quads (or 8-node quads with mid-side nodes) on a mapped grid; returns the count."""
+    db = s.db
+    et = db.element_types[db.active_type]
+    nv, nu = grid.shape[0] - 1, grid.shape[1] - 1
+    extent = float(np.ptp(grid.reshape(-1, 2), axis=0).max())
+    # MAPDL's order: side by side around the area from its first keypoint, each side's
+    # end keypoints (when still unnumbered) before its interior nodes; then the interior
+    sides = [[(0, i) for i in range(nu + 1)], [(j, nu) for j in range(nv + 1)],
+             [(nv, i) for i in range(nu, -1, -1)], [(j, 0) for j in range(nv, -1, -1)]]
+    order: list[tuple[int, int]] = []
+    for side in sides:
+        order += [p for p in (side[0], side[-1]) if p not in order]
+        order += side[1:-1]
+    order += [(j, i) for j in range(1, nv) for i in range(1, nu)]
+    pts = np.array([grid[j, i] for j, i in order])
+    numbers = place_nodes(s, pts, extent)
+    number_at = {ji: int(n) for ji, n in zip(order, numbers, strict=True)}
+    mids: dict[tuple, int] = {}
+    el = db.elements
+    el.flush()
+    first = int(el.ids.max()) + 1 if len(el.ids) else 1
+    count = 0
+    for j in range(nv):
+        for i in range(nu):
+            corners = [number_at[(j, i)], number_at[(j, i + 1)], number_at[(j + 1, i + 1)],
+                       number_at[(j + 1, i)]]
+            conn: tuple[int, ...] = tuple(corners)
+            if et.quadratic:
+                cells = [((j, i), (j, i + 1)), ((j, i + 1), (j + 1, i + 1)),
+                         ((j + 1, i + 1), (j + 1, i)), ((j + 1, i), (j, i))]
+                side = []
+                for a, b in cells:
+                    key = (min(a, b), max(a, b))
+                    if key not in mids:
+                        mid = 0.5 * (grid[a] + grid[b])
+                        mids[key] = int(place_nodes(s, mid[None, :], extent)[0])
+                    side.append(mids[key])
+                conn = (*corners, *side)
+            el.add(first + count, db.active_type, db.active_mat, db.active_real, conn)
+            count += 1
+    el.flush()
+    return count

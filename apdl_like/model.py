@@ -374,6 +374,17 @@ class SolutionSettings:
 
 
 @dataclass
+class Line:
+    """A straight line between keypoints k1 -> k2, its divisions and spacing ratio (LESIZE;
+    the last division over the first, along k1 -> k2)."""
+
+    k1: int
+    k2: int
+    ndiv: int | None = None
+    space: float = 1.0
+
+
+@dataclass
 class Database:
     nodes: NodeTable = field(default_factory=NodeTable)
     elements: ElementTable = field(default_factory=ElementTable)
@@ -390,6 +401,9 @@ class Database:
     # AMESH geometry: keypoints and areas (lists of keypoint numbers)
     keypoints: dict[int, tuple[float, float]] = field(default_factory=dict)
     areas: dict[int, list[int]] = field(default_factory=dict)
+    lines: dict[int, Line] = field(default_factory=dict)
+    esize_divisions: int | None = None  # ESIZE,,NDIV: divisions of lines without LESIZE
+    mesh_triangles: bool = False  # MSHAPE,1
     meshed_areas: set[int] = field(default_factory=set)
     esize: float | None = None
     title: str = ""

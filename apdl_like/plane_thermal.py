@@ -6,6 +6,9 @@ interior Gauss points only; an 8-node PLANE77 is the serendipity quad (`ElementQ
 model of only 6-node triangles (PLANE35, or PLANE77 with K = L = O) runs on P2 triangles.
 Mid-side nodes carry the edge dofs; the geometry is straight-sided.
 
+Linear elements (PLANE55) diagonalize their specific heat and convection surface matrices
+(row sums), as MAPDL's PLANE55 does; quadratic ones keep them consistent.
+
 Planar (KEYOPT(3) = 0, unit thickness) or axisymmetric (KEYOPT(3) = 1: x is the radius,
 every integral carries 2πr, so reaction heats are for the full circumference as MAPDL
 reports them).  Conductivity may be orthotropic (KXX, KYY in the global axes) and, like ρ
@@ -45,7 +48,7 @@ from apdl_like.errors import ApdlError
 
 PICARD_TOLERANCE = 1e-8
 PICARD_ITERATIONS = 200
-STEP_TOLERANCE = 1e-4
+STEP_TOLERANCE = 1e-5
 MAX_SUBSTEPS = 200_000
 PAIR_BASE = np.int64(1) << 31
 
@@ -285,7 +288,10 @@ class PlaneThermal:
             for keys, h, tb in inputs.films:
                 fb = self._facet_basis(k, keys)
                 if fb is not None:
-                    K = K + S @ film.assemble(fb, h=h, axisymmetric=ax) @ S.T
+                    Hf = film.assemble(fb, h=h, axisymmetric=ax)
+                    if self.mesh.lumped:
+                        Hf = sp.diags(np.asarray(Hf.sum(axis=1)).ravel())
+                    K = K + S @ Hf @ S.T
                     f = f + S @ face_load.assemble(fb, g=h * tb, axisymmetric=ax)
             for keys, flux in inputs.fluxes:
                 fb = self._facet_basis(k, keys)

@@ -20,11 +20,13 @@ from apdl_like.commands import (
     post26,
     prep7,
     selection,
+    solid,
     solution,
     tables,
 )
 
-FAMILIES = (begin, blocks, generate, loads, post1, post26, prep7, selection, solution, tables)
+FAMILIES = (begin, blocks, generate, loads, post1, post26, prep7, selection, solid,
+            solution, tables)
 
 
 def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:

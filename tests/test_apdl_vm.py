@@ -7,6 +7,7 @@ lie within 2 % of its target.
 
 from __future__ import annotations
 
+import math
 import re
 import subprocess
 import sys
@@ -19,7 +20,7 @@ TOLERANCE = 0.02
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[EeDd][-+]?\d+)?")
 
 # the decks that run as published, and the rows of their results tables
-ROWS = {"vm102": 8, "vm105": 8, "vm28": 4}
+ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4}
 
 
 def results_table(path: Path) -> list[tuple[str, float, float]]:
@@ -43,3 +44,19 @@ def test_verification_deck_runs_as_published(deck, tmp_path):
     assert len(rows) == ROWS[deck], rows
     for label, target, computed in rows:
         assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), (deck, label)
+
+
+def test_vm111_sphere_center_matches_the_exact_series_solution(tmp_path):
+    """VM111's target (28 °F) is read from a Heisler chart; the exact series solution of the
+    sphere (Bi = hR/k = 1, Fo = αt/R² = 1.08: λ1 = π/2, C1 = 4/π) gives 28.55 °F at the
+    centre.  The published deck, run as is, must land within 0.5 % of that."""
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(DECKS / "vm111.dat"),
+                           "--out", str(out)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    (label, target, computed), = results_table(out / "vm111.vrt")
+    lam, c1 = math.pi / 2, 4 / math.pi
+    fourier = (1 / 3) / (62 * 1.0752677) * 6.0 / (1 / 6) ** 2
+    exact = 25.0 + (65.0 - 25.0) * c1 * math.exp(-lam**2 * fourier)
+    assert exact == pytest.approx(28.55, abs=0.01)
+    assert computed == pytest.approx(exact, rel=0.005)

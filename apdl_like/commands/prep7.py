@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec, ignored
+from apdl_like.call import PREP7, Call, CommandSpec
 from apdl_like.commands.generate import to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
@@ -244,70 +244,6 @@ def e(s: SessionState, c: Call) -> None:
     el.add(number, db.active_type, db.active_mat, db.active_real, tuple(nums))
 
 
-def k(s: SessionState, c: Call) -> None:
-    kps = s.db.keypoints
-    num = _entity_number(c, 1, "NPT") if c.given(1) else max(kps, default=0) + 1
-    if c.given(4) and c.num(4) != 0.0:
-        raise ApdlError("field 4 (Z) must be 0 in a 2-D axisymmetric model")
-    kps[num] = (c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
-
-
-def a(s: SessionState, c: Call) -> None:
-    pts = [_entity_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
-    if len(pts) < 3:
-        raise ApdlError("an area needs at least 3 keypoints")
-    for p in pts:
-        if p not in s.db.keypoints:
-            raise ApdlError(f"keypoint {p} does not exist")
-    s.db.areas[max(s.db.areas, default=0) + 1] = pts
-
-
-def rectng(s: SessionState, c: Call) -> None:
-    x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
-    y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
-    if x1 == x2 or y1 == y2:
-        raise ApdlError("the rectangle has zero width or height")
-    kps = s.db.keypoints
-    first = max(kps, default=0) + 1
-    corners = [(x1, y1), (x2, y1), (x2, y2), (x1, y2)]
-    for i, xy in enumerate(corners):
-        kps[first + i] = xy
-    s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
-
-
-def esize(s: SessionState, c: Call) -> None:
-    size = c.num(1, what="SIZE")
-    if not size > 0.0:
-        raise ApdlError(f"field 1 (SIZE) must be positive, got {size!r}")
-    s.db.esize = size
-
-
-# AMESH makes triangles whatever is asked
-
-
-def amesh(s: SessionState, c: Call) -> None:
-    from apdl_like.meshing import mesh_areas
-
-    areas = s.db.areas
-    if c.label(1, "ALL") == "ALL":
-        chosen = sorted(areas)
-    else:
-        first = _entity_number(c, 1, "NA1")
-        last = _entity_number(c, 2, "NA2") if c.given(2) else first
-        step = c.int(3, 1, what="NINC")
-        if step < 1:
-            raise ApdlError("field 3 (NINC) must be ≥ 1")
-        chosen = list(range(first, last + 1, step))
-        for num in chosen:
-            if num not in areas:
-                raise ApdlError(f"area {num} does not exist")
-    chosen = [num for num in chosen if num not in s.db.meshed_areas]
-    if not chosen:
-        raise ApdlError("no unmeshed areas to mesh")
-    mesh_areas(s, chosen)
-    s.db.meshed_areas.update(chosen)
-
-
 def emodif(s: SessionState, c: Call) -> None:
     """EMODIF,IEL|ALL,MAT|TYPE|REAL,value: change an attribute of elements."""
     from apdl_like.commands.loads import element_targets
@@ -335,15 +271,8 @@ COMMANDS = (
     CommandSpec("RMODIF", PREP7, 8, rmodif),
     CommandSpec("N", PREP7, 7, n),
     CommandSpec("E", PREP7, 8, e),
-    CommandSpec("K", PREP7, 4, k),
-    CommandSpec("A", PREP7, 18, a),
-    CommandSpec("RECTNG", PREP7, 4, rectng),
-    CommandSpec("ESIZE", PREP7, 2, esize),
-    CommandSpec("AMESH", PREP7, 3, amesh),
     CommandSpec("EMODIF", PREP7, 3, emodif),
     CommandSpec("TYPE", PREP7, 1, _attribute("type")),
     CommandSpec("MAT", PREP7, 1, _attribute("mat")),
     CommandSpec("REAL", PREP7, 1, _attribute("real")),
-    CommandSpec("MSHAPE", PREP7, 2, ignored),
-    CommandSpec("MSHKEY", PREP7, 1, ignored),
 )

@@ -1,0 +1,225 @@
+"""/PREP7 solid model and meshing: K, KGEN, L, LESIZE, A, AL, RECTNG, ESIZE, MSHAPE, MSHKEY,
+AMESH.
+
+A 4-sided area whose opposite sides have as many divisions (LESIZE, or ESIZE) is meshed
+mapped, with quads (8-node ones for a quadratic element type); any other area, or MSHAPE,1
+(triangles), is meshed free by gmsh.  Keypoint coordinates follow the active CSYS.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from apdl_like.call import PREP7, Call, CommandSpec, ignored
+from apdl_like.commands.generate import from_cartesian, to_cartesian
+from apdl_like.errors import ApdlError
+from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped
+from apdl_like.model import Line
+
+if TYPE_CHECKING:
+    from apdl_like.state import SessionState
+
+MAX_ENTITY_NUMBER = 2**31 - 1
+MAX_DIVISIONS = 10_000
+
+
+def _number(c: Call, i: int, what: str) -> int:
+    n = c.int(i, what=what)
+    if not 1 <= n <= MAX_ENTITY_NUMBER:
+        raise ApdlError(f"field {i} ({what}) must lie in 1..{MAX_ENTITY_NUMBER}, got {n}")
+    return n
+
+
+def k(s: SessionState, c: Call) -> None:
+    """K,NPT,X,Y: a keypoint (number 0 or blank: the next free one)."""
+    kps = s.db.keypoints
+    num = c.int(1, 0, what="NPT")
+    if num == 0:
+        num = max(kps, default=0) + 1
+    if c.given(4) and c.num(4) != 0.0:
+        raise ApdlError("field 4 (Z) must be 0 in a 2-D model")
+    kps[num] = to_cartesian(s.db.csys, c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
+
+
+def kgen(s: SessionState, c: Call) -> None:
+    """KGEN,ITIME,NP1,NP2,NINC,DX,DY,DZ,KINC: copies of keypoints, offset."""
+    itime = c.int(1, what="ITIME")
+    kps = s.db.keypoints
+    if c.label(2) == "ALL":
+        pattern = sorted(kps)
+    else:
+        first = _number(c, 2, "NP1")
+        last = c.int(3, first, what="NP2")
+        pattern = [n for n in range(first, last + 1, max(c.int(4, 1, what="NINC"), 1))
+                   if n in kps]
+    dx, dy = c.num(5, 0.0, what="DX"), c.num(6, 0.0, what="DY")
+    kinc = c.int(8, 0, what="KINC")
+    top = max(kps, default=0)
+    for j in range(1, itime):
+        for idx, n in enumerate(pattern):
+            a, b = from_cartesian(s.db.csys, np.array([kps[n]]))[0]
+            new = n + j * kinc if kinc else top + (j - 1) * len(pattern) + idx + 1
+            kps[new] = to_cartesian(s.db.csys, a + j * dx, b + j * dy)
+
+
+def line(s: SessionState, c: Call) -> None:
+    """L,P1,P2[,NDIV,SPACE]: a straight line between two keypoints."""
+    p1, p2 = _number(c, 1, "P1"), _number(c, 2, "P2")
+    for p in (p1, p2):
+        if p not in s.db.keypoints:
+            raise ApdlError(f"keypoint {p} does not exist")
+    if p1 == p2:
+        raise ApdlError("a line needs two different keypoints")
+    ndiv = c.int(3, 0, what="NDIV") or None
+    s.db.lines[max(s.db.lines, default=0) + 1] = Line(p1, p2, ndiv, c.num(4, 1.0, what="SPACE"))
+
+
+def lesize(s: SessionState, c: Call) -> None:
+    """LESIZE,NL1,SIZE,ANGSIZ,NDIV,SPACE: divisions (or size) and spacing ratio of lines."""
+    lines = s.db.lines
+    chosen = sorted(lines) if c.label(1) == "ALL" else [_number(c, 1, "NL1")]
+    for n in chosen:
+        if n not in lines:
+            raise ApdlError(f"line {n} does not exist")
+    space = c.num(5, 1.0, what="SPACE")
+    if not space > 0.0:
+        raise ApdlError(f"field 5 (SPACE) must be a positive ratio, got {space!r}")
+    for n in chosen:
+        ln = lines[n]
+        if c.given(4):
+            ndiv = c.int(4, what="NDIV")
+        elif c.given(2):
+            size = c.num(2, what="SIZE")
+            if not size > 0.0:
+                raise ApdlError(f"field 2 (SIZE) must be positive, got {size!r}")
+            length = float(np.hypot(*np.subtract(s.db.keypoints[ln.k2], s.db.keypoints[ln.k1])))
+            ndiv = max(1, int(np.ceil(length / size - 1e-9)))
+        else:
+            ndiv = ln.ndiv or 1
+        if not 1 <= ndiv <= MAX_DIVISIONS:
+            raise ApdlError(f"NDIV must lie in 1..{MAX_DIVISIONS}, got {ndiv}")
+        ln.ndiv, ln.space = ndiv, space
+
+
+def area(s: SessionState, c: Call) -> None:
+    """A,P1,P2,...: an area through keypoints (in order around it)."""
+    pts = [_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
+    if len(pts) < 3:
+        raise ApdlError("an area needs at least 3 keypoints")
+    for p in pts:
+        if p not in s.db.keypoints:
+            raise ApdlError(f"keypoint {p} does not exist")
+    s.db.areas[max(s.db.areas, default=0) + 1] = pts
+
+
+def area_lines(s: SessionState, c: Call) -> None:
+    """AL,L1,L2,...: an area bounded by lines (in order around it)."""
+    nums = [_number(c, i, "line") for i in range(1, c.count() + 1) if c.given(i)]
+    if len(nums) < 3:
+        raise ApdlError("an area needs at least 3 lines")
+    lines = s.db.lines
+    for n in nums:
+        if n not in lines:
+            raise ApdlError(f"line {n} does not exist")
+    first, second = lines[nums[0]], lines[nums[1]]
+    start = first.k1 if first.k1 not in (second.k1, second.k2) else first.k2
+    pts, at = [], start
+    for n in nums:
+        ln = lines[n]
+        if at not in (ln.k1, ln.k2):
+            raise ApdlError(f"line {n} does not continue the loop of the lines before it")
+        pts.append(at)
+        at = ln.k2 if at == ln.k1 else ln.k1
+    if at != start:
+        raise ApdlError("the lines do not close a loop")
+    s.db.areas[max(s.db.areas, default=0) + 1] = pts
+
+
+def rectng(s: SessionState, c: Call) -> None:
+    x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
+    y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
+    if x1 == x2 or y1 == y2:
+        raise ApdlError("the rectangle has zero width or height")
+    kps = s.db.keypoints
+    first = max(kps, default=0) + 1
+    corners = [(x1, y1), (x2, y1), (x2, y2), (x1, y2)]
+    for i, xy in enumerate(corners):
+        kps[first + i] = xy
+    s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
+
+
+def esize(s: SessionState, c: Call) -> None:
+    """ESIZE,SIZE,NDIV: element edge length, or divisions per line when SIZE is blank."""
+    if c.given(1):
+        size = c.num(1, what="SIZE")
+        if not size > 0.0:
+            raise ApdlError(f"field 1 (SIZE) must be positive, got {size!r}")
+        s.db.esize, s.db.esize_divisions = size, None
+    elif c.given(2):
+        ndiv = c.int(2, what="NDIV")
+        if not 1 <= ndiv <= MAX_DIVISIONS:
+            raise ApdlError(f"field 2 (NDIV) must lie in 1..{MAX_DIVISIONS}, got {ndiv}")
+        s.db.esize_divisions = ndiv
+    else:
+        raise ApdlError("ESIZE needs SIZE (field 1) or NDIV (field 2)")
+
+
+def mshape(s: SessionState, c: Call) -> None:
+    """MSHAPE,KEY: 0 quads (mapped where the area allows), 1 triangles."""
+    key = c.int(1, 0, what="KEY")
+    if key not in (0, 1):
+        raise ApdlError(f"field 1 must be 0 (quads) or 1 (triangles), got {key}")
+    s.db.mesh_triangles = key == 1
+
+
+def amesh(s: SessionState, c: Call) -> None:
+    areas = s.db.areas
+    if c.label(1, "ALL") == "ALL":
+        chosen = sorted(areas)
+    else:
+        first = _number(c, 1, "NA1")
+        last = _number(c, 2, "NA2") if c.given(2) else first
+        step = c.int(3, 1, what="NINC")
+        if step < 1:
+            raise ApdlError("field 3 (NINC) must be ≥ 1")
+        chosen = list(range(first, last + 1, step))
+        for num in chosen:
+            if num not in areas:
+                raise ApdlError(f"area {num} does not exist")
+    chosen = [num for num in chosen if num not in s.db.meshed_areas]
+    if not chosen:
+        raise ApdlError("no unmeshed areas to mesh")
+    db = s.db
+    et = db.element_types.get(db.active_type)
+    if et is None:
+        raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
+    free = []
+    for num in chosen:
+        pts = np.array([db.keypoints[p] for p in areas[num]], float)
+        extent = float(np.ptp(pts, axis=0).max())
+        size = db.esize if db.esize is not None else extent / 10.0
+        grid = None if db.mesh_triangles or et.triangle6 else mapped_grid(s, num, size)
+        if grid is None:
+            free.append(num)
+        else:
+            s.say(f"AMESH: area {num} mapped, {mesh_mapped(s, num, grid)} elements")
+    if free:
+        mesh_areas(s, free)
+    db.meshed_areas.update(chosen)
+
+
+COMMANDS = (
+    CommandSpec("K", PREP7, 4, k),
+    CommandSpec("KGEN", PREP7, 8, kgen),
+    CommandSpec("L", PREP7, 4, line),
+    CommandSpec("LESIZE", PREP7, 9, lesize),
+    CommandSpec("A", PREP7, 18, area),
+    CommandSpec("AL", PREP7, 10, area_lines),
+    CommandSpec("RECTNG", PREP7, 4, rectng),
+    CommandSpec("ESIZE", PREP7, 2, esize),
+    CommandSpec("MSHAPE", PREP7, 2, mshape),
+    CommandSpec("MSHKEY", PREP7, 1, ignored),  # mapped wherever the area allows
+    CommandSpec("AMESH", PREP7, 3, amesh),
+)
