@@ -267,3 +267,15 @@ def test_replay_cli_writes_the_band_and_the_estimated_factors(tmp_path):
     assert acc["ratio"]["band_coverage_pct"] is None
     assert 0.0 <= acc["estimator"]["band_coverage_pct"] <= 100.0
     assert (run_dir / "decks" / "window_003.inp").is_file()
+
+
+def test_initial_ensemble_has_exactly_the_prior_covariance():
+    prior = np.array([0.3, 0.4, 0.2])
+    ens = Ensemble.initial(np.full(10, 21.0), 0.2, prior, 8, np.random.default_rng(1))
+    cov = ens.log_factor_anomalies @ ens.log_factor_anomalies.T / 7
+    np.testing.assert_allclose(cov, np.diag(prior**2), atol=1e-12)
+    np.testing.assert_allclose(ens.field_anomalies.std(axis=1, ddof=1), 0.2)
+    # field offset and parameters uncorrelated
+    np.testing.assert_allclose(ens.log_factor_anomalies @ ens.field_anomalies[0], 0, atol=1e-12)
+    with pytest.raises(ValueError, match="at least 5 members"):
+        Ensemble.initial(np.zeros(3), 0.2, prior, 4, np.random.default_rng(1))

@@ -35,12 +35,14 @@ class Ensemble:
         rng: np.random.Generator,
     ) -> Ensemble:
         """A spindle at rest: the field known up to a uniform offset of `field_sd_C`, the
-        log-factors at 0 with the prior spreads.  Anomalies are centred and scaled so that
-        their sample spread equals the prior exactly (small ensembles stay calibrated)."""
-        if members < 2:
-            raise ValueError(f"an ensemble needs at least two members, got {members}")
+        log-factors at 0 with the prior spreads.  The anomalies' sample covariance equals the
+        prior exactly — right spreads and no spurious correlations between parameters, which
+        a small random ensemble would feed into every later update."""
         p = len(prior_sd)
-        z = standardized(rng.standard_normal((p + 1, members)))
+        if members < p + 2:
+            raise ValueError(f"an ensemble of {p} parameters needs at least {p + 2} members, "
+                             f"got {members}")
+        z = orthonormal_rows(rng.standard_normal((p + 1, members)))
         offsets = field_sd_C * z[0]
         return cls(
             field_mean=np.asarray(field_C, float).copy(),
@@ -63,6 +65,13 @@ class Ensemble:
 
     def log_factor_sd(self) -> np.ndarray:
         return np.sqrt(np.sum(self.log_factor_anomalies**2, axis=1) / (self.size - 1))
+
+
+def orthonormal_rows(z: np.ndarray) -> np.ndarray:
+    """Rows centred, mutually orthogonal and of unit sample spread: Z Zᵀ/(N − 1) = I."""
+    k, n = z.shape
+    q, _ = np.linalg.qr((z - z.mean(axis=1, keepdims=True)).T)
+    return np.sqrt(n - 1) * q[:, :k].T
 
 
 def standardized(z: np.ndarray) -> np.ndarray:

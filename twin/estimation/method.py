@@ -34,15 +34,19 @@ run with the twin model itself: 30 min from a cold start, T1..T5 and the axial d
     temperature at all (it scales the drift only, which the filter does not assimilate).
 
 The filter (Evensen 2009; REFERENCE.md §7)
-    Ensemble of N members (default 24) as mean + anomalies of [T; φ] (`ensemble`).  Each
+    Ensemble of N members (default 24) as mean + anomalies of [T; φ] (`ensemble`; the
+    initial anomalies have exactly the prior covariance, no spurious correlation).  Each
     window: (1) analysis with the measurements of the window just ended (ETKF, `analysis`;
     T1..T5 averaged over three 20 s bins: 15 observations; invalid samples — dead, stuck,
     dropped out per the data-quality check — are left out), updating field and log-factors
     through their ensemble covariance with the predicted sensor values inside the window;
-    (2) random walk of the log-factors, spread capped at the prior, mean clipped to the
-    bounds; (3) forecast of the next window (`forecast`): the mean by the FEM with the mean
-    factors, members tangent-linear on the mean's factorization.  Multiplicative inflation
-    (default 1.05) guards against collapse; the bounded log-space priors against drift.
+    if the speed changed inside that window (after its loads were fixed), the misfit is
+    the unforeseen input and only the field is updated, the log-factors keep their forecast;
+    (2) random walk of the log-factors (seeded draws: a replay is deterministic), spread
+    capped at the prior, mean clipped to the bounds; (3) forecast of the next window
+    (`forecast`): the mean by the FEM with the mean factors, members tangent-linear on one
+    factorization, stepping 20 s.  Multiplicative inflation (default 1.05) guards against
+    collapse; the bounded log-space priors against drift.
 
 Causality
     Window k's loads and starting field use measurements up to 60k s only: the analysis at
@@ -134,6 +138,7 @@ class EnsembleEstimator:
     _forecast: WindowForecast | None = field(default=None, init=False, repr=False)
     _rng: np.random.Generator | None = field(default=None, init=False, repr=False)
     _drift_start_um: float = field(default=0.0, init=False, repr=False)
+    _forecast_speed_rpm: float = field(default=0.0, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._params = parameters(self.config.parameters)
@@ -179,6 +184,7 @@ class EnsembleEstimator:
         thermal = self.model.thermal
         substeps = cfg.steps_per_window // cfg.bins_per_window
         with threadpool_limits(1):  # tiny dense blocks: BLAS threads only contend
+            self._forecast_speed_rpm = f.speed_rpm
             self._forecast = forecast_window(
                 thermal.transient(loads, cfg.step_s),
                 thermal.transient(loads, cfg.step_s * substeps),
@@ -231,6 +237,11 @@ class EnsembleEstimator:
         )
         n = end.field_mean.size
         mean[:n] = prior_mean[:n] + cfg.field_update * (mean[:n] - prior_mean[:n])
+        if abs(f.speed_rpm - self._forecast_speed_rpm) > 0.5:
+            # the speed changed inside the window just ended, after its loads were fixed:
+            # the misfit is the unforeseen input, not wrong factors.  The field takes the
+            # update; the log-factors keep their forecast (mean and spread).
+            mean[n:], anomalies[n:] = prior_mean[n:], end.log_factor_anomalies
         return Ensemble.from_stacked(mean, anomalies, n)
 
     def _band_sd(self, fc: WindowForecast) -> np.ndarray:
