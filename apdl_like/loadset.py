@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 from apdl_like.errors import ApdlError
 from apdl_like.model import record_groups
+from twin.contract import STEP_S, STEPS_PER_WINDOW
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -46,8 +47,8 @@ class LoadSet:
 
     window: int
     start_s: float
-    dt_s: float = 4.0
-    n_steps: int = 15
+    dt_s: float = STEP_S
+    n_steps: int = STEPS_PER_WINDOW
     heat_generation: Mapping[str, float] = field(default_factory=dict)
     convection: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     contact_resistance: Mapping[str, float] = field(default_factory=dict)

@@ -30,8 +30,9 @@ def run(windows: int = 15) -> dict:
     from apdl_like.parser import parse_deck
     from apdl_like.session import Session
     from apdl_like.writer import window_deck
+    from twin.contract import STEP_S, STEPS_PER_WINDOW
     from twin.fem import ThermalLoads
-    from twin.loop.replay import STEP_S, STEPS_PER_WINDOW, nominal_conditions
+    from twin.loop.replay import nominal_conditions
     from twin.loop.runfiles import default_spindle
 
     model = default_spindle()

@@ -16,8 +16,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-WINDOW_S = 60.0
-"""Correction window (s): the paper corrects every 60 s."""
+from twin.contract import WINDOW_S
 
 BEARINGS: tuple[str, ...] = ("front", "rear")
 RING_SENSOR = {"front": 0, "rear": 2}

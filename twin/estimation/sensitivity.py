@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin.contract import STEP_S
 from twin.estimation.parameters import ALL_PARAMETERS, apply_factors
 
 
@@ -63,7 +64,7 @@ def trajectory_sensitivity(
     minutes: float = 30.0,
     names: Sequence[str] = tuple(ALL_PARAMETERS),
     delta: float = 0.05,
-    dt_s: float = 4.0,
+    dt_s: float = STEP_S,
 ) -> Sensitivity:
     """Forward-difference sensitivities of T1..T5 and the drift every 60 s (module doc)."""
     from twin.spindle import nominal_conditions

@@ -30,7 +30,8 @@ import math
 
 import numpy as np
 
-SENSORS = ("T1", "T2", "T3", "T4", "T5")
+from twin.contract import SENSOR_NAMES
+
 T_FLOOR_C = 20.0
 """Smallest denominator of the temperature accuracy (°C): a workshop temperature."""
 
@@ -68,7 +69,7 @@ def accuracy_metrics(
     rise = np.where(ok, np.abs(tm - np.asarray(T_meas0_C, float)[None, :]), 0.0)
     rise_acc = 100.0 * (1.0 - err.sum() / rise.sum()) if rise.sum() > 0 else math.nan
     rmse = {}
-    for i, name in enumerate(SENSORS):
+    for i, name in enumerate(SENSOR_NAMES):
         col = ok[:, i]
         rmse[name] = _nan_to_none(
             float(np.sqrt(np.mean(err[col, i] ** 2))) if col.any() else math.nan

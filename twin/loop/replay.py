@@ -22,15 +22,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import BoundaryValues, TwinState, WindowFeatures
 from twin.correction.result import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
 
-WINDOW_S = 60.0
-STEP_S = 4.0
-STEPS_PER_WINDOW = 15
 FILM_AMBIENT_STEP_K = 0.5
 """The film coefficients see the ambient on this grid (the sink temperature stays exact).
 

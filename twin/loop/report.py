@@ -17,11 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.contract import STEP_S, WINDOW_S
+from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
-from twin.loop.metrics import SENSORS
 from twin.loop.summary import collect_summary, run_folder
 
 METHOD_COLORS = {
@@ -81,7 +80,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     t_min = _floats(kp["time_s"]) / 60.0
 
     fig, axes = plt.subplots(1, 5, figsize=(17, 3.2), sharex=True)
-    for i, s in enumerate(SENSORS):
+    for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
         first = method_col == methods[0]
         ax.plot(t_min[first], _floats(kp[f"{s}_meas_C"])[first], "k.", ms=2, label="measured")

@@ -25,10 +25,11 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.contract import SENSOR_NAMES
 from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.folders import replaced_folder
-from twin.loop.metrics import SENSORS, accuracy_metrics
+from twin.loop.metrics import accuracy_metrics
 from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
 
 DONE_FILE = ".done.json"
@@ -207,11 +208,11 @@ def _write_keypoints(
     path: Path, results: dict[str, MethodReplay], meas_T: np.ndarray, meas_drift: np.ndarray | None
 ) -> None:
     header = ["time_s", "method"]
-    header += [f"{s}_twin_C" for s in SENSORS] + [f"{s}_meas_C" for s in SENSORS]
+    header += [f"{s}_twin_C" for s in SENSOR_NAMES] + [f"{s}_meas_C" for s in SENSOR_NAMES]
     header += ["disp_z_twin_um", "disp_z_meas_um", "disp_r_twin_um", "disp_r_meas_um"]
     with_band = any(r.band_sd is not None for r in results.values())
     if with_band:
-        for s in SENSORS:
+        for s in SENSOR_NAMES:
             header += [f"{s}_twin_lo_C", f"{s}_twin_hi_C"]
         header += ["disp_z_twin_lo_um", "disp_z_twin_hi_um"]
     rows = []

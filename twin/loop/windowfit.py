@@ -36,9 +36,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.contract import STEP_S, STEPS_PER_WINDOW
 from twin.correction.features import WindowFeatures
 from twin.correction.result import Correction
-from twin.loop.replay import STEP_S, STEPS_PER_WINDOW, direct_window_solver
+from twin.loop.replay import direct_window_solver
 from twin.runs import RecordedRun
 from twin.spindle.model import SpindleModel
 

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.contract import SENSOR_NAMES
 from twin.errors import InputError
 from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
@@ -191,7 +192,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         "time_s": t_out,
         "speed_rpm": speed(t_out).astype(float),
         "ambient_C": add_noise(rng, tables.ambient_C(t_out), sensors.noise_C),
-        **{f"T{j + 1}_C": add_noise(rng, T_meas[:, j], sensors.noise_C) for j in range(5)},
+        **{f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
+           for j, s in enumerate(SENSOR_NAMES)},
         "coolant_C": add_noise(rng, tables.coolant_C(t_out), sensors.noise_C),
         "disp_x_um": add_noise(rng, x_true, sensors.noise_um),
         "disp_y_um": add_noise(rng, y_true, sensors.noise_um),
@@ -207,8 +209,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     for side in ("front", "rear"):
         truth_cols[f"factor_H_{side}"] = truth_cols[f"H_{side}"] / truth_cols[f"H_{side}_nominal"]
         truth_cols[f"factor_R_{side}"] = truth_cols[f"R_{side}"] / truth_cols[f"R_{side}_nominal"]
-    for j in range(5):
-        truth_cols[f"T{j + 1}_true_C"] = np.interp(t_out, truth.time_s, truth.sensors_C[:, j])
+    for j, s in enumerate(SENSOR_NAMES):
+        truth_cols[f"{s}_true_C"] = np.interp(t_out, truth.time_s, truth.sensors_C[:, j])
     truth_cols.update(disp_z_true_um=disp_z, disp_x_true_um=x_true, disp_y_true_um=y_true)
 
     if speed_rpm is not None:

@@ -27,12 +27,13 @@ from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from twin.contract import SENSOR_NAMES
 from twin.errors import InputError
 from twin.paths import parse_toml, read_input_text
 from twin.plant.timetable import TimeTable
 
 SENSOR_COLUMNS = {
-    "T1": "T1_C", "T2": "T2_C", "T3": "T3_C", "T4": "T4_C", "T5": "T5_C",
+    **{s: f"{s}_C" for s in SENSOR_NAMES},
     "ambient": "ambient_C", "coolant": "coolant_C",
     "disp_x": "disp_x_um", "disp_y": "disp_y_um", "disp_z": "disp_z_um",
 }

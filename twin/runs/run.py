@@ -19,7 +19,9 @@ from twin.runs.schema import AMBIENT, COOLANT, DISPLACEMENTS, SPEED, TEMPERATURE
 from twin.runs.table import RawTable
 from twin.runs.validate import check_operating_range, check_structure, check_values
 
+# one reader and one writer per format, chosen by file suffix (meshio's registry)
 _READERS = {".csv": read_csv_table, ".parquet": read_parquet_table, ".pq": read_parquet_table}
+_WRITERS = {".csv": write_csv_table, ".parquet": write_parquet_table, ".pq": write_parquet_table}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -216,12 +218,10 @@ def write_run(path: str | os.PathLike[str], columns: Mapping[str, np.ndarray],
     if missing:
         raise ValueError(f"missing required columns: {', '.join(missing)}")
     suffix = Path(path).suffix.lower()
-    if suffix == ".csv":
-        write_csv_table(path, columns, metadata)
-    elif suffix in (".parquet", ".pq"):
-        write_parquet_table(path, columns, metadata)
-    else:
+    writer = _WRITERS.get(suffix)
+    if writer is None:
         raise ValueError(f"unknown run format {suffix!r}; expected .csv or .parquet")
+    writer(path, columns, metadata)
 
 
 def write_quality(run: RecordedRun, path: str | os.PathLike[str]) -> None:

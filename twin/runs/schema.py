@@ -6,13 +6,12 @@ time in s, displacements in µm.  Column names carry their unit as a suffix.
 
 from __future__ import annotations
 
+from twin.contract import SENSOR_NAMES
+
 TIME = "time_s"
 SPEED = "speed_rpm"
 AMBIENT = "ambient_C"
 COOLANT = "coolant_C"
-SENSOR_NAMES: tuple[str, ...] = ("T1", "T2", "T3", "T4", "T5")
-"""T1 front-bearing outer ring, T2 front-bearing sleeve, T3 rear-bearing outer ring,
-T4 rear-bearing sleeve, T5 housing surface (REFERENCE.md §1)."""
 TEMPERATURES: tuple[str, ...] = tuple(f"{s}_C" for s in SENSOR_NAMES)
 DISPLACEMENTS: tuple[str, ...] = ("disp_x_um", "disp_y_um", "disp_z_um")
 
@@ -23,8 +22,6 @@ ALL_COLUMNS: tuple[str, ...] = REQUIRED + OPTIONAL
 CELSIUS_COLUMNS: tuple[str, ...] = (AMBIENT, COOLANT, *TEMPERATURES)
 """Columns holding temperatures in °C (checked for Kelvin/Fahrenheit mix-ups)."""
 
-WINDOW_S = 60.0
-"""Correction window length of the twin (s); a run must hold at least two windows."""
 
 MAX_SAMPLE_INTERVAL_S = 10.0
 """The contract accepts any sample rate of at least one sample per 10 s (median interval)."""

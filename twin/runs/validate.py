@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from twin.contract import WINDOW_S
 from twin.errors import InputError
 from twin.runs.schema import (
     AMBIENT,
@@ -21,7 +22,6 @@ from twin.runs.schema import (
     SPEED,
     TEMPERATURES,
     TIME,
-    WINDOW_S,
 )
 from twin.runs.table import RawTable
 

@@ -23,8 +23,9 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
+from twin.contract import SENSOR_NAMES
 from twin.fem import AxiMesh, ElasticProblem, Material, ThermalProblem
-from twin.spindle.spec import DEFAULT_SPEC_PATH, PROBE_NAMES, SENSOR_NAMES, SpindleSpec, load_spec
+from twin.spindle.spec import DEFAULT_SPEC_PATH, PROBE_NAMES, SpindleSpec, load_spec
 
 DEFAULT_MESH_PATH = DEFAULT_SPEC_PATH.with_suffix(".msh")
 #: bump when twin/spindle/mesher.py changes what it produces, to invalidate cached meshes

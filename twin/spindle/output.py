@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.contract import SENSOR_NAMES
 from twin.io.atomic import write_json, write_text
 from twin.io.vtk import write_field_series
 from twin.spindle.fields import field_mesh
@@ -51,7 +52,8 @@ def summary(model: SpindleModel, result: SimulationResult) -> dict:
                                "region": result.max_temperature_region},
         "region_max_C": result.region_max_C,
         "region_mean_C": result.region_mean_C,
-        "final_keypoints_C": {f"T{i + 1}": float(v) for i, v in enumerate(result.sensors_C[-1])},
+        "final_keypoints_C": {s: float(v) for s, v in zip(SENSOR_NAMES, result.sensors_C[-1],
+                                                          strict=True)},
         "nose_drift_um": {"axial": float(result.disp_z_um[-1]),
                           "radial": float(result.disp_r_um[-1]),
                           "axial_max_abs": float(np.abs(result.disp_z_um).max())},

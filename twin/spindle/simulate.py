@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.errors import InputError
 from twin.spindle.conditions import BoundaryConditions, check_operating_point, nominal_conditions
 from twin.spindle.model import SpindleModel
@@ -61,16 +62,16 @@ class SimulationResult:
 
     def keypoints(self) -> dict[str, np.ndarray]:
         out = {"time_s": self.time_s}
-        for i in range(self.sensors_C.shape[1]):
-            out[f"T{i + 1}_C"] = self.sensors_C[:, i]
+        for i, name in enumerate(SENSOR_NAMES):
+            out[f"{name}_C"] = self.sensors_C[:, i]
         out["disp_z_um"] = self.disp_z_um
         out["disp_r_um"] = self.disp_r_um
         return out
 
 
 def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: float,
-             coolant_C: float | None = None, dt: float = 4.0, *,
-             update_every_s: float | None = 60.0,
+             coolant_C: float | None = None, dt: float = STEP_S, *,
+             update_every_s: float | None = WINDOW_S,
              field_every_s: float | None = None) -> SimulationResult:
     """Open-loop transient at a constant speed (see the module doc).
 

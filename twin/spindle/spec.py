@@ -24,6 +24,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from twin.contract import SENSOR_NAMES
 from twin.data import bundled_path
 from twin.errors import InputError
 from twin.paths import read_toml
@@ -47,7 +48,6 @@ BOUNDARY_NAMES = (
     "internal_air",
     "mount",
 )
-SENSOR_NAMES = ("T1", "T2", "T3", "T4", "T5")
 PROBE_NAMES = ("nose_axial", "nose_radial")
 
 _TOL_MM = 1e-9
