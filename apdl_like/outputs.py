@@ -48,18 +48,17 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
     import meshio
 
     res = session.solution.results[result_index]
-    fem = session.fem.model
     points = np.column_stack([session.db.nodes.xy, np.zeros(len(session.db.nodes.ids))])
     data = {"TEMP": res.nodal_temperature}
-    if res.displacement is not None and fem is not None:
+    nodal = res.nodal_structural
+    if nodal:
         n = points.shape[0]
         u = np.zeros((n, 3))
-        u[:, 0] = fem.glued_nodal(res.displacement[0])
-        u[:, 1] = fem.glued_nodal(res.displacement[1])
+        u[:, 0], u[:, 1] = nodal["UX"], nodal["UY"]
         s = np.zeros((n, 6))
-        for j, key in enumerate(("rr", "zz", "tt", "rz")):
-            s[:, j] = fem.glued_nodal(res.stress[key])
-        data.update(U=u, S=s, SEQV=fem.glued_nodal(res.stress["von_mises"]))
+        for j, item in enumerate(("SX", "SY", "SZ", "SXY")):
+            s[:, j] = nodal[item]
+        data.update(U=u, S=s, SEQV=nodal["SEQV"])
     mesh = meshio.Mesh(points, _cells(session), point_data=data)
     write_vtu(path, mesh)
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.model import Database, record_groups
+from apdl_like.plane_elastic import solve_elastic
 from apdl_like.plane_thermal import (
     PlaneMesh,
     PlaneThermal,
@@ -106,11 +107,11 @@ def plane_mesh(s: SessionState) -> PlaneMesh:
     db = s.db
     db.nodes.flush()
     db.elements.flush()
-    key = (db.nodes.version, db.elements.version, _axisymmetric(db))
+    key = (db.nodes.version, db.elements.version, analysis_mode(db))
     cache = s.fem
     if cache.plane is None or cache.plane_key != key:
         corners, mid = corners_and_midside(db)
-        mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2])
+        mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2] == "axisymmetric")
         cache.plane, cache.plane_key = mesh, key
         cache.plane_solver = None
     return cache.plane  # type: ignore[return-value]
@@ -129,7 +130,8 @@ def deck_faces(s: SessionState) -> FaceTable:
     return cache.faces
 
 
-def _axisymmetric(db: Database) -> bool:
+def analysis_mode(db: Database) -> str:
+    """axisymmetric, plane_stress (planar, the default) or plane_strain, from KEYOPT(3)."""
     used = {int(t) for t in np.unique(db.elements.type)}
     kinds = set()
     for t in used:
@@ -140,13 +142,15 @@ def _axisymmetric(db: Database) -> bool:
             raise ApdlError(f"element type {t} ({et.name}) is not supported: use PLANE35, "
                             "PLANE55, PLANE77, PLANE182 or PLANE183")
         k3 = et.keyopt.get(3, 0)
-        if k3 not in (0, 1):
+        allowed = (0, 1, 2) if et.physics == "structural" else (0, 1)
+        if k3 not in allowed:
             raise ApdlError(f"element type {t} ({et.name}): KEYOPT(3) = {k3} is not supported "
-                            "(0 planar, 1 axisymmetric)")
-        kinds.add(k3 == 1)
+                            "(0 planar, 1 axisymmetric" +
+                            (", 2 plane strain)" if et.physics == "structural" else ")"))
+        kinds.add({0: "plane_stress", 1: "axisymmetric", 2: "plane_strain"}[k3])
     if len(kinds) > 1:
         raise ApdlError("the model mixes planar and axisymmetric element types")
-    return kinds.pop() if kinds else False
+    return kinds.pop() if kinds else "plane_stress"
 
 
 # ---------------------------------------------------------------- materials
@@ -373,3 +377,72 @@ def _temperature_scale(T0: np.ndarray, inputs: ThermalInputs) -> float:
     values += [np.array([tb]) for _, _, tb in inputs.films]
     allv = np.concatenate(values)
     return float(np.ptp(allv)) if allv.size else 1.0
+
+
+# --------------------------------------------------------------- structural
+def _element_values(db: Database, label: str, why: str, default: float | None) -> np.ndarray:
+    mats = db.elements.mat
+    out = np.empty(mats.size)
+    for m in np.unique(mats):
+        material = db.materials.get(int(m))
+        props = material.props if material is not None else {}
+        if label in ("PRXY",) and label not in props and "NUXY" in props:
+            value = props["NUXY"]
+        elif label in props:
+            value = props[label]
+        elif default is not None:
+            value = default
+        else:
+            raise ApdlError(f"material {int(m)} has no {label} (MP,{label},{int(m)},...), "
+                            f"needed {why}")
+        if material is not None and material.temperature_dependent(label):
+            raise ApdlError(f"material {int(m)}: temperature-dependent {label} is not supported "
+                            "in a structural analysis")
+        out[mats == m] = value
+    return out
+
+
+def solve_plane_structural(s: SessionState) -> StepResult:
+    """A static thermo-elastic load step on the deck's mesh (LDREAD/BF temperatures)."""
+    db = s.db
+    settings = db.settings
+    if settings.antype != "STATIC":
+        raise ApdlError("structural analyses are static only (ANTYPE,STATIC)")
+    mode = analysis_mode(db)
+    mesh = plane_mesh(s)
+    n = mesh.n_dofs
+    E = _element_values(db, "EX", "for a structural analysis", None)
+    nu = _element_values(db, "PRXY", "", 0.3)
+    alpha = _element_values(db, "ALPX", "", 0.0)
+    T = np.full(n, settings.tunif)
+    body = s.solution.body_temperature
+    if body is not None and body.nodal_temperature is not None:
+        given = ~np.isnan(body.nodal_temperature) & (mesh.node_dof >= 0)
+        T[mesh.node_dof[given]] = body.nodal_temperature[given]
+    bf = db.nodes.arrays["bf_temp"]
+    given = ~np.isnan(bf) & (mesh.node_dof >= 0)
+    T[mesh.node_dof[given]] = bf[given]
+    dofs, values = [], []
+    for c, label in enumerate(("d_ux", "d_uy")):
+        d = db.nodes.arrays[label]
+        held = np.nonzero(~np.isnan(d) & (mesh.node_dof >= 0))[0]
+        dofs.append(c * n + mesh.node_dof[held])
+        values.append(d[held])
+    couplings = []
+    for label, numbers in db.couplings.values():
+        idx = db.nodes.index(numbers)
+        scalar = mesh.node_dof[idx[idx >= 0]]
+        scalar = scalar[scalar >= 0]
+        for c, name in enumerate(("UX", "UY")):
+            if label in (name, "ALL"):
+                couplings.append(c * n + scalar)
+    disp, stress = solve_elastic(mesh, mode, E, nu, alpha, T - settings.tref,
+                                 (np.concatenate(dofs), np.concatenate(values)), couplings)
+    sol = s.solution
+    sol.time = settings.time if settings.time is not None else sol.time + 1.0
+    nodal = {"UX": mesh.nodal(disp[0]), "UY": mesh.nodal(disp[1])}
+    for item, key in (("SX", "rr"), ("SY", "zz"), ("SZ", "tt"), ("SXY", "rz"),
+                      ("SEQV", "von_mises")):
+        nodal[item] = mesh.nodal(stress[key])
+    return StepResult(len(sol.results) + 1, sol.time, "structural", T, disp, stress,
+                      nodal_temperature=mesh.nodal(T), nodal_structural=nodal)

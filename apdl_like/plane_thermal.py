@@ -246,7 +246,7 @@ class PlaneThermal:
             mats = element_material[part.elements]
             self.groups.append({int(m): np.nonzero(mats == m)[0] for m in np.unique(mats)})
         self._facet_bases: dict[tuple[int, bytes], FacetBasis] = {}
-        self._reduce = _coupling_map(mesh.n_dofs, couplings)
+        self._reduce = coupling_map(mesh.n_dofs, couplings)
         self._linear_cache: tuple[ThermalInputs, tuple] | None = None
 
     # ---------------------------------------------------------------- pieces
@@ -316,31 +316,11 @@ class PlaneThermal:
 
     def _solve(self, A: sp.csr_matrix, rhs: np.ndarray,
                fixed: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-        """A x = rhs with fixed dofs and coupled sets (each set shares one unknown)."""
-        P = self._reduce
-        Ar = (P.T @ A @ P).tocsr()
-        br = P.T @ rhs
-        n = Ar.shape[0]
-        x = np.zeros(n)
-        dofs, values = fixed
-        rdofs = P[dofs].indices if dofs.size else np.zeros(0, np.int64)
-        if rdofs.size:
-            x[rdofs] = values
-        free = np.ones(n, bool)
-        free[rdofs] = False
-        if not free.any():
-            return P @ x
-        rhs_free = br[free] - Ar[free][:, ~free] @ x[~free]
-        A_free = Ar[free][:, free].tocsc()
-        try:
-            x[free] = spla.spsolve(A_free, rhs_free)
-        except RuntimeError as exc:
-            raise ApdlError(f"the thermal system is singular ({exc}): fix a temperature or "
-                            "add convection") from None
+        x = solve_constrained(A, rhs, fixed, self._reduce)
         if not np.all(np.isfinite(x)):
             raise ApdlError("the thermal system is singular: fix a temperature (D,,TEMP) "
                             "or add convection (SF,,CONV)")
-        return P @ x
+        return x
 
     # ---------------------------------------------------------------- solves
     def steady(self, inputs: ThermalInputs, T0: np.ndarray, nonlinear: bool) -> np.ndarray:
@@ -423,7 +403,29 @@ class PlaneThermal:
         return K @ T - f
 
 
-def _coupling_map(n: int, couplings: list[np.ndarray]) -> sp.csr_matrix:
+def solve_constrained(A: sp.csr_matrix, rhs: np.ndarray, fixed: tuple[np.ndarray, np.ndarray],
+                      P: sp.csr_matrix) -> np.ndarray:
+    """A x = rhs with fixed dofs and coupled sets (P: each set shares one unknown)."""
+    Ar = (P.T @ A @ P).tocsr()
+    br = P.T @ rhs
+    n = Ar.shape[0]
+    x = np.zeros(n)
+    dofs, values = fixed
+    rdofs = P[dofs].indices if len(dofs) else np.zeros(0, np.int64)
+    if rdofs.size:
+        x[rdofs] = values
+    free = np.ones(n, bool)
+    free[rdofs] = False
+    if free.any():
+        rhs_free = br[free] - Ar[free][:, ~free] @ x[~free]
+        try:
+            x[free] = spla.spsolve(Ar[free][:, free].tocsc(), rhs_free)
+        except RuntimeError:
+            x[free] = np.nan  # singular: the caller names what is missing
+    return P @ x
+
+
+def coupling_map(n: int, couplings: list[np.ndarray]) -> sp.csr_matrix:
     """P (n × n_reduced): the dofs of a coupled set share one column."""
     rep = np.arange(n)
     for dofs in couplings:

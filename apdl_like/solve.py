@@ -21,7 +21,7 @@ import numpy as np
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
 from apdl_like.model import record_groups
-from apdl_like.plane_solve import deck_faces, solve_plane_thermal
+from apdl_like.plane_solve import deck_faces, solve_plane_structural, solve_plane_thermal
 from apdl_like.state import TCC_LOCATION, StepResult
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
@@ -320,6 +320,9 @@ def _constraints(session: SessionState, fem: FemModel) -> dict[str, str]:
 
 
 def solve_structural(session: SessionState) -> StepResult:
+    """A static thermo-elastic load step: twin.fem for a twin session, else the deck mesh."""
+    if not session.fem.external_mesh:
+        return solve_plane_structural(session)
     fem = fem_model(session)
     _check_axisymmetric(session, "structural")
     s = session.db.settings
@@ -350,5 +353,9 @@ def solve_structural(session: SessionState) -> StepResult:
     u = elastic.solve(T)
     stress = elastic.stresses(u, T)
     sol.time = s.time if s.time is not None else sol.time + 1.0
+    nodal = {"UX": fem.glued_nodal(u[0]), "UY": fem.glued_nodal(u[1])}
+    for item, key in (("SX", "rr"), ("SY", "zz"), ("SZ", "tt"), ("SXY", "rz"),
+                      ("SEQV", "von_mises")):
+        nodal[item] = fem.glued_nodal(stress[key])
     return StepResult(len(sol.results) + 1, sol.time, "structural", T, u, stress,
-                      nodal_temperature=fem.thermal_nodal(T))
+                      nodal_temperature=fem.thermal_nodal(T), nodal_structural=nodal)

@@ -49,6 +49,8 @@ class StepResult:
     displacement: np.ndarray | None = None  # (2, n glued scalar dofs), m
     stress: dict[str, np.ndarray] = field(default_factory=dict)  # glued scalar dofs, Pa
     nodal_temperature: np.ndarray | None = None  # per APDL node, °C (NaN: no element)
+    # per APDL node: UX, UY (m), SX, SY, SZ, SXY, SEQV (Pa; averaged nodal stresses)
+    nodal_structural: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 @dataclass
@@ -209,18 +211,12 @@ class SessionState:
         """TEMP, UX, UY, SX, SY, SZ, SXY, SEQV at node n from the current result set."""
         i = self.node_index(n)
         res = self.result()
-        fem = self.fem.model
         if item == "TEMP":
             value = res.nodal_temperature[i]
-        elif res.displacement is None:
+        elif not res.nodal_structural:
             raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
         else:
-            d = fem.glued_dof[i]
-            if item in ("UX", "UY"):
-                value = res.displacement[0 if item == "UX" else 1, d] if d >= 0 else np.nan
-            else:
-                key = {"SX": "rr", "SY": "zz", "SZ": "tt", "SXY": "rz", "SEQV": "von_mises"}[item]
-                value = res.stress[key][d] if d >= 0 else np.nan
+            value = res.nodal_structural[item][i]
         if np.isnan(value):
             raise ApdlError(f"node {n:g} is not attached to an element (no {item})")
         return float(value)

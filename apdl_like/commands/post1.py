@@ -48,20 +48,16 @@ def prnsol(s: SessionState, c: Call) -> None:
         raise ApdlError(f"PRNSOL supports TEMP, U,X|Y|COMP and S,X|Y|Z|XY|COMP|EQV, got "
                         f"{','.join(k for k in key if k)!r}")
     res = s.result()
-    fem = s.fem.model
     nodes = s.db.nodes
     sel = np.nonzero(nodes.selected)[0]
     columns = []
     for item in items:
         if item == "TEMP":
             columns.append(res.nodal_temperature[sel])
-        elif res.displacement is None or fem is None:
+        elif not res.nodal_structural:
             raise ApdlError(f"{item} needs a structural result (the current one is thermal)")
-        elif item in ("UX", "UY"):
-            columns.append(fem.glued_nodal(res.displacement[0 if item == "UX" else 1])[sel])
         else:
-            k = {"SX": "rr", "SY": "zz", "SZ": "tt", "SXY": "rz", "SEQV": "von_mises"}[item]
-            columns.append(fem.glued_nodal(res.stress[k])[sel])
+            columns.append(res.nodal_structural[item][sel])
     s.say(f"PRNSOL load step {res.load_step}, time {res.time:g}")
     s.say("    NODE " + "".join(f"{item:>16}" for item in items))
     for j, i in enumerate(sel):
