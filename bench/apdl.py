@@ -33,9 +33,9 @@ def run(windows: int = 15) -> dict:
     from twin.contract import STEP_S, STEPS_PER_WINDOW
     from twin.fem import ThermalLoads
     from twin.loop.replay import nominal_conditions
-    from twin.loop.runfiles import default_spindle
+    from twin.spindle.model import SpindleModel
 
-    model = default_spindle()
+    model = SpindleModel.load()
     session = Session.from_mesh(model.mesh, model.materials, order=model.order,
                                 T_ref_C=model.elastic.T_ref, thermal=model.thermal)
 

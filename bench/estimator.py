@@ -30,10 +30,11 @@ def bundled_runs() -> list[Path]:
 def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
     from twin.estimation.method import EnsembleEstimator, EstimatorConfig
     from twin.loop.replay import deck_window_solver, replay_method
-    from twin.loop.runfiles import default_spindle, measured_reference, method_accuracy
+    from twin.loop.runfiles import measured_reference, method_accuracy
     from twin.runs import read_run
+    from twin.spindle.model import SpindleModel
 
-    model = default_spindle()
+    model = SpindleModel.load()
     runs = [read_run(p) for p in bundled_runs()]
     rows = []
     for n in members:

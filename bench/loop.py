@@ -62,15 +62,16 @@ def _replay(runs: list[str], out: Path, *extra: str) -> tuple[float, float]:
 
 def warm_replay_s() -> float:
     """The replay itself (3 methods, writes included) with the model already loaded."""
-    from twin.loop.runfiles import default_spindle, replay_run_to_dir
+    from twin.loop.runfiles import replay_run_to_dir
+    from twin.spindle.model import SpindleModel
 
-    default_spindle()
+    spindle = SpindleModel.load()
     with tempfile.TemporaryDirectory() as tmp:
-        replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL))  # warm-up
+        replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL), spindle=spindle)  # warm-up
         best = float("inf")
         for _ in range(3):
             t = time.perf_counter()
-            replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL))
+            replay_run_to_dir(RUN, tmp, METHODS.split(","), str(MODEL), spindle=spindle)
             best = min(best, time.perf_counter() - t)
     return best
 

@@ -14,17 +14,18 @@ from pathlib import Path
 
 
 def run() -> dict:
-    from twin.plant.emulator import synthesize, truth_model, write_synth
+    from twin.plant.emulator import synthesize, write_synth
     from twin.plant.scenario import Scenario
     from twin.runs import read_run
+    from twin.spindle import SpindleModel
 
     t0 = time.perf_counter()
-    model = truth_model(Scenario().model.size_factor)
+    model = SpindleModel.load(size_factor=Scenario().model.size_factor)
     load = time.perf_counter() - t0
     times = []
     for seed in (1, 2, 3):
         t0 = time.perf_counter()
-        result = synthesize(speed_rpm=9000, minutes=30, ambient_C=25.3, seed=seed)
+        result = synthesize(speed_rpm=9000, minutes=30, ambient_C=25.3, seed=seed, model=model)
         times.append(time.perf_counter() - t0)
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()

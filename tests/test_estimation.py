@@ -25,7 +25,7 @@ from twin.estimation.parameters import (
 )
 from twin.loop.metrics import accuracy_metrics, band_coverage
 from twin.loop.replay import deck_window_solver, direct_window_solver, replay_method
-from twin.loop.runfiles import band_of, default_spindle
+from twin.loop.runfiles import band_of
 from twin.runs import read_run
 from twin.spindle.conditions import nominal_conditions
 
@@ -34,14 +34,13 @@ from .test_replay import make_recorded_run
 TRUE_FACTORS = {"H_front": 1.25, "H_rear": 0.85, "R_front": 1.5, "motor": 1.2, "film_rotor": 0.8}
 
 
-def make_run(path, minutes=12, factors=TRUE_FACTORS, edit=None):
+def make_run(path, model, minutes=12, factors=TRUE_FACTORS, edit=None):
     """A recorded run of the twin model with `factors` applied, 1 sample per 4 s."""
-    make_recorded_run(path, minutes=minutes, ambient_C=24.0, factors=factors, edit=edit)
+    make_recorded_run(path, model, minutes=minutes, ambient_C=24.0, factors=factors, edit=edit)
     return read_run(path)
 
 
-def estimate(run, **config):
-    model = default_spindle()
+def estimate(run, model, **config):
     est = EnsembleEstimator(model, EstimatorConfig(**config))
     windows = []
     original = est.correct
@@ -106,8 +105,8 @@ def test_inflation_widens_and_cap_limits_the_spread():
 
 
 # ------------------------------------------------------------------ forecast
-def test_tangent_linear_members_match_finite_differences_of_the_fem():
-    model = default_spindle()
+def test_tangent_linear_members_match_finite_differences_of_the_fem(spindle_model):
+    model = spindle_model
     bc0 = nominal_conditions(model, 9000, 25.0)
     T = np.full(model.n_dofs, 25.0)
     warm = model.thermal.transient(bc0.to_thermal_loads(), 4.0)
@@ -142,10 +141,10 @@ def test_thermocouple_reading_is_the_exact_ramp_response():
 
 # ------------------------------------------------------------------ the method
 @pytest.fixture(scope="module")
-def synthetic(tmp_path_factory):
+def synthetic(tmp_path_factory, spindle_model):
     path = tmp_path_factory.mktemp("est") / "known.csv"
-    run = make_run(path)
-    return run, estimate(run, sensor_lag_s=0.0)
+    run = make_run(path, spindle_model)
+    return run, estimate(run, spindle_model, sensor_lag_s=0.0)
 
 
 def test_parameters_are_recovered_on_a_case_the_model_can_represent(synthetic):
@@ -181,14 +180,14 @@ def test_band_coverage_counts_finite_samples_inside():
     assert band_coverage(measured[:, 1:] * np.nan, lo[:, 1:], hi[:, 1:]) is None
 
 
-def test_window_loads_use_only_earlier_measurements(tmp_path):
+def test_window_loads_use_only_earlier_measurements(tmp_path, spindle_model):
     def late_change(t, temps):
         temps[t > 400.0] += 3.0  # a different future
 
-    a = make_run(tmp_path / "a.csv", minutes=10)
-    b = make_run(tmp_path / "b.csv", minutes=10, edit=late_change)
-    _, _, wa = estimate(a)
-    _, _, wb = estimate(b)
+    a = make_run(tmp_path / "a.csv", spindle_model, minutes=10)
+    b = make_run(tmp_path / "b.csv", spindle_model, minutes=10, edit=late_change)
+    _, _, wa = estimate(a, spindle_model)
+    _, _, wb = estimate(b, spindle_model)
     # window k starts at 60k s and may use samples up to 60k s: windows 0..6 are the same
     for k in range(7):
         assert tuple(wa[k][0]) == tuple(wb[k][0]), k
@@ -197,25 +196,27 @@ def test_window_loads_use_only_earlier_measurements(tmp_path):
     assert tuple(wa[7][0]) != tuple(wb[7][0])
 
 
-def test_a_stuck_sensor_is_left_out_of_the_update(tmp_path):
+def test_a_stuck_sensor_is_left_out_of_the_update(tmp_path, spindle_model):
     def stuck_at(value):
         def edit(t, temps):
             temps[:, 1] = value
         return edit
 
-    a = read_run(make_run(tmp_path / "a.csv", minutes=8, edit=stuck_at(24.0)).path)
-    b = read_run(make_run(tmp_path / "b.csv", minutes=8, edit=stuck_at(31.0)).path)
+    a = read_run(make_run(tmp_path / "a.csv", spindle_model, minutes=8,
+                          edit=stuck_at(24.0)).path)
+    b = read_run(make_run(tmp_path / "b.csv", spindle_model, minutes=8,
+                          edit=stuck_at(31.0)).path)
     assert not a.valid_T[:, 1].any() and not b.valid_T[:, 1].any()  # the quality check
-    _, ra, wa = estimate(a)
-    _, rb, wb = estimate(b)
+    _, ra, wa = estimate(a, spindle_model)
+    _, rb, wb = estimate(b, spindle_model)
     for (ca, _), (cb, _) in zip(wa, wb, strict=True):
         assert tuple(ca) == tuple(cb)
     np.testing.assert_array_equal(ra.T_twin_C, rb.T_twin_C)
 
 
-def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path):
-    model = default_spindle()
-    run = make_run(tmp_path / "deck.csv", minutes=4)
+def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, spindle_model):
+    model = spindle_model
+    run = make_run(tmp_path / "deck.csv", model, minutes=4)
     est = EnsembleEstimator(model)
     forecasts = []
     original = est.correct
@@ -237,7 +238,7 @@ def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path):
         np.testing.assert_allclose(replay.T_twin_C[15 * k: 15 * (k + 1)], fc, atol=1e-4)
 
 
-def test_replay_cli_writes_the_band_and_the_estimated_factors(tmp_path):
+def test_replay_cli_writes_the_band_and_the_estimated_factors(tmp_path, spindle_model):
     import csv
     import json
 
@@ -245,7 +246,7 @@ def test_replay_cli_writes_the_band_and_the_estimated_factors(tmp_path):
 
     from twin.cli import app
 
-    make_run(tmp_path / "known.csv", minutes=4)
+    make_run(tmp_path / "known.csv", spindle_model, minutes=4)
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["replay", str(tmp_path / "known.csv"), "--out", str(out),
                                       "--methods", "ratio,estimator", "--snapshots", "none",

@@ -17,7 +17,6 @@ from typer.testing import CliRunner
 
 from twin.cli import app
 from twin.estimation.parameters import apply_factors
-from twin.loop.runfiles import default_spindle
 from twin.runs import write_run
 from twin.spindle.conditions import nominal_conditions
 
@@ -26,14 +25,14 @@ MINUTES = 5
 
 
 def make_recorded_run(
-    path, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7, seed=0,
-    factors=None, noise_C=0.02, edit=None,
+    path, model, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7,
+    seed=0, factors=None, noise_C=0.02, edit=None,
 ):
     """`factors` (twin.estimation.parameters names → multiplier) replaces heat/resistance;
-    `edit(time_s, temps)` may change the measured temperatures in place before writing."""
+    `edit(time_s, temps)` may change the measured temperatures in place before writing;
+    `model` is the SpindleModel that plays the spindle."""
     if factors is None:
         factors = {"H_front": heat, "H_rear": heat, "R_front": resistance}
-    model = default_spindle()
     T = np.full(model.n_dofs, ambient_C)
     T0 = T.copy()
     times, temps, drift = [0.0], [model.sensor_matrix @ T], [0.0]
@@ -65,10 +64,10 @@ def make_recorded_run(
 
 
 @pytest.fixture(scope="module")
-def runs_dir(tmp_path_factory):
+def runs_dir(tmp_path_factory, spindle_model):
     d = tmp_path_factory.mktemp("runs")
-    make_recorded_run(d / "hot_9000.csv")
-    make_recorded_run(d / "hot_12000.csv", speed_rpm=12000.0, seed=1)
+    make_recorded_run(d / "hot_9000.csv", spindle_model)
+    make_recorded_run(d / "hot_12000.csv", spindle_model, speed_rpm=12000.0, seed=1)
     return d
 
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from twin.plant.emulator import DT_S, synthesize, truth_model, write_synth
+from twin.plant.emulator import DT_S, synthesize, write_synth
 from twin.plant.profile import SpeedProfile
-from twin.plant.scenario import parse_scenario
+from twin.plant.scenario import Scenario, parse_scenario
 from twin.plant.timetable import StepTable
 from twin.runs import read_run
 
@@ -24,21 +24,29 @@ ambient_C = [{AMBIENT}]
 
 
 @pytest.fixture(scope="module")
-def default_run():
-    return synthesize(speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=1)
+def truth_spindle():
+    """The truth's spindle model (the default scenario's mesh), built once for the module."""
+    from twin.spindle import SpindleModel
+
+    return SpindleModel.load(size_factor=Scenario().model.size_factor)
 
 
 @pytest.fixture(scope="module")
-def nominal():
+def default_run(truth_spindle):
+    return synthesize(model=truth_spindle, speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=1)
+
+
+@pytest.fixture(scope="module")
+def nominal(spindle_model):
     """The twin's open loop: nominal loads on the default mesh (issue 3's simulate)."""
     from twin.spindle import simulate
 
-    return simulate(truth_model(1.0), 9000, 30, AMBIENT)
+    return simulate(spindle_model, 9000, 30, AMBIENT)
 
 
-def test_deterministic_by_seed(default_run):
-    again = synthesize(speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=1)
-    other = synthesize(speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=2)
+def test_deterministic_by_seed(default_run, truth_spindle):
+    again = synthesize(model=truth_spindle, speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=1)
+    other = synthesize(model=truth_spindle, speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=2)
     for name, values in default_run.columns.items():
         np.testing.assert_array_equal(values, again.columns[name])
     assert not np.array_equal(default_run.columns["T1_C"], other.columns["T1_C"])
@@ -65,8 +73,8 @@ def test_energy_balance_every_step(default_run):
     assert np.all(loads["H_front"] > 0) and np.all(loads["R_front"] > 0)
 
 
-def test_monotone_warm_up_at_constant_speed():
-    run = synthesize(speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=4,
+def test_monotone_warm_up_at_constant_speed(truth_spindle):
+    run = synthesize(model=truth_spindle, speed_rpm=9000, minutes=30, ambient_C=AMBIENT, seed=4,
                      scenario=parse_scenario(STEADY_EXTERNALS))
     truth = run.extra["truth_run"]
     T = truth.sensors_C
@@ -79,7 +87,7 @@ def test_monotone_warm_up_at_constant_speed():
     assert 4.0 < truth.disp_z_um[-1] < 15.0  # the reference system: 8.47 µm
 
 
-def test_truth_factors_follow_the_scenario():
+def test_truth_factors_follow_the_scenario(truth_spindle):
     scenario = parse_scenario(STEADY_EXTERNALS + """
 [bearing_heat.front]
 time_s = [0, 300, 1800]
@@ -88,7 +96,8 @@ factor = [1.00, 1.12, 1.04]
 time_s = [0, 600]
 factor = [1.0, 0.7]
 """)
-    run = synthesize(speed_rpm=9000, minutes=12, ambient_C=AMBIENT, seed=3, scenario=scenario)
+    run = synthesize(model=truth_spindle, speed_rpm=9000, minutes=12, ambient_C=AMBIENT, seed=3,
+                     scenario=scenario)
     t, truth = run.columns["time_s"], run.truth
     # loads are held over 20 s update intervals: compare at the interval starts
     starts = np.isin(t, np.arange(0.0, 720.0, 20.0))
@@ -99,16 +108,17 @@ factor = [1.0, 0.7]
     np.testing.assert_allclose(truth["coolant_C"], AMBIENT)
 
 
-def test_sensor_lag_and_noise():
+def test_sensor_lag_and_noise(truth_spindle):
     quiet = "[sensors]\nnoise_C = 0.0\nnoise_um = 0.0\nlag_s = 8.0\n"
     scenario = parse_scenario(STEADY_EXTERNALS + quiet)
-    run = synthesize(speed_rpm=9000, minutes=10, ambient_C=AMBIENT, seed=5, scenario=scenario)
+    run = synthesize(model=truth_spindle, speed_rpm=9000, minutes=10, ambient_C=AMBIENT, seed=5,
+                     scenario=scenario)
     t, truth = run.columns["time_s"], run.truth["T1_true_C"]
     slope = np.gradient(truth, t)
     i = np.searchsorted(t, 400.0)
     # a first-order sensor on a slowly bending ramp trails by τ·dT/dt
     assert run.columns["T1_C"][i] == pytest.approx(truth[i] - 8.0 * slope[i], abs=0.01)
-    noisy = synthesize(speed_rpm=9000, minutes=10, ambient_C=AMBIENT, seed=5,
+    noisy = synthesize(model=truth_spindle, speed_rpm=9000, minutes=10, ambient_C=AMBIENT, seed=5,
                        scenario=parse_scenario(STEADY_EXTERNALS))
     residual = noisy.columns["T3_C"] - run.columns["T3_C"]
     assert np.std(residual) == pytest.approx(0.05, rel=0.1)
@@ -122,12 +132,12 @@ def test_xy_drift_is_a_few_microns(default_run):
         assert 0.5 < final < 6.0
 
 
-def test_written_run_reads_clean_and_faults_are_found(tmp_path, default_run):
+def test_written_run_reads_clean_and_faults_are_found(tmp_path, default_run, truth_spindle):
     path, truth_path = write_synth(default_run, tmp_path / "run.csv")
     run = read_run(path)
     assert run.quality == [] and run.coolant_C is not None and run.disp_um.shape == (1801, 3)
     assert truth_path.name == "run.truth.csv" and truth_path.exists()
-    faulty = synthesize(speed_rpm=9000, minutes=20, ambient_C=AMBIENT, seed=1,
+    faulty = synthesize(model=truth_spindle, speed_rpm=9000, minutes=20, ambient_C=AMBIENT, seed=1,
                         scenario=parse_scenario("""
 [faults]
 stuck = ["T2"]
@@ -139,9 +149,9 @@ spikes = [{sensor = "T1", time_s = 300, size = 6.0}]
     assert found == {("T2_C", "stuck"), ("T4_C", "long_dropout"), ("T1_C", "spike")}
 
 
-def test_speed_profile_steps_the_loads():
+def test_speed_profile_steps_the_loads(truth_spindle):
     profile = SpeedProfile(StepTable([0.0, 301.0], [6000.0, 12000.0]))
-    run = synthesize(profile=profile, minutes=10, ambient_C=AMBIENT, seed=2,
+    run = synthesize(model=truth_spindle, profile=profile, minutes=10, ambient_C=AMBIENT, seed=2,
                      scenario=parse_scenario(STEADY_EXTERNALS))
     t, speed = run.columns["time_s"], run.columns["speed_rpm"]
     assert speed[t < 301].max() == 6000.0 and speed[t >= 301].min() == 12000.0

@@ -14,8 +14,7 @@ from tests.test_replay import make_recorded_run
 from twin.correction.samples import fit_samples
 from twin.correction.training_data import run_curves
 from twin.loop.replay import replay_method
-from twin.loop.runfiles import default_spindle
-from twin.loop.training import DRIVEN_PASSES, simulate_for_training
+from twin.loop.training import DRIVEN_PASSES, simulate_for_training, training_simulator
 from twin.loop.windowfit import WindowFit
 from twin.runs import read_run
 
@@ -23,13 +22,14 @@ TRUE_FACTORS = np.array([1.15, 1.15, 0.7, 1.0])
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, spindle_model):
     path = tmp_path_factory.mktemp("fit") / "run.csv"
-    return read_run(make_recorded_run(path, minutes=6, heat=1.15, resistance=0.7))
+    return read_run(make_recorded_run(path, spindle_model, minutes=6, heat=1.15,
+                                      resistance=0.7))
 
 
-def test_fit_recovers_the_true_factors(run):
-    model = default_spindle()
+def test_fit_recovers_the_true_factors(run, spindle_model):
+    model = spindle_model
     fit = WindowFit(run, model)
     result = replay_method(run, model, fit, keep_fields=False)
     factors = np.array(fit.fitted) / np.array([list(w.nominal) for w in result.windows])
@@ -43,27 +43,27 @@ def test_fit_recovers_the_true_factors(run):
     assert np.sqrt(np.mean((result.T_twin_C[15:] - measured[15:]) ** 2)) < 0.03
 
 
-def test_training_passes_are_seeded_and_targets_are_the_fit(run):
-    passes = simulate_for_training(run)
+def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
+    passes = simulate_for_training(run, spindle_model)
     assert len(passes) == 1 + len(DRIVEN_PASSES)
     exact, driven = passes[0], passes[1]
     # the exact pass runs on its fit; a driven pass runs off it but still targets the fit
     assert np.array_equal(exact.used, exact.fitted)
     assert not np.allclose(driven.used, driven.fitted)
-    again = simulate_for_training(run)
+    again = simulate_for_training(run, spindle_model)
     assert all(np.array_equal(a.fitted, b.fitted) for a, b in zip(passes, again, strict=True))
-    samples = [fit_samples(c) for c in run_curves(run, simulate_for_training)]
+    samples = [fit_samples(c) for c in run_curves(run, training_simulator("fit", spindle_model))]
     assert len(samples[0]) == 6
     np.testing.assert_array_equal(samples[1].targets["heat_front"], driven.fitted[:, 0])
     # the inputs are what the loop shows the network at each window start
     np.testing.assert_array_equal(samples[0].inputs["heat_front"][:, 4], 60.0 * np.arange(6))
 
 
-def test_fit_needs_the_twin_state(run):
+def test_fit_needs_the_twin_state(run, spindle_model):
     from twin.correction.features import BoundaryValues, WindowFeatures
 
     nominal = BoundaryValues(1.0, 1.0, 1.0, 1.0)
     f = WindowFeatures(0, 0.0, 9000.0, 25.0, np.zeros(1), np.zeros((1, 5)), np.zeros(1),
                        np.zeros((1, 5)), nominal, nominal)
     with pytest.raises(ValueError, match="twin's state"):
-        WindowFit(run, default_spindle()).correct(f)
+        WindowFit(run, spindle_model).correct(f)

@@ -23,16 +23,16 @@ def snapshot(
     """Headless picture of the twin's field at a time of a recorded run."""
     from twin.correction.methods import make_corrector
     from twin.loop.replay import replay_method
-    from twin.loop.runfiles import default_spindle
     from twin.loop.snapshot import render_snapshot
     from twin.runs import read_run
+    from twin.spindle.model import SpindleModel
 
     method_name = method.value
     model_path = checked_model([method_name], model)
     if out.suffix.lower() != ".png":
         raise InputError("the picture must be a .png file", file=str(out), column="--out")
     check_out_file(out, inputs=[run, model])
-    spindle = default_spindle()
+    spindle = SpindleModel.load()
     recorded = read_run(run, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
     try:
         r = replay_method(

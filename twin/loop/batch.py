@@ -42,11 +42,13 @@ class BatchResult:
         return 2 if self.failed else 0
 
 
-def run_job(job: ReplayJob) -> dict:
-    """Replay one run; never raises: returns {"ok": accuracy} or {"error": ...}."""
+def run_job(job: ReplayJob, spindle=None) -> dict:  # noqa: ANN001
+    """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
+    spindle for this run); never raises: returns {"ok": accuracy} or {"error": ...}."""
     try:
         acc = replay_run_to_dir(
-            job.run_path, job.out_root, job.methods, job.model_path, job.snapshots
+            job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
+            spindle=spindle,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -144,9 +146,14 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
                 _tell(progress, outcome)
                 yield outcome
         return
+    # a worker process or a dask task builds its own spindle per run (about 0.5 s of a
+    # run's replay); in this process one model serves every run
     if jobs <= 1 or len(todo) <= 1:
+        from twin.spindle.model import SpindleModel
+
+        spindle = SpindleModel.load() if todo else None
         for job in todo:
-            outcome = run_job(job)
+            outcome = run_job(job, spindle)
             _tell(progress, outcome)
             yield outcome
         return

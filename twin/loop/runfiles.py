@@ -17,7 +17,6 @@ The primary method is bpnn when it runs, else the last method listed.
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 from collections.abc import Callable, Sequence
@@ -100,8 +99,9 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
     from twin.correction.methods import make_corrector
     from twin.loop.report import render_run_plots
     from twin.runs import read_run, write_quality
+    from twin.spindle.model import SpindleModel
 
-    model = spindle if spindle is not None else default_spindle()
+    model = spindle if spindle is not None else SpindleModel.load()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
     token = resume_token(run_path, methods, model_path)
 
@@ -287,11 +287,3 @@ def _write_fields(out_dir: Path, model, r: MethodReplay) -> None:  # noqa: ANN00
     write_field_series(out_dir, ((t, f"fields/{r.method}_t{t:05.0f}s.vtu",
                                   field_mesh(model, r.fields[t], r.T_initial_C))
                                  for t in sorted(r.fields)))
-
-
-@functools.cache
-def default_spindle():  # noqa: ANN201
-    """The bundled reference spindle, loaded once per process (a batch worker reuses it)."""
-    from twin.spindle.model import SpindleModel
-
-    return SpindleModel.load()

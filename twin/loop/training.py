@@ -7,18 +7,20 @@ scattered around it; each pass carries the fitted values per window (the targets
 `simulate_with_ratio` (the paper's way, `twin train --targets ratio`): the run replayed
 with the online ratio correction; the targets then come from Eq. 2/5/6 on fitted curves.
 
-`training_simulator(rule)` picks one of them for a `TargetRule`; `twin.correction` takes
-the simulator as an argument (`run_curves(run, simulator)`) and never imports the loop.
+`training_simulator(rule, spindle)` picks one of them for a `TargetRule`, bound to one
+spindle model for every run; `twin.correction` takes the simulator as an argument
+(`run_curves(run, simulator)`) and never imports the loop.
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 
 from twin.correction.methods import make_corrector
 from twin.correction.training_data import SimulatedRun, Simulator
 from twin.loop.replay import MethodReplay, replay_method
-from twin.loop.runfiles import default_spindle
 from twin.loop.target_rules import TargetRule
 from twin.loop.windowfit import WindowFit
 
@@ -26,9 +28,9 @@ DRIVEN_PASSES = (0.05, 0.05)
 """drive_spread of the extra passes per run (seeds 1, 2, …): see `WindowFit`."""
 
 
-def simulate_for_training(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.runs.RecordedRun
-    """The run replayed with the window fit: one exact pass, then the driven passes."""
-    model = default_spindle()
+def simulate_for_training(run, model) -> list[SimulatedRun]:  # noqa: ANN001
+    """The run (a `twin.runs.RecordedRun`) replayed on `model` (a `SpindleModel`) with the
+    window fit: one exact pass, then the driven passes."""
     out = []
     for seed, spread in enumerate((0.0, *DRIVEN_PASSES)):
         fit = WindowFit(run, model, drive_spread=spread, seed=seed)
@@ -37,20 +39,28 @@ def simulate_for_training(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.r
     return out
 
 
-def simulate_with_ratio(run) -> list[SimulatedRun]:  # noqa: ANN001 - a twin.runs.RecordedRun
-    """The run replayed with the online ratio correction (the paper's training simulation)."""
-    result = replay_method(run, default_spindle(), make_corrector("ratio"), keep_fields=False)
+def simulate_with_ratio(run, model) -> list[SimulatedRun]:  # noqa: ANN001
+    """The run replayed on `model` with the online ratio correction (the paper's training
+    simulation)."""
+    result = replay_method(run, model, make_corrector("ratio"), keep_fields=False)
     return [_simulated(run, result, None)]
 
 
-def training_simulator(rule: TargetRule | str = TargetRule.FIT) -> Simulator:
-    """The twin's simulation of a training run for a target rule."""
+def training_simulator(rule: TargetRule | str = TargetRule.FIT, spindle=None) -> Simulator:  # noqa: ANN001
+    """The twin's simulation of a training run for a target rule, on `spindle` (a loaded
+    `SpindleModel`; None: the bundled reference spindle, loaded here once for every run).
+    The simulator keeps the name of the simulation it runs (the model file records it)."""
     simulators = {TargetRule.FIT: simulate_for_training, TargetRule.RATIO: simulate_with_ratio}
     try:
-        return simulators[TargetRule(rule)]
+        simulate = simulators[TargetRule(rule)]
     except ValueError:
         rules = ", ".join(r.value for r in TargetRule)
         raise ValueError(f"unknown target rule {rule!r}; expected one of {rules}") from None
+    if spindle is None:
+        from twin.spindle.model import SpindleModel
+
+        spindle = SpindleModel.load()
+    return functools.update_wrapper(functools.partial(simulate, model=spindle), simulate)
 
 
 def _simulated(run, result: MethodReplay, fitted: np.ndarray | None) -> SimulatedRun:  # noqa: ANN001

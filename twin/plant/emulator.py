@@ -37,18 +37,6 @@ DT_S = 2.0
 UPDATE_S = 20.0
 """The truth's loads are re-evaluated this often, s (the twin corrects every 60 s)."""
 
-_MODELS: dict[float, object] = {}
-
-
-def truth_model(size_factor: float):  # noqa: ANN201 - SpindleModel, imported lazily
-    """The spindle model at a mesh size factor, built once per process."""
-    if size_factor not in _MODELS:
-        from twin.spindle import SpindleModel
-
-        _MODELS[size_factor] = SpindleModel.load(size_factor=size_factor)
-    return _MODELS[size_factor]
-
-
 @dataclass
 class TruthRun:
     """The truth at the solver steps: metal temperatures, nose drift, applied loads."""
@@ -167,7 +155,10 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         ambient_base = None
     if ambient_base is None:
         ambient_base = StepTable.constant(float(ambient_C))
-    model = model or truth_model(scenario.model.size_factor)
+    if model is None:
+        from twin.spindle import SpindleModel
+
+        model = SpindleModel.load(size_factor=scenario.model.size_factor)
     limit = model.spec.spindle.max_speed_rpm
     if np.max(speed.values) > limit:
         raise InputError(f"speed {np.max(speed.values):g} rpm exceeds the spindle's limit "
