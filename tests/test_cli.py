@@ -30,12 +30,27 @@ def test_top_level_help_lists_every_command():
         assert name in result.output
 
 
-@pytest.mark.parametrize("name", COMMAND_NAMES)
-def test_every_command_has_help(name):
-    result = CliRunner().invoke(app, [name, "--help"])
+def _command_paths(group, prefix=()):  # noqa: ANN001, ANN202 - a click group of typer's
+    """Every command path of the app, sub-commands of groups (`drift fit`, …) included."""
+    for name, command in group.commands.items():
+        yield (*prefix, name)
+        if hasattr(command, "commands"):
+            yield from _command_paths(command, (*prefix, name))
+
+
+COMMAND_PATHS = list(_command_paths(typer.main.get_command(app)))
+
+
+def test_command_paths_cover_groups():
+    assert {("replay",), ("drift",), ("drift", "fit")} <= set(COMMAND_PATHS)
+
+
+@pytest.mark.parametrize("path", COMMAND_PATHS, ids=" ".join)
+def test_every_command_has_help(path):
+    result = CliRunner().invoke(app, [*path, "--help"])
     assert result.exit_code == 0, result.output
     assert "--help" in result.output
-    assert "Usage: " in result.output and name in result.output
+    assert "Usage: twin " + " ".join(path) in " ".join(result.output.split())
 
 
 def _loaded_modules(code: str) -> set[str]:
@@ -176,3 +191,12 @@ def test_methods_are_normalised_before_the_command_runs():
     from twin.cli.inputs import method_list
 
     assert method_list(" ratio,open_loop ,ratio") == "ratio,open_loop"
+
+
+@pytest.mark.parametrize("args", [[], ["run"], ["export-cdb"]], ids=lambda a: " ".join(a) or "-")
+def test_apdl_like_help(args):
+    from apdl_like.cli import app as apdl_app
+
+    result = CliRunner().invoke(apdl_app, [*args, "--help"])
+    assert result.exit_code == 0, result.output
+    assert "Usage: " in result.output
