@@ -122,3 +122,19 @@ def test_defect15_warnings_go_to_the_log_not_the_terminal(tmp_path):
     assert done.stderr == ""
     log = (tmp_path / "twin.log").read_text()
     assert "Mean of empty slice" in log and "bad X server connection" in log
+
+
+@pytest.mark.parametrize("args", [
+    ["simulate", "--speed", 9000, "--minutes", "1e9", "--ambient", 25, "--out", "OUT"],
+    ["simulate", "--speed", 9000, "--minutes", "nan", "--ambient", 25, "--out", "OUT"],
+    ["simulate", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--size-factor", "1e-6",
+     "--out", "OUT"],
+    ["mesh", "--size-factor", "1e-6", "--out", "OUT.msh"],
+    ["mesh", "--size-factor", "nan", "--out", "OUT.msh"],
+    ["replay", "--jobs", 100000, "--methods", "open_loop", "--out", "OUT"],
+])
+def test_defect5_unbounded_work_from_arguments_refused(tmp_path, args):
+    result = cli(*[str(tmp_path / "OUT") + a[3:] if isinstance(a, str) and a.startswith("OUT")
+                   else a for a in args])
+    assert result.exit_code == 2, result.output
+    assert list(tmp_path.iterdir()) == []

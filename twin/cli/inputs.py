@@ -41,6 +41,9 @@ class Field(StrEnum):
     DISPLACEMENT = "displacement"
 
 
+MIN_SIZE_FACTOR = 0.2
+"""Finest mesh element size multiplier: 25 times the default elements (minutes to mesh);
+finer, the work grows without a useful bound."""
 MAX_SIZE_FACTOR = 100.0
 """Mesh element size multiplier: above this the spindle is no longer resolved at all."""
 

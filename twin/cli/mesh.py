@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SIZE_FACTOR, between
+from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between
 
 
 def mesh(
@@ -15,7 +15,7 @@ def mesh(
         None, "--spec", help="Spindle spec TOML (default: the bundled reference spindle)."
     ),
     size_factor: float = typer.Option(
-        1.0, "--size-factor", callback=between(0.0, MAX_SIZE_FACTOR),
+        1.0, "--size-factor", callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
         help="Element size multiplier (< 1 refines).",
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),

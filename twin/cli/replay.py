@@ -27,7 +27,7 @@ def replay(
         "open_loop,ratio,bpnn,estimator", "--methods", callback=method_list,
         help="comma-separated: open_loop, ratio, bpnn, estimator",
     ),
-    jobs: int = typer.Option(1, "--jobs", min=1, help="local worker processes"),
+    jobs: int = typer.Option(1, "--jobs", min=1, max=256, help="local worker processes"),
     dask: str | None = typer.Option(
         None, "--dask", help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     ),

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SIZE_FACTOR, between
+from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between
 
 
 def simulate_command(
@@ -20,7 +20,7 @@ def simulate_command(
     ),
     spec: Path | None = typer.Option(None, "--spec", help="Spindle spec TOML."),
     size_factor: float = typer.Option(1.0, "--size-factor",
-                                      callback=between(0.0, MAX_SIZE_FACTOR),
+                                      callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
                                       help="Mesh size multiplier."),
     field_every: float = typer.Option(
         60.0, "--field-every", min=0.0, help="Seconds between field snapshots (0: only the end)."
@@ -31,11 +31,16 @@ def simulate_command(
 
     Writes keypoints.csv, fields.pvd + fields/*.vtu and summary.json to OUT.
     """
+    from twin.errors import InputError
     from twin.io.destinations import check_out_dir
+    from twin.runs.schema import MAX_DURATION_S
     from twin.spindle import SpindleModel, simulate, write_simulation
     from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
 
+    if minutes > MAX_DURATION_S / 60.0:
+        raise InputError(f"must be at most {MAX_DURATION_S / 60.0:g} minutes (one day), got "
+                         f"{minutes:g}", column="--minutes")
     check_out_dir(out, inputs=[spec],
                   owned=["keypoints.csv", "fields.pvd", "fields", "summary.json"])
     # validate the operating point before the (slower) model build

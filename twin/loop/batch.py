@@ -157,7 +157,7 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
             _tell(progress, outcome)
             yield outcome
         return
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with ProcessPoolExecutor(max_workers=min(jobs, len(todo))) as pool:
         futures = [pool.submit(run_job, job) for job in todo]
         for fut in as_completed(futures):
             outcome = fut.result()
