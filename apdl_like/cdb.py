@@ -29,6 +29,16 @@ _NFORMAT = re.compile(
 _IFORMAT = re.compile(r"\(\s*(\d+)\s*i\s*(\d+)\s*\)", re.I)
 
 
+MAX_FORMAT_FIELDS = 64
+"""Most fields and characters per field a block's format line may declare (MAPDL writes
+19i9, 8i10, 3i9 and 6e21.13e3): `(999999999i9)` would make a reader loop for ever."""
+def _checked_format(block: str, *pairs: tuple[int, int]) -> None:
+    for count, width in pairs:
+        if not (1 <= count <= MAX_FORMAT_FIELDS and 1 <= width <= MAX_FORMAT_FIELDS):
+            raise ApdlError(f"{block} format declares {count} fields of {width} characters; "
+                            f"each must lie in 1..{MAX_FORMAT_FIELDS}")
+
+
 def _fixed(line: str, width: int, count: int, start: int = 0) -> list[str]:
     return [line[start + k * width : start + (k + 1) * width] for k in range(count)]
 
@@ -39,6 +49,7 @@ def parse_nblock(lines: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
     if m is None:
         raise ApdlError(f"NBLOCK format {lines[0].strip()!r} is not of the form (3i9,6e21.13e3)")
     ni, iw, nf, fw = (int(g) for g in m.groups())
+    _checked_format("NBLOCK", (ni, iw), (nf, fw))
     ids, xyz = [], []
     for k, line in enumerate(lines[1:], start=1):
         if not line.strip():
@@ -50,6 +61,8 @@ def parse_nblock(lines: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
             coords = [float(f.replace("D", "E").replace("d", "e")) for f in floats[:3]]
         except ValueError:
             raise ApdlError(f"NBLOCK data line {k} is not in the declared format") from None
+        if not np.all(np.isfinite(coords)):
+            raise ApdlError(f"NBLOCK data line {k}: node {ids[-1]} has a non-finite coordinate")
         xyz.append(coords + [0.0] * (3 - len(coords)))
     return np.asarray(ids, np.int64), np.asarray(xyz, float).reshape(-1, 3)
 
@@ -59,6 +72,7 @@ def parse_eblock(lines: tuple[str, ...]) -> list[tuple[int, int, int, int, list[
     m = _IFORMAT.fullmatch(lines[0].strip())
     if m is None:
         raise ApdlError(f"EBLOCK format {lines[0].strip()!r} is not of the form (19i9)")
+    _checked_format("EBLOCK", (int(m.group(1)), int(m.group(2))))
     width = int(m.group(2))
     out = []
     rows = iter(enumerate(lines[1:], start=1))
@@ -85,6 +99,7 @@ def parse_cmblock(lines: tuple[str, ...]) -> np.ndarray:
     m = _IFORMAT.fullmatch(lines[0].strip())
     if m is None:
         raise ApdlError(f"CMBLOCK format {lines[0].strip()!r} is not of the form (8i10)")
+    _checked_format("CMBLOCK", (int(m.group(1)), int(m.group(2))))
     width = int(m.group(2))
     values: list[int] = []
     for line in lines[1:]:

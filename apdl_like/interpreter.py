@@ -297,3 +297,5 @@ def _dispatch(session: SessionState, st: Statement) -> None:
         raise exc.located(st.file, st.line, st.shown) from None
     except ValueError as exc:  # validation inside twin.fem (names the item)
         raise st.error(str(exc)) from None
+    except ArithmeticError as exc:  # the deck's numbers overflow (RECTNG at 1e300, ...)
+        raise st.error(f"numbers out of range ({exc})") from None

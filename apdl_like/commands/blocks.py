@@ -54,7 +54,12 @@ def cmblock(s: SessionState, c: Call) -> None:
     entity = c.label(2)
     if entity not in ("NODE", "ELEM"):
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity!r}")
-    s.db.components[name] = Component(entity, parse_cmblock(c.statement.block))
+    numbers = parse_cmblock(c.statement.block)
+    table = s.db.nodes if entity == "NODE" else s.db.elements
+    missing = numbers[table.index(numbers) < 0] if numbers.size else numbers
+    if missing.size:  # an id beyond the model would select nothing, or the wrong entity later
+        raise ApdlError(f"CMBLOCK {name}: {entity.lower()} {int(missing[0])} does not exist")
+    s.db.components[name] = Component(entity, numbers)
 
 
 COMMANDS = (

@@ -1,0 +1,63 @@
+"""Issue 14 regressions on decks (defects 5 and 6): caps hold on every path, bad numbers
+are refused naming file, line and command."""
+
+from __future__ import annotations
+
+import pytest
+
+from apdl_like.errors import ApdlError
+from apdl_like.session import Session
+
+GOOD = """/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,50
+*DO,I,0,4
+N,I+1,0.01+0.01*I,0
+N,I+11,0.01+0.01*I,0.01
+*ENDDO
+*DO,I,1,4
+E,I,I+1,I+11,I+10
+*ENDDO
+/SOLU
+NSEL,S,LOC,X,0.01
+SF,ALL,HFLUX,1E4
+NSEL,S,LOC,X,0.05
+D,ALL,TEMP,20
+ALLSEL
+"""
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(("deck", "line", "message"), [
+    ("/PREP7\nNBLOCK,6,SOLID\n(999999999i9,6e21.13)\n1 0 0 0\n-1\n", 2, "1..64"),
+    ("/PREP7\nEBLOCK,19,SOLID\n(19i0)\n1 1 1 1 0 0 0 0 4 0 1 1 2 3 4\n-1\n", 2, "1..64"),
+    ("/PREP7\nNBLOCK,6,SOLID\n(3i9,6e21.13e3)\n"
+     f"{1:9d}{0:9d}{0:9d}{'nan':>21}{0.0:21.13E}{0.0:21.13E}\nN,R5.3,LOC,       -1,\n", 2,
+     "non-finite coordinate"),
+    ("/PREP7\nN,1,0.01,NAN\n", 2, "NAN"),
+    ("/PREP7\nET,1,PLANE55,,,1\nRECTNG,0,1e300,0,1e300\nAMESH,ALL\n", 4, "out of range"),
+    ("/PREP7\nN,1,0.01,0\nN,2,0.02,0\nCMBLOCK,C,NODE,2\n(8i10)\n         1       500\n", 4,
+     "node 500 does not exist"),
+    ("/PREP7\nN,1,0.01,0\nCMBLOCK,C,NODE,1\n(8i30)\n" + "9" * 30 + "\n", 3, "out of range"),
+])
+def test_bad_block_and_number_refused(tmp_path, deck, line, message):
+    with pytest.raises(ApdlError, match=message) as info:
+        Session(base_dir=tmp_path).run_text(deck, "deck.inp")
+    assert info.value.file == "deck.inp" and info.value.line == line
+
+
+@pytest.mark.timeout(60)
+def test_deltim_cannot_bypass_the_substep_cap(tmp_path):
+    deck = GOOD + "ANTYPE,TRANS\nTIME,100\nDELTIM,1e-9\nSOLVE\n"
+    with pytest.raises(ApdlError) as info:
+        Session(base_dir=tmp_path).run_text(deck, "deck.inp")
+    assert info.value.line is not None and info.value.line > GOOD.count("\n")
+
+
+@pytest.mark.timeout(60)
+def test_amesh_inside_do_cannot_bypass_the_element_cap(tmp_path):
+    deck = ("/PREP7\nET,1,PLANE55,,,1\nESIZE,0.0001\n*DO,I,1,1000\n"
+            "RECTNG,0,0.1,0,0.1\nAMESH,ALL\n*ENDDO\n")
+    with pytest.raises(ApdlError) as info:
+        Session(base_dir=tmp_path).run_text(deck, "deck.inp")
+    assert info.value.file == "deck.inp"
