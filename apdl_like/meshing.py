@@ -20,6 +20,18 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 MAX_NEW_ELEMENTS = 200_000
+MAX_MODEL_ELEMENTS = 500_000
+"""Elements a model may hold in all: AMESH in a *DO loop adds up, each call under the
+per-call cap `MAX_NEW_ELEMENTS`."""
+
+
+def check_new_elements(s: SessionState, count: float, size: float) -> None:
+    """ApdlError before meshing if `count` new elements break either cap."""
+    if count > MAX_NEW_ELEMENTS:
+        raise ApdlError(f"ESIZE {size:g} would make more than {MAX_NEW_ELEMENTS} elements")
+    s.db.elements.flush()
+    if len(s.db.elements.ids) + count > MAX_MODEL_ELEMENTS:
+        raise ApdlError(f"the model would hold more than {MAX_MODEL_ELEMENTS} elements")
 
 
 def _triangulate(polygons: list[np.ndarray], size: float) -> tuple[np.ndarray, np.ndarray]:
@@ -80,8 +92,7 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
         total += 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
     if total <= 0.0:
         raise ApdlError("an area has zero size (check the keypoint order)")
-    if 2.5 * total / size**2 > MAX_NEW_ELEMENTS:
-        raise ApdlError(f"ESIZE {size:g} would make more than {MAX_NEW_ELEMENTS} elements")
+    check_new_elements(s, 2.5 * total / size**2, size)
     xy, tri = _triangulate(polygons, size)
     if tri.size == 0:
         raise ApdlError("gmsh produced no triangles")
@@ -143,12 +154,19 @@ def _side(s: SessionState, a: int, b: int, size: float) -> np.ndarray:
     for line in db.lines.values():
         if {line.k1, line.k2} == {a, b}:
             length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
-            n = line.ndiv or (db.esize_divisions or max(1, int(np.ceil(length / size - 1e-9))))
+            n = line.ndiv or (db.esize_divisions or _divisions(length, size))
             f = side_fractions(n, line.space)
             return f if line.k1 == a else 1.0 - f[::-1]
     length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
-    n = db.esize_divisions or max(1, int(np.ceil(length / size - 1e-9)))
+    n = db.esize_divisions or _divisions(length, size)
     return side_fractions(n, 1.0)
+
+
+def _divisions(length: float, size: float) -> int:
+    n = length / size
+    if not n <= MAX_NEW_ELEMENTS:  # before allocating a side of n divisions
+        raise ApdlError(f"ESIZE {size:g} would make more than {MAX_NEW_ELEMENTS} elements")
+    return max(1, int(np.ceil(n - 1e-9)))
 
 
 def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
@@ -163,6 +181,7 @@ def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
     left, right = _side(s, k0, k3, size), _side(s, k1, k2, size)
     if bottom.size != top.size or left.size != right.size:
         return None
+    check_new_elements(s, (bottom.size - 1) * (left.size - 1), size)
     p0, p1, p2, p3 = (np.array(db.keypoints[k], float) for k in kps)
     u = 0.5 * (bottom + top)[None, :, None]
     v = 0.5 * (left + right)[:, None, None]

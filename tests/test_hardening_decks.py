@@ -35,7 +35,8 @@ ALLSEL
      f"{1:9d}{0:9d}{0:9d}{'nan':>21}{0.0:21.13E}{0.0:21.13E}\nN,R5.3,LOC,       -1,\n", 2,
      "non-finite coordinate"),
     ("/PREP7\nN,1,0.01,NAN\n", 2, "NAN"),
-    ("/PREP7\nET,1,PLANE55,,,1\nRECTNG,0,1e300,0,1e300\nAMESH,ALL\n", 4, "out of range"),
+    ("/PREP7\nET,1,PLANE55,,,1\nMP,KXX,1,50\nRECTNG,0,1e300,0,1e300\nAMESH,ALL\n/SOLU\n"
+     "NSEL,S,LOC,X,0\nD,ALL,TEMP,20\nALLSEL\nSOLVE\n", 10, "out of range"),
     ("/PREP7\nN,1,0.01,0\nN,2,0.02,0\nCMBLOCK,C,NODE,2\n(8i10)\n         1       500\n", 4,
      "node 500 does not exist"),
     ("/PREP7\nN,1,0.01,0\nCMBLOCK,C,NODE,1\n(8i30)\n" + "9" * 30 + "\n", 3, "out of range"),
@@ -61,3 +62,13 @@ def test_amesh_inside_do_cannot_bypass_the_element_cap(tmp_path):
     with pytest.raises(ApdlError) as info:
         Session(base_dir=tmp_path).run_text(deck, "deck.inp")
     assert info.value.file == "deck.inp"
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_amesh_in_a_loop_stops_at_the_model_element_cap(tmp_path):
+    deck = ("/PREP7\nET,1,PLANE55,,,1\nESIZE,0.0005\n*DO,I,1,1000\n"
+            "RECTNG,I,I+0.1,0,0.1\nAMESH,ALL\n*ENDDO\n")
+    with pytest.raises(ApdlError, match="more than 500000 elements") as info:
+        Session(base_dir=tmp_path).run_text(deck, "deck.inp")
+    assert info.value.line == 6
