@@ -280,3 +280,16 @@ def test_initial_ensemble_has_exactly_the_prior_covariance():
     np.testing.assert_allclose(ens.log_factor_anomalies @ ens.field_anomalies[0], 0, atol=1e-12)
     with pytest.raises(ValueError, match="at least 5 members"):
         Ensemble.initial(np.zeros(3), 0.2, prior, 4, np.random.default_rng(1))
+
+
+def test_the_recorded_drift_enters_only_when_asked(tmp_path):
+    import dataclasses
+
+    run = make_run(tmp_path / "drift.csv", minutes=5)
+    shifted = dataclasses.replace(run, disp_um=run.disp_um * 1.3)
+    off = [tuple(c) for c, _ in estimate(run)[2]], [tuple(c) for c, _ in estimate(shifted)[2]]
+    assert off[0] == off[1]  # default: temperatures only
+    on_a = estimate(run, assimilate_drift=True)[1]
+    on_b = estimate(shifted, assimilate_drift=True)[1]
+    # a 30 % larger measured drift pulls the twin's drift up
+    assert on_b.drift_z_um[-1] > on_a.drift_z_um[-1] + 0.05 * abs(on_a.drift_z_um[-1])

@@ -115,6 +115,9 @@ class WindowFeatures:
     """Nominal values of the previous window, if the speed changed since (else = nominal)."""
     twin_state: TwinState | None = None
     """The twin's field and conditions at the window start (set by the loop)."""
+    measured_drift_um: np.ndarray | None = None
+    """(n,) the recorded axial nose drift at `measured_time_s` (NaN: invalid; None: not
+    recorded).  Only an estimator told to assimilate it reads it."""
 
     def __post_init__(self) -> None:
         pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))

@@ -179,6 +179,9 @@ def replay_method(
     T = np.full(model.n_dofs, T0)
 
     measured_T = np.where(run.valid_T, run.T_C, np.nan)
+    measured_drift = None
+    if run.disp_um is not None and "disp_z_um" in run.valid:
+        measured_drift = np.where(run.valid["disp_z_um"], run.disp_um[:, 2], np.nan)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)
     starts = WINDOW_S * np.arange(windows)
@@ -225,6 +228,7 @@ def replay_method(
             previous=previous or nominal,
             previous_nominal=previous_nominal,
             twin_state=TwinState(T, bc),
+            measured_drift_um=None if measured_drift is None else measured_drift[upto],
         )
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
