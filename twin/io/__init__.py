@@ -4,7 +4,9 @@ atomic       the one atomic writer (temporary file beside the target, then os.re
              and its text, JSON and CSV forms
 vtk          the one field-file writer (VTU per time + ParaView .pvd) and the names and
              units of its arrays: temperature_C, displacement_um, von_mises_MPa
-html_pages   HTML pages from the jinja2 templates in `templates/` (package data)
+destinations the checks on every --out before any work starts (inputs, folders, devices)
+html_pages   HTML pages from the jinja2 templates in `templates/` (package data): the
+             replay, training and drift reports
 
 Imports are per module (`from twin.io.atomic import write_json`): this package imports
 nothing itself, so a writer never pulls in the plotting or FEM stack it does not need.
