@@ -282,14 +282,14 @@ def test_initial_ensemble_has_exactly_the_prior_covariance():
         Ensemble.initial(np.zeros(3), 0.2, prior, 4, np.random.default_rng(1))
 
 
-def test_the_recorded_drift_enters_only_when_asked(tmp_path):
+def test_the_recorded_drift_enters_only_when_asked(tmp_path, spindle_model):
     import dataclasses
 
-    run = make_run(tmp_path / "drift.csv", minutes=5)
+    run = make_run(tmp_path / "drift.csv", spindle_model, minutes=5)
     shifted = dataclasses.replace(run, disp_um=run.disp_um * 1.3)
-    off = [tuple(c) for c, _ in estimate(run)[2]], [tuple(c) for c, _ in estimate(shifted)[2]]
+    off = [tuple(c) for c, _ in estimate(run, spindle_model)[2]], [tuple(c) for c, _ in estimate(shifted, spindle_model)[2]]
     assert off[0] == off[1]  # default: temperatures only
-    on_a = estimate(run, assimilate_drift=True)[1]
-    on_b = estimate(shifted, assimilate_drift=True)[1]
+    on_a = estimate(run, spindle_model, assimilate_drift=True)[1]
+    on_b = estimate(shifted, spindle_model, assimilate_drift=True)[1]
     # a 30 % larger measured drift pulls the twin's drift up
     assert on_b.drift_z_um[-1] > on_a.drift_z_um[-1] + 0.05 * abs(on_a.drift_z_um[-1])
