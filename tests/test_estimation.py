@@ -287,7 +287,7 @@ def test_the_recorded_drift_enters_only_when_asked(tmp_path, spindle_model):
 
     run = make_run(tmp_path / "drift.csv", spindle_model, minutes=5)
     shifted = dataclasses.replace(run, disp_um=run.disp_um * 1.3)
-    off = [tuple(c) for c, _ in estimate(run, spindle_model)[2]], [tuple(c) for c, _ in estimate(shifted, spindle_model)[2]]
+    off = [[tuple(c) for c, _ in estimate(r, spindle_model)[2]] for r in (run, shifted)]
     assert off[0] == off[1]  # default: temperatures only
     on_a = estimate(run, spindle_model, assimilate_drift=True)[1]
     on_b = estimate(shifted, spindle_model, assimilate_drift=True)[1]
