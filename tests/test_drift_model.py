@@ -133,3 +133,28 @@ def test_temperature_gaps_are_bridged_causally_and_reported(tmp_path):
     assert a[26] != a[19]
     found = {(f["column"], f["first_row"], f["last_row"]) for f in data.findings}
     assert found == {("A_C", 2, 3), ("A_C", 22, 27)}
+
+
+def test_parquet_data_read_like_csv(data_file, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    columns = synthetic_columns()
+    path = tmp_path / "machine.parquet"
+    pq.write_table(pa.table(columns), path)
+    a = read_drift_data([path], targets=["drift_um"])
+    b = read_drift_data([data_file], targets=["drift_um"])
+    assert a.sensors == b.sensors and a.rows[0] == 1
+    np.testing.assert_allclose(a.T_C, b.T_C, rtol=1e-5)
+
+
+def test_bp_fit_is_repeatable_for_a_seed(data_file):
+    data = read_drift_data([data_file], targets=["drift_um"])
+    spec = FeatureSpec(tuple(data.sensors), tuple(reference_temperatures(data.T_C)))
+    X = dynamic_features(spec, data.time_s, data.T_C, data.speed_rpm)[::8]
+    Y = data.targets_um[::8]
+    rows = FitRows(X, Y, data.time_s[::8], block_labels(len(X)), seed=5)
+    a, b = METHODS["bp"].fit(rows), METHODS["bp"].fit(rows)
+    assert a.keys() == b.keys()
+    for key in a:
+        np.testing.assert_array_equal(a[key], b[key])

@@ -1,8 +1,10 @@
 """Stacking ensemble (REFERENCE.md §2): linear, BP and RBF base learners, linear meta-learner.
 
 The meta-learner is fitted on out-of-fold predictions of the base learners (time-blocked
-folds inside the training rows), per target, with non-negative weights and an intercept
-(a convex-like blend stays stable when two base learners agree).  The base learners are
+folds inside the training rows), per target: non-negative weights and no intercept, a
+blend of the base learners.  An intercept fitted to out-of-fold predictions picks up the
+offset of whichever block was left out and carries it to new data: on the real step tests
+(examples/real/) it raised the validation RMSE from 4.2 to 6.6 µm.  The base learners are
 then refitted on all training rows.
 """
 
@@ -50,7 +52,7 @@ def fit_stacking(X: np.ndarray, Y: np.ndarray, time_s: np.ndarray, seed: int,
     weight = np.zeros((p, len(BASE_LEARNERS)))
     bias = np.zeros(p)
     for j in range(p):
-        meta = LinearRegression(positive=True).fit(oof[:, j, :], Y[:, j])
+        meta = LinearRegression(positive=True, fit_intercept=False).fit(oof[:, j, :], Y[:, j])
         weight[j], bias[j] = meta.coef_, meta.intercept_
     out = {"meta_weight": weight, "meta_bias": bias}
     for name in BASE_LEARNERS:
