@@ -71,11 +71,11 @@ def _gauss_newton_blocks(params: dict[str, np.ndarray], Z: np.ndarray) -> list[n
     """J_jᵀJ_j per output; only the hidden layer and output j's own weights are non-zero."""
     p = params["output_weight"].shape[0]
     blocks = []
+    size = flat_weights(params).size
     for j in range(p):
-        J = output_jacobian(params, Z, j)
-        used = np.flatnonzero(np.any(J != 0.0, axis=0))
-        G = np.zeros((J.shape[1], J.shape[1]))
-        G[np.ix_(used, used)] = J[:, used].T @ J[:, used]
+        J, used = output_jacobian(params, Z, j, compact=True)
+        G = np.zeros((size, size))
+        G[np.ix_(used, used)] = J.T @ J
         blocks.append(G)
     return blocks
 
@@ -129,11 +129,15 @@ def predict_bayesian(params: dict[str, np.ndarray], X: np.ndarray,
     mean = forward_scaled(params, Z)
     p = mean.shape[1]
     var = np.empty_like(mean)
-    R = params["posterior_factor"]              # L⁻¹ with H = L·Lᵀ: gᵀH⁻¹g = |L⁻¹g|²
+    # L⁻¹ with H = L·Lᵀ: gᵀH⁻¹g = |L⁻¹g|².  The product costs n·P² and dominates
+    # prediction; single precision halves it and keeps σ to ~5 significant digits.
+    Rt = params["posterior_factor"].T.astype(np.float32)
     for start in range(0, Z.shape[0], chunk):
         rows = slice(start, start + chunk)
         for j in range(p):
-            G = output_jacobian(params, Z[rows], j) @ R.T
-            var[rows, j] = np.einsum("ij,ij->i", G, G) + 1.0 / params["beta"][j]
+            J, used = output_jacobian(params, Z[rows], j, compact=True)
+            G = J.astype(np.float32) @ Rt[used]
+            var[rows, j] = (np.einsum("ij,ij->i", G, G, dtype=np.float64)
+                            + 1.0 / params["beta"][j])
     scale = params["y_scale"]
     return mean * scale + params["y_offset"], np.sqrt(var) * scale

@@ -51,23 +51,35 @@ def flat_weights(params: dict[str, np.ndarray]) -> np.ndarray:
     return np.concatenate([params[k].ravel() for k in WEIGHT_NAMES])
 
 
-def output_jacobian(params: dict[str, np.ndarray], Z: np.ndarray, output: int) -> np.ndarray:
-    """∂f_output/∂w (n, P) in scaled units; w ordered as `flat_weights`."""
+def output_jacobian(params: dict[str, np.ndarray], Z: np.ndarray, output: int,
+                    compact: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """∂f_output/∂w (n, P) in scaled units; w ordered as `flat_weights`.
+
+    `compact` returns (J restricted to the weights output j depends on — the hidden layer
+    and its own output and skip weights —, their indices in w): the other columns are 0.
+    """
     a = hidden_activations(params, Z)
     v = params["output_weight"][output]
     n, h = a.shape
     m = Z.shape[1]
     p = params["output_weight"].shape[0]
     dz = (1.0 - a**2) * v                         # ∂f/∂(pre-activation), (n, h)
-    J = np.zeros((n, h * m + h + p * h + p + p * m))
+    own_v = h * m + h + output * h
+    own_c = h * m + h + p * h + output
+    own_s = h * m + h + p * h + p + output * m
+    cols = np.concatenate([np.arange(h * m + h), np.arange(own_v, own_v + h), [own_c],
+                           np.arange(own_s, own_s + m)])
+    J = np.empty((n, cols.size))
     J[:, : h * m] = (dz[:, :, None] * Z[:, None, :]).reshape(n, h * m)
     J[:, h * m : h * m + h] = dz
-    start = h * m + h + output * h
-    J[:, start : start + h] = a
-    J[:, h * m + h + p * h + output] = 1.0
-    start = h * m + h + p * h + p + output * m
-    J[:, start : start + m] = Z
-    return J
+    J[:, h * m + h : h * m + 2 * h] = a
+    J[:, h * m + 2 * h] = 1.0
+    J[:, h * m + 2 * h + 1 :] = Z
+    if compact:
+        return J, cols
+    full = np.zeros((n, h * m + h + p * h + p + p * m))
+    full[:, cols] = J
+    return full
 
 
 def initial_weights(m: int, h: int, p: int, seed: int) -> dict[str, np.ndarray]:
