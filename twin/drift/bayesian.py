@@ -62,8 +62,9 @@ def evidence_update(
         H += b * G
     H_inv = np.linalg.inv(H)
     gamma = np.array([b * np.sum(G * H_inv) for b, G in zip(beta, gauss_newton, strict=True)])
-    alpha_new = float(gamma.sum() / (2.0 * E_W))
-    beta_new = (n - gamma) / (2.0 * np.asarray(E_D, dtype=float))
+    # floors keep a perfect fit (E → 0) or tiny data from sending α or β to infinity
+    alpha_new = float(gamma.sum() / (2.0 * max(E_W, 1e-12)))
+    beta_new = np.maximum(n - gamma, 1e-3) / (2.0 * np.maximum(np.asarray(E_D, float), 1e-12))
     return alpha_new, beta_new, gamma
 
 
