@@ -111,11 +111,13 @@ def fit(
     if not quiet:
         validation = model.metadata["validation"]["methods"]
         typer.echo(f"time-blocked validation ({model.metadata['validation']['blocks']} "
-                   "blocks), RMSE µm per target / mean:")
+                   "blocks): RMSE µm per target, mean; coverage of the 90 % interval")
         for name, v in validation.items():
             per = " ".join(f"{v['rmse_um'][t]:6.2f}" for t in targets)
+            cover = sum(v["coverage_90_pct"].values()) / len(targets)
             mark = "  <- chosen" if name == model.method else ""
-            typer.echo(f"  {name:14s} {per}   mean {v['mean_rmse_um']:6.2f}{mark}")
+            typer.echo(f"  {name:14s} {per}   mean {v['mean_rmse_um']:6.2f}   {cover:5.1f} %"
+                       f"{mark}")
         typer.echo(f"sensors: {', '.join(model.spec.sensors)}")
         typer.echo(f"wrote {out}")
 
