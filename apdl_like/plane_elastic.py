@@ -90,21 +90,42 @@ def thermal_load_form(mode: str, b: int) -> LinearForm:
     return LinearForm(form)
 
 
+def _corner_dofs(part) -> np.ndarray:  # noqa: ANN001 - plane_thermal.Part
+    """(cells, corners) global scalar dofs of the corners of each cell."""
+    return part.local_dofs[part.basis.nodal_dofs[0]][part.basis.mesh.t].T
+
+
 def solve_elastic(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
                   alpha: np.ndarray, dT: np.ndarray, fixed: tuple[np.ndarray, np.ndarray],
-                  couplings: list[np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+                  couplings: list[np.ndarray],
+                  enhanced: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Displacements (2, n) and nodal stresses per scalar dof (rr/xx, zz/yy, tt/zz, rz/xy,
     von_mises) of the thermal strain dT (per scalar dof, K) with E, ν, α per element.
 
     fixed      (vector dofs c·n + i, values m); couplings  vector dof sets sharing a value
+    enhanced   per element: PLANE182 with enhanced strain (bilinear quads only)
     """
     if mode not in MODES:
         raise ApdlError(f"unknown 2-D mode {mode!r}")
     n = mesh.n_dofs
     A = sp.csr_matrix((2 * n, 2 * n))
     f = np.zeros(2 * n)
-    for part in mesh.parts:
+    recovery = {}
+    for k, part in enumerate(mesh.parts):
         b, S = part.basis, part.to_global
+        if enhanced is not None and part.basis.mesh.t.shape[0] == 4 and \
+                b.N == part.basis.mesh.p.shape[1] and np.any(enhanced[part.elements]):
+            g = _corner_dofs(part)
+            xy = np.moveaxis(part.basis.mesh.p[:, part.basis.mesh.t], 0, -1).swapaxes(0, 1)
+            el = part.elements
+            Ke, fe, recover = enhanced_quads(xy, mode, E[el], nu[el], alpha[el][:, None] * dT[g])
+            idx = np.hstack([g, g + n])
+            rows = np.repeat(idx, 8, axis=1).ravel()
+            cols = np.tile(idx, (1, 8)).ravel()
+            A = A + sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(2 * n, 2 * n))
+            np.add.at(f, idx.ravel(), fe.ravel())
+            recovery[k] = (recover, idx, g)
+            continue
         el = part.elements
         nq = b.X.shape[-1]
         E_q, nu_q, a_q = (np.repeat(x[el][:, None], nq, axis=1) for x in (E, nu, alpha))
@@ -122,16 +143,25 @@ def solve_elastic(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
     if not np.all(np.isfinite(u)):
         raise ApdlError("the structure is not held (singular stiffness): constrain it")
     disp = u.reshape(2, n)
-    return disp, nodal_stress(mesh, mode, E, nu, alpha, dT, disp)
+    return disp, nodal_stress(mesh, mode, E, nu, alpha, dT, disp, recovery, u)
 
 
 def nodal_stress(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
-                 alpha: np.ndarray, dT: np.ndarray, disp: np.ndarray) -> dict[str, np.ndarray]:
+                 alpha: np.ndarray, dT: np.ndarray, disp: np.ndarray,
+                 recovery: dict | None = None,
+                 u: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Stresses at the element corners, averaged at each corner dof."""
     n = mesh.n_dofs
     sums = np.zeros((4, n))
     counts = np.zeros(n)
-    for part in mesh.parts:
+    for k, part in enumerate(mesh.parts):
+        if recovery and k in recovery:
+            recover, idx, g = recovery[k]
+            sig = recover(u[idx])  # (4, cells, corners)
+            for i in range(4):
+                np.add.at(sums[i], g.ravel(), sig[i].ravel())
+            np.add.at(counts, g.ravel(), 1.0)
+            continue
         corners = part.basis.mesh.t.shape[0]
         ref = part.basis.elem.doflocs[:corners].T  # reference corner points
         b = Basis(part.basis.mesh, part.basis.elem, quadrature=(ref, np.ones(corners)))
@@ -164,3 +194,100 @@ def nodal_stress(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
     sx, sy, sz, sxy = avg
     vm = np.sqrt(0.5 * ((sx - sy) ** 2 + (sy - sz) ** 2 + (sz - sx) ** 2) + 3.0 * sxy**2)
     return {"rr": sx, "zz": sy, "tt": sz, "rz": sxy, "von_mises": vm}
+
+
+# ----------------------------------------------- PLANE182 enhanced strain (KEYOPT(1) = 2)
+_GAUSS = 1.0 / np.sqrt(3.0)
+_CORNERS = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+
+
+def _quad_shapes(xi: float, eta: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear N (4,) and dN/d(ξ, η) (2, 4) at a reference point."""
+    N = 0.25 * (1 + xi * _CORNERS[:, 0]) * (1 + eta * _CORNERS[:, 1])
+    dN = 0.25 * np.array([_CORNERS[:, 0] * (1 + eta * _CORNERS[:, 1]),
+                          _CORNERS[:, 1] * (1 + xi * _CORNERS[:, 0])])
+    return N, dN
+
+
+def _enhanced_matrices(xy: np.ndarray, mode: str, xi: float, eta: float,
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """At (ξ, η) for every element (xy: (ne, 4, 2) corners): B (ne, 4, 8) of the corner
+    displacements [u1..u4, v1..v4], G (ne, 4, 4) of the incompatible modes (1−ξ², 1−η²)
+    per component (Taylor's centre-Jacobian form), det J and the radius."""
+    N, dN = _quad_shapes(xi, eta)
+    J = np.einsum("ak,ekb->eab", dN, xy)  # (ne, 2, 2): d(x, y)/d(ξ, η)
+    det = np.linalg.det(J)
+    dNdx = np.linalg.solve(J, np.broadcast_to(dN, (xy.shape[0], 2, 4)))  # (ne, 2, 4)
+    r = xy[:, :, 0] @ N
+    _, dN0 = _quad_shapes(0.0, 0.0)
+    J0 = np.einsum("ak,ekb->eab", dN0, xy)
+    det0 = np.linalg.det(J0)
+    dP = np.array([[-2.0 * xi, 0.0], [0.0, -2.0 * eta]])  # d(P1, P2)/d(ξ, η): rows ξ, η
+    dPdx = np.linalg.solve(J0, np.broadcast_to(dP, (xy.shape[0], 2, 2))) * \
+        (det0 / det)[:, None, None]
+    ne = xy.shape[0]
+    B = np.zeros((ne, 4, 8))
+    G = np.zeros((ne, 4, 4))
+    B[:, 0, :4] = dNdx[:, 0]
+    B[:, 1, 4:] = dNdx[:, 1]
+    B[:, 3, :4] = dNdx[:, 1]
+    B[:, 3, 4:] = dNdx[:, 0]
+    G[:, 0, :2] = dPdx[:, 0]
+    G[:, 1, 2:] = dPdx[:, 1]
+    G[:, 3, :2] = dPdx[:, 1]
+    G[:, 3, 2:] = dPdx[:, 0]
+    if mode == "axisymmetric":
+        r_safe = np.where(r == 0.0, 1.0, r)  # on the axis the caller takes ε3 = ε1
+        B[:, 2, :4] = N[None, :] / r_safe[:, None]
+        # the incompatible modes add no hoop strain: with it the element fails the patch
+        # test (a uniform strain state would not be reproduced)
+    return B, G, det, r
+
+
+def enhanced_quads(xy: np.ndarray, mode: str, E: np.ndarray, nu: np.ndarray,
+                   th: np.ndarray) -> tuple[np.ndarray, np.ndarray, object]:
+    """Condensed element stiffness (ne, 8, 8) and thermal load (ne, 8) of bilinear quads with
+    four incompatible modes (MAPDL's PLANE182 enhanced strain), and a recovery function
+    u_e (ne, 8) -> stresses (4, ne, 4 corners).  th: thermal strain α ΔT at the corners."""
+    D = np.moveaxis(elasticity_matrix(E, nu, mode), -1, 0)  # (ne, 4, 4)
+    normal = 2 if mode == "plane_stress" else 3
+    ne = xy.shape[0]
+    Kuu, Kua, Kaa = np.zeros((ne, 8, 8)), np.zeros((ne, 8, 4)), np.zeros((ne, 4, 4))
+    fu, fa = np.zeros((ne, 8)), np.zeros((ne, 4))
+    for xi in (-_GAUSS, _GAUSS):
+        for eta in (-_GAUSS, _GAUSS):
+            B, G, det, r = _enhanced_matrices(xy, mode, xi, eta)
+            w = det * (2.0 * np.pi * r if mode == "axisymmetric" else 1.0)
+            N, _ = _quad_shapes(xi, eta)
+            eps_th = np.zeros((ne, 4))
+            eps_th[:, :normal] = (th @ N)[:, None]
+            DB, DG = D @ B, D @ G
+            Kuu += np.einsum("eia,eib,e->eab", B, DB, w)
+            Kua += np.einsum("eia,eib,e->eab", B, DG, w)
+            Kaa += np.einsum("eia,eib,e->eab", G, DG, w)
+            s_th = np.einsum("eij,ej->ei", D, eps_th)
+            fu += np.einsum("eia,ei,e->ea", B, s_th, w)
+            fa += np.einsum("eia,ei,e->ea", G, s_th, w)
+    Kaa_inv = np.linalg.inv(Kaa)
+    K = Kuu - Kua @ Kaa_inv @ np.swapaxes(Kua, 1, 2)
+    f = fu - np.einsum("eab,ebc,ec->ea", Kua, Kaa_inv, fa)
+
+    def recover(u_e: np.ndarray) -> np.ndarray:
+        alpha = np.einsum("eab,eb->ea", Kaa_inv,
+                          fa - np.einsum("eab,eb->ea", np.swapaxes(Kua, 1, 2), u_e))
+        # stresses at the 2 × 2 integration points, extrapolated to the corners (MAPDL's
+        # nodal solution of linear elements)
+        gauss = np.zeros((4, ne, 4))
+        for k, (xi, eta) in enumerate(_CORNERS * _GAUSS):
+            B, G, _, _ = _enhanced_matrices(xy, mode, xi, eta)
+            N, _ = _quad_shapes(xi, eta)
+            eps = np.einsum("eia,ea->ei", B, u_e) + np.einsum("eia,ea->ei", G, alpha)
+            eps[:, :normal] -= (th @ N)[:, None]
+            sig = np.einsum("eij,ej->ei", D, eps)
+            if mode == "plane_stress":
+                sig[:, 2] = 0.0
+            gauss[:, :, k] = sig.T
+        extrapolate = np.array([_quad_shapes(*(c / _GAUSS))[0] for c in _CORNERS])
+        return np.einsum("sek,ck->sec", gauss, extrapolate)
+
+    return K, f, recover

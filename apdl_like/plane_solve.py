@@ -436,8 +436,12 @@ def solve_plane_structural(s: SessionState) -> StepResult:
         for c, name in enumerate(("UX", "UY")):
             if label in (name, "ALL"):
                 couplings.append(c * n + scalar)
+    enhanced = np.array([db.element_types[int(t)].name == "PLANE182" and
+                         db.element_types[int(t)].keyopt.get(1, 0) in (2, 3)
+                         for t in db.elements.type], bool)
     disp, stress = solve_elastic(mesh, mode, E, nu, alpha, T - settings.tref,
-                                 (np.concatenate(dofs), np.concatenate(values)), couplings)
+                                 (np.concatenate(dofs), np.concatenate(values)), couplings,
+                                 enhanced)
     sol = s.solution
     sol.time = settings.time if settings.time is not None else sol.time + 1.0
     nodal = {"UX": mesh.nodal(disp[0]), "UY": mesh.nodal(disp[1])}

@@ -329,3 +329,63 @@ NP = NODE(0.05,0.04)
     assert s.params["UX_OUT"] == pytest.approx(alpha * dT * 0.05, rel=1e-8)
     assert s.params["UY_TOP"] == pytest.approx(alpha * dT * 0.04, rel=1e-8)
     assert s.params["S_EQV"] < 1e-6 * 2e11 * alpha * dT
+
+
+LONG_CYLINDER = """
+/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,3
+N,1,.1875
+N,41,.625
+FILL
+NGEN,2,100,1,41,1,,.1
+E,1,2,102,101
+EGEN,40,1,1
+/SOLU
+ANTYPE,STATIC
+D,1,TEMP,{t_in},,101,100
+D,41,TEMP,0,,141,100
+SOLVE
+FINISH
+/PREP7
+ETCHG,TTS
+KEYOPT,1,1,{keyopt1}
+KEYOPT,1,3,1
+MP,EX,1,30E6
+MP,ALPX,1,1.435E-5
+MP,NUXY,1,.3
+CPNGEN,1,UY,101,141
+*DO,I,1,41
+CP,NEXT,UX,I,I+100
+*ENDDO
+FINISH
+/SOLU
+ANTYPE,STATIC
+D,1,UY,,,41
+LDREAD,TEMP
+SOLVE
+FINISH
+/POST1
+*GET,HOOP_IN,NODE,1,S,Z
+*GET,AXIAL_IN,NODE,1,S,Y
+*GET,HOOP_OUT,NODE,41,S,Z
+"""
+
+
+@pytest.mark.parametrize("keyopt1, rel", [(2, 0.015), (0, 0.06)])
+def test_long_cylinder_thermal_stress_on_quads(keyopt1, rel):
+    """Timoshenko (Strength of Materials II, p. 234; VM32): a long cylinder, a = 0.1875,
+    b = 0.625 in, T = −1 at a, 0 at b (steady, ln r profile), free ends (UY coupled):
+    σθ(a) = σz(a) = Eα/(2(1−ν) ln(b/a)) · T(a) · (1 − 2b²/(b²−a²) ln(b/a)) = 420.42 psi.
+    40 bilinear quads: enhanced strain (KEYOPT(1)=2) within 1.5 %, plain within 6 % (the
+    plain element's corner stress converges as O(h))."""
+    a, b, E, alpha, nu = 0.1875, 0.625, 30e6, 1.435e-5, 0.3
+    ln = math.log(b / a)
+    exact = E * alpha / (2 * (1 - nu) * ln) * (-1.0) * (1 - 2 * b**2 / (b**2 - a**2) * ln)
+    assert exact == pytest.approx(420.42, abs=0.01)
+    s = run(LONG_CYLINDER.format(t_in=-1, keyopt1=keyopt1))
+    assert s.params["HOOP_IN"] == pytest.approx(exact, rel=rel)
+    assert s.params["AXIAL_IN"] == pytest.approx(exact, rel=rel)
+    uniform = run(LONG_CYLINDER.format(t_in=5, keyopt1=keyopt1).replace(
+        "D,41,TEMP,0,,141,100", "D,41,TEMP,5,,141,100"))
+    assert abs(uniform.params["HOOP_IN"]) < 1e-6 * E * alpha * 5  # free expansion: no stress
