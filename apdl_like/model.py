@@ -24,6 +24,8 @@ ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
     "PLANE182": ("structural", 4, False),
     "PLANE183": ("structural", 4, True),
     "PLANE35": ("thermal", 3, True),
+    # surface effect elements: they carry face loads (SFE) onto the solid's exterior faces
+    "SURF151": ("surface", 2, False),
 }
 # ETCHG,TTS / STT pairs (thermal <-> structural)
 THERMAL_TO_STRUCTURAL = {"PLANE55": "PLANE182", "PLANE77": "PLANE183"}

@@ -23,20 +23,21 @@ if TYPE_CHECKING:
 def _cells(session: SessionState) -> list[tuple[str, np.ndarray]]:
     db = session.db
     el = db.elements
+    solid = np.array([db.element_types[int(t)].physics != "surface" for t in el.type], bool)
     idx = db.nodes.index(el.nodes.ravel()).reshape(el.nodes.shape)
     tri6_type = np.array([db.element_types[int(t)].triangle6 for t in el.type], bool)
     quadratic = np.array([db.element_types[int(t)].quadratic for t in el.type], bool)
     degenerate = (el.nodes[:, 2] == el.nodes[:, 3]) & ~tri6_type
     blocks = []
-    lin = ~quadratic
+    lin = ~quadratic & solid
     if np.any(lin & degenerate):
         blocks.append(("triangle", idx[lin & degenerate][:, :3]))
     if np.any(lin & ~degenerate):
         blocks.append(("quad", idx[lin & ~degenerate][:, :4]))
-    q8 = quadratic & ~degenerate & ~tri6_type
+    q8 = quadratic & ~degenerate & ~tri6_type & solid
     if np.any(q8):
         blocks.append(("quad8", idx[q8]))
-    t6 = quadratic & degenerate
+    t6 = quadratic & degenerate & solid
     if np.any(t6):
         blocks.append(("triangle6", idx[t6][:, [0, 1, 2, 4, 5, 7]]))
     if np.any(tri6_type):

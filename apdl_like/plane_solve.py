@@ -54,9 +54,10 @@ class FaceTable:
         return np.where(sorted_keys[pos] == keys, order[pos], -1)
 
 
-def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None]:
-    """Per element: corner node indices (m, 4; K = L for triangles) and mid-side node
-    indices (m, 4: I-J, J-K, K-L, L-I; -1 none) or None for a linear model."""
+def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+    """Per element: corner node indices (m, 4; K = L for triangles), mid-side node indices
+    (m, 4: I-J, J-K, K-L, L-I; -1 none) or None for a linear model, and which elements are
+    solids (surface elements such as SURF151 only carry face loads)."""
     el = db.elements
     el.flush()
     if len(el.ids) == 0:
@@ -64,9 +65,13 @@ def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None]:
     missing = [int(t) for t in np.unique(el.type) if int(t) not in db.element_types]
     if missing:
         raise ApdlError(f"element type {missing[0]} is used by elements but never defined (ET)")
+    solid = np.array([db.element_types[int(t)].physics != "surface" for t in el.type], bool)
+    if not solid.any():
+        raise ApdlError("the model has only surface elements")
     nodes = el.nodes
     idx = db.nodes.index(nodes.ravel()).reshape(nodes.shape)
     idx[nodes == 0] = -1
+    idx[~solid] = np.where(idx[~solid, :1] >= 0, idx[~solid, :1], 0)  # not meshed
     tri6 = np.array([db.element_types[int(t)].triangle6 for t in el.type], bool)
     quadratic = np.array([db.element_types[int(t)].quadratic for t in el.type], bool)
     corners = idx[:, :4].copy()
@@ -75,21 +80,23 @@ def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None]:
     if np.any(corners[:, :3] < 0):
         bad = el.ids[np.nonzero(np.any(corners[:, :3] < 0, axis=1))[0][0]]
         raise ApdlError(f"element {bad} refers to a node that does not exist")
-    if not quadratic.any():
-        return corners, None
-    if not quadratic.all():
+    if not quadratic[solid].any():
+        return corners, None, solid
+    if not quadratic[solid].all():
         raise ApdlError("mixing linear and quadratic elements is not supported")
     mid = idx[:, 4:8].copy()
     mid[tri6] = np.column_stack([idx[tri6, 3], idx[tri6, 4], np.full(tri6.sum(), -1),
                                  idx[tri6, 5]])
     collapsed = corners[:, 2] == corners[:, 3]
     mid[collapsed & ~tri6, 2] = -1  # O of a degenerate 8-node quad sits on K = L
-    return corners, mid
+    mid[~solid] = -1
+    return corners, mid, solid
 
 
 def exterior_faces(db: Database) -> FaceTable:
     """The element edges used by exactly one element."""
-    corners, _ = corners_and_midside(db)
+    corners, _, solid = corners_and_midside(db)
+    corners = corners[solid]
     a = corners.ravel()
     b = np.roll(corners, -1, axis=1).ravel()
     keep = a != b
@@ -110,8 +117,9 @@ def plane_mesh(s: SessionState) -> PlaneMesh:
     key = (db.nodes.version, db.elements.version, analysis_mode(db))
     cache = s.fem
     if cache.plane is None or cache.plane_key != key:
-        corners, mid = corners_and_midside(db)
-        mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2] == "axisymmetric")
+        corners, mid, solid = corners_and_midside(db)
+        mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2] == "axisymmetric",
+                          solid)
         cache.plane, cache.plane_key = mesh, key
         cache.plane_solver = None
     return cache.plane  # type: ignore[return-value]
@@ -138,6 +146,8 @@ def analysis_mode(db: Database) -> str:
         et = db.element_types.get(t)
         if et is None:
             continue
+        if et.physics == "surface":
+            continue  # SURF151 follows the solid it lies on
         if et.physics == "unsupported":
             raise ApdlError(f"element type {t} ({et.name}) is not supported: use PLANE35, "
                             "PLANE55, PLANE77, PLANE182 or PLANE183")

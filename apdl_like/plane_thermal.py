@@ -95,10 +95,13 @@ class PlaneMesh:
 
 
 def build_mesh(xy: np.ndarray, node_ids: np.ndarray, corners: np.ndarray,
-               midside: np.ndarray | None, axisymmetric: bool) -> PlaneMesh:
+               midside: np.ndarray | None, axisymmetric: bool,
+               solid: np.ndarray | None = None) -> PlaneMesh:
     """corners (m, 4) node indices (K = L for a triangle); midside (m, 4) node indices of
-    the mid-side nodes I-J, J-K, K-L, L-I (-1 none) for quadratic elements, else None."""
-    vertex_node = np.unique(corners)
+    the mid-side nodes I-J, J-K, K-L, L-I (-1 none) for quadratic elements, else None;
+    solid (m,) the elements to mesh (default all)."""
+    solid = np.ones(corners.shape[0], bool) if solid is None else solid
+    vertex_node = np.unique(corners[solid])
     if axisymmetric:
         x = xy[vertex_node, 0]
         if np.any(x < -1e-9 * max(1.0, float(np.abs(xy[vertex_node]).max()))):
@@ -111,7 +114,7 @@ def build_mesh(xy: np.ndarray, node_ids: np.ndarray, corners: np.ndarray,
     tri = corners[:, 2] == corners[:, 3]
     parts = []
     for is_tri in (False, True):
-        elements = np.nonzero(tri == is_tri)[0]
+        elements = np.nonzero((tri == is_tri) & solid)[0]
         if not elements.size:
             continue
         part_corners = corners[elements][:, :3] if is_tri else corners[elements]

@@ -389,3 +389,33 @@ def test_long_cylinder_thermal_stress_on_quads(keyopt1, rel):
     uniform = run(LONG_CYLINDER.format(t_in=5, keyopt1=keyopt1).replace(
         "D,41,TEMP,0,,141,100", "D,41,TEMP,5,,141,100"))
     assert abs(uniform.params["HOOP_IN"]) < 1e-6 * E * alpha * 5  # free expansion: no stress
+
+
+def test_surf151_convection_matches_the_one_dimensional_wall():
+    """A slab 0.1 m long, T = 100 at x = 0, SURF151 elements (ESURF) at x = 0.1 carrying
+    SFE convection h = 50, T_bulk = 20; k = 20: T(L) = T_b + (T_0 − T_b)/(1 + hL/k) = 84."""
+    s = run("""
+/PREP7
+ET,1,PLANE55
+ET,2,SURF151
+MP,KXX,1,20
+RECTNG,0,0.1,0,0.05
+ESIZE,0.01
+AMESH,1
+NSEL,S,LOC,X,0.1
+ESLN,S,0
+TYPE,2
+ESURF
+ALLSEL
+/SOLU
+NSEL,S,LOC,X,0
+D,ALL,TEMP,100
+ALLSEL
+ESEL,S,TYPE,,2
+SFE,ALL,1,CONV,1,50
+SFE,ALL,1,CONV,2,20
+ALLSEL
+SOLVE
+*GET,T_END,NODE,NODE(0.1,0,0),TEMP
+""")
+    assert s.params["T_END"] == pytest.approx(20.0 + 80.0 / (1.0 + 50.0 * 0.1 / 20.0), rel=1e-9)

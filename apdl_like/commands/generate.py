@@ -232,6 +232,44 @@ def nummrg(s: SessionState, c: Call) -> None:
     s.say(f"NUMMRG: {int(np.sum(keep != np.arange(keep.size)))} coincident nodes merged")
 
 
+def esurf(s: SessionState, c: Call) -> None:
+    """ESURF: surface elements (the active TYPE, e.g. SURF151) on the exterior faces of the
+    selected solid elements whose nodes are all selected."""
+    from apdl_like.plane_solve import corners_and_midside
+
+    db = s.db
+    et = db.element_types.get(db.active_type)
+    if et is None or et.physics != "surface":
+        raise ApdlError(f"ESURF needs a surface element type active (ET,n,SURF151; TYPE,n), "
+                        f"got {et.name if et else 'none'}")
+    corners, _, solid = corners_and_midside(db)
+    el, nodes = db.elements, db.nodes
+    chosen = solid & el.selected
+    a = corners[chosen].ravel()
+    b = np.roll(corners[chosen], -1, axis=1).ravel()
+    keep = a != b
+    a, b = a[keep], b[keep]
+    all_a = corners[solid].ravel()
+    all_b = np.roll(corners[solid], -1, axis=1).ravel()
+    ok = all_a != all_b
+    ids = nodes.ids
+    lo = np.minimum(ids[all_a[ok]], ids[all_b[ok]]) * (1 << 31) + \
+        np.maximum(ids[all_a[ok]], ids[all_b[ok]])
+    keys, counts = np.unique(lo, return_counts=True)
+    exterior = set(keys[counts == 1].tolist())
+    number = int(el.ids.max()) + 1
+    made = 0
+    for i, j in zip(a.tolist(), b.tolist(), strict=True):
+        key = min(ids[i], ids[j]) * (1 << 31) + max(ids[i], ids[j])
+        if key in exterior and nodes.selected[i] and nodes.selected[j]:
+            el.add(number, db.active_type, db.active_mat, db.active_real,
+                   (int(ids[i]), int(ids[j])))
+            number += 1
+            made += 1
+    el.flush()
+    s.say(f"ESURF: {made} surface elements")
+
+
 def _coupling_label(c: Call, i: int) -> str:
     label = c.label(i)
     if label not in COUPLING_LABELS:
@@ -309,6 +347,7 @@ COMMANDS = (
     CommandSpec("EGEN", PREP7, 14, egen),
     CommandSpec("EMID", PREP7, 2, emid),
     CommandSpec("NUMMRG", PREP7, 5, nummrg),
+    CommandSpec("ESURF", PREP7, 3, esurf),
     CommandSpec("CP", PREP7, 19, cp),
     CommandSpec("CPNGEN", PREP7, 5, cpngen),
     CommandSpec("CPSGEN", PREP7, 6, cpsgen),

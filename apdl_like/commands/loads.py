@@ -165,7 +165,13 @@ def _element_faces(s: SessionState, elems: np.ndarray, lkey: int) -> np.ndarray:
     tri6 = np.array([db.element_types[int(t)].triangle6 for t in db.elements.type[elems]], bool)
     corners = nodes[:, :4].copy()
     corners[tri6, 3] = corners[tri6, 2]
-    if lkey == 3:
+    surface = np.array([db.element_types[int(t)].physics == "surface"
+                        for t in db.elements.type[elems]], bool)
+    if surface.all():  # SURF151: its one face is the solid face it lies on
+        a, b = corners[:, 0], corners[:, 1]
+    elif surface.any():
+        raise ApdlError("SFE on surface and solid elements at once: select one kind")
+    elif lkey == 3:
         a, b = corners[:, 2], corners[:, 3]
         a = np.where(tri6, corners[:, 2], a)
         b = np.where(tri6, corners[:, 0], b)

@@ -34,8 +34,8 @@ def _entity_number(c: Call, i: int, what: str) -> int:
 # 3-D types that archives written by other tools carry (mapdl-archive writes triangles as
 # SHELL181): accepted so the archive reads, to be redefined (ET,n,PLANE55) before SOLVE
 FOREIGN_TYPES = {181: "SHELL181", 185: "SOLID185", 186: "SOLID186", 187: "SOLID187"}
-_BY_NUMBER = {int(name[5:]): name for name in ELEMENT_TYPES} | FOREIGN_TYPES | \
-    {172: "CONTA172", 169: "TARGE169"}
+_BY_NUMBER = {int("".join(ch for ch in name if ch.isdigit())): name
+              for name in ELEMENT_TYPES} | FOREIGN_TYPES | {172: "CONTA172", 169: "TARGE169"}
 
 
 def _element_name(c: Call) -> str:
@@ -212,7 +212,7 @@ def n(s: SessionState, c: Call) -> None:
 
 # node counts E accepts (quadratic elements without mid-side nodes get them from EMID)
 _NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (3, 4, 8),
-                "PLANE183": (3, 4, 8), "PLANE35": (3, 6)}
+                "PLANE183": (3, 4, 8), "PLANE35": (3, 6), "SURF151": (2, 3)}
 
 
 def e(s: SessionState, c: Call) -> None:
@@ -234,9 +234,12 @@ def e(s: SessionState, c: Call) -> None:
     idx = db.nodes.index(np.array(nums))
     if np.any(idx < 0):
         raise ApdlError(f"node {nums[int(np.nonzero(idx < 0)[0][0])]} does not exist")
-    if len(set(nums[:3])) < 3:
+    if et_.physics == "surface":
+        if nums[0] == nums[1]:
+            raise ApdlError("a surface element needs two different nodes (I, J)")
+    elif len(set(nums[:3])) < 3:
         raise ApdlError("the first three nodes (I, J, K) must be distinct")
-    if len(nums) == 3 and not et_.triangle6:
+    if len(nums) == 3 and not et_.triangle6 and et_.physics != "surface":
         nums.append(nums[2])  # the triangle is the quad with K = L
     el = db.elements
     el.flush()

@@ -142,7 +142,7 @@ def ldread(s: SessionState, c: Call) -> None:
 def solve(s: SessionState, c: Call) -> None:
     s.budget.unsolved = None
     types = {s.db.element_types[int(t)].physics for t in np.unique(s.db.elements.type)
-             if int(t) in s.db.element_types}
+             if int(t) in s.db.element_types} - {"surface"}  # SURF151 only carries loads
     if s.record_only:
         from apdl_like.loadset import record_solve
 
