@@ -79,6 +79,9 @@ def test_model_file_round_trip_without_pickle(ridge_model, data_file, tmp_path):
     for x, y in zip(ridge_model.predict(data), loaded.predict(data), strict=True):
         np.testing.assert_array_equal(x, y)
     assert loaded.interval == ridge_model.interval
+    assert loaded.validation.keys() == ridge_model.validation.keys() and loaded.validation
+    for key, value in ridge_model.validation.items():
+        np.testing.assert_array_equal(loaded.validation[key], value)
     raw = bytearray(path.read_bytes())
     raw[-3] ^= 0xFF                                  # flip bits in the last tensor
     (tmp_path / "bad.safetensors").write_bytes(bytes(raw))

@@ -36,6 +36,9 @@ class DriftModel:
     params: dict[str, np.ndarray]
     interval: dict
     metadata: dict = field(default_factory=dict)
+    validation: dict[str, np.ndarray] = field(default_factory=dict)
+    """The chosen method's time-blocked validation: `time_s`, `block`, `measured_um`,
+    `predicted_um`, `lo_um`, `hi_um` (rows with every target; (n,) or (n, p))."""
 
     def predict_arrays(self, time_s: np.ndarray, T_C: np.ndarray, speed_rpm: np.ndarray | None,
                        segment_starts: np.ndarray | None = None
@@ -146,6 +149,8 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
                        "methods": {r.name: r.to_json(data.targets) for r in results}},
         "data_findings": data.findings,
     }
+    validation = {"time_s": data.time_s[rows], "block": blocks.astype(float), "measured_um": Y,
+                  "predicted_um": result.predicted, "lo_um": result.lo, "hi_um": result.hi}
     return DriftModel(best, list(data.targets), spec,
                       {k: np.asarray(v, dtype=float) for k, v in params.items()},
-                      result.interval, metadata)
+                      result.interval, metadata, validation)

@@ -1,6 +1,7 @@
 """The drift model file: parameters as safetensors tensors, everything else as JSON.
 
-Tensors are float64 arrays named as the method stores them; the safetensors header
+Tensors are float64 arrays named as the method stores them, plus the chosen method's
+out-of-fold validation under `validation.*` (for the report); the safetensors header
 holds one metadata entry `spindle_twin_drift` with JSON: format, version, method,
 targets, feature spec, interval rule, metadata (ranking, validation) and a SHA-256 of
 the tensors.  Loading reads tensors and JSON only (no unpickling) and checks them.
@@ -24,6 +25,8 @@ from twin.io.atomic import write_bytes
 FORMAT = "spindle-twin-drift"
 VERSION = 1
 METADATA_KEY = "spindle_twin_drift"
+VALIDATION = "validation."
+"""Prefix of the tensors holding the out-of-fold validation (shown by `twin drift report`)."""
 
 
 def _digest(tensors: dict[str, np.ndarray]) -> str:
@@ -40,6 +43,8 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
     from safetensors.numpy import save
 
     tensors = {k: np.ascontiguousarray(v, dtype="<f8") for k, v in model.params.items()}
+    tensors.update({f"{VALIDATION}{k}": np.ascontiguousarray(v, dtype="<f8")
+                    for k, v in model.validation.items()})
     doc = {"format": FORMAT, "version": VERSION, "method": model.method,
            "targets": model.targets, "features": model.spec.to_json(),
            "interval": model.interval, "metadata": model.metadata, "sha256": _digest(tensors)}
@@ -79,7 +84,10 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
         raise InputError("checksum mismatch: the weights were modified or damaged", file=file)
     try:
         spec = FeatureSpec.from_json(doc["features"])
-        return DriftModel(doc["method"], list(doc["targets"]), spec, dict(tensors),
-                          dict(doc["interval"]), dict(doc.get("metadata", {})))
+        params = {k: v for k, v in tensors.items() if not k.startswith(VALIDATION)}
+        validation = {k[len(VALIDATION):]: v for k, v in tensors.items()
+                      if k.startswith(VALIDATION)}
+        return DriftModel(doc["method"], list(doc["targets"]), spec, params,
+                          dict(doc["interval"]), dict(doc.get("metadata", {})), validation)
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"malformed model metadata: {exc}", file=file) from None

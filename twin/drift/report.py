@@ -58,6 +58,7 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
         images.append({"title": f"{target}: measured and predicted, residuals",
                        "src": png_data_uri(_png(fig))})
         plt.close(fig)
+    images += _validation_figures(model, plt)
     ranking = model.metadata.get("ranking", {}).get("sensors", [])
     if ranking:
         fig, ax = plt.subplots(figsize=(10, 3.2))
@@ -72,6 +73,37 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
         ax.tick_params(axis="x", rotation=60, labelsize=8)
         fig.tight_layout()
         images.append({"title": "Sensor ranking", "src": png_data_uri(_png(fig))})
+        plt.close(fig)
+    return images
+
+
+def _validation_figures(model: DriftModel, plt) -> list[dict]:  # noqa: ANN001 - pyplot
+    """Out-of-fold predictions of the time-blocked validation at fitting, per target."""
+    v = model.validation
+    if not v:
+        return []
+    t = v["time_s"]
+    step = np.diff(t, prepend=t[0])
+    hours = np.cumsum(np.where(step > 0, step, 0.0)) / 3600.0   # files back to back
+    images = []
+    for j, target in enumerate(model.targets):
+        fig, ax = plt.subplots(figsize=(10, 3.6))
+        for b in np.unique(v["block"]):
+            rows = v["block"] == b
+            if int(b) % 2:
+                ax.axvspan(hours[rows][0], hours[rows][-1], color="0.92", lw=0)
+            ax.fill_between(hours[rows], v["lo_um"][rows, j], v["hi_um"][rows, j],
+                            color="tab:orange", alpha=0.3, lw=0,
+                            label="90 % interval" if b == 0 else None)
+            ax.plot(hours[rows], v["predicted_um"][rows, j], color="tab:orange", lw=1,
+                    label="out-of-fold prediction" if b == 0 else None)
+        ax.plot(hours, v["measured_um"][:, j], color="k", lw=0.8, label="measured")
+        ax.set_ylabel(f"{target} [µm]")
+        ax.set_xlabel("time [h] (each block predicted by a model fitted on the others)")
+        ax.legend(loc="best", fontsize=8)
+        fig.tight_layout()
+        images.append({"title": f"{target}: time-blocked validation at fitting "
+                       f"({model.method})", "src": png_data_uri(_png(fig))})
         plt.close(fig)
     return images
 

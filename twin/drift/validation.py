@@ -31,6 +31,8 @@ class MethodValidation:
     posterior_coverage_pct: list[float] | None  # per target, uncalibrated posterior
 
     pooled_rmse_um: np.ndarray     # (p,) over every out-of-fold row
+    lo: np.ndarray                 # (n, p) the interval calibrated without the row's block
+    hi: np.ndarray
 
     @property
     def mean_rmse_um(self) -> float:
@@ -86,7 +88,7 @@ def validate_method(
                                   predicted[:, j] + Z90 * std[:, j]) for j in range(Y.shape[1])]
     pooled = np.sqrt(np.mean((predicted - Y) ** 2, axis=0))
     return MethodValidation(name, predicted, std, rmse, interval_rule(predicted, std, Y),
-                            coverage, posterior, pooled)
+                            coverage, posterior, pooled, lo, hi)
 
 
 def choose_default(results: Sequence[MethodValidation]) -> str:
