@@ -136,6 +136,7 @@ class SessionState:
     # /POST26 variables: number -> (name, times s, values); FSUM's last total heat, W
     variables: dict[int, tuple[str, np.ndarray, np.ndarray]] = field(default_factory=dict)
     fsum_heat: float | None = None
+    load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving
     recorded_solves: list[dict] = field(default_factory=list)
     model_functions: dict[str, Any] = field(init=False, repr=False)

@@ -419,3 +419,37 @@ SOLVE
 *GET,T_END,NODE,NODE(0.1,0,0),TEMP
 """)
     assert s.params["T_END"] == pytest.approx(20.0 + 80.0 / (1.0 + 50.0 * 0.1 / 20.0), rel=1e-9)
+
+
+def test_lswrite_lssolve_solves_each_written_load_step():
+    """Two load steps written with LSWRITE and solved by LSSOLVE: a slab with T_0 at x = 0
+    and convection h = 50, T_b = 20 at x = L: T(L) = T_b + (T_0 − T_b)/(1 + hL/k)."""
+    s = run("""
+/PREP7
+ET,1,PLANE55
+MP,KXX,1,20
+RECTNG,0,0.1,0,0.05
+ESIZE,0.025
+AMESH,1
+NSEL,S,LOC,X,0.1
+SF,ALL,CONV,50,20
+NSEL,S,LOC,X,0
+D,ALL,TEMP,100
+ALLSEL
+LSWRITE,1
+NSEL,S,LOC,X,0
+D,ALL,TEMP,200
+ALLSEL
+LSWRITE,2
+FINISH
+/SOLU
+LSSOLVE,1,2
+FINISH
+/POST1
+SET,1
+*GET,T_ONE,NODE,NODE(0.1,0,0),TEMP
+SET,2
+*GET,T_TWO,NODE,NODE(0.1,0,0),TEMP
+""")
+    for t0, name in ((100.0, "T_ONE"), (200.0, "T_TWO")):
+        assert s.params[name] == pytest.approx(20.0 + (t0 - 20.0) / 1.25, rel=1e-9)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -167,7 +168,62 @@ def solve(s: SessionState, c: Call) -> None:
     s.say(f"load step {result.load_step}: {result.analysis} solution at time {result.time:g}")
 
 
+def _load_state(s: SessionState) -> dict:
+    """What a load step file holds: the loads on nodes, elements and faces, and the
+    load-step options."""
+    db = s.db
+    return copy.deepcopy({
+        "nodes": {k: v for k, v in db.nodes.arrays.items() if k != "selected"},
+        "elements": {k: v for k, v in db.elements.arrays.items() if k != "selected"},
+        "faces": db.faces, "settings": db.settings, "real_sets": db.real_sets,
+        "node_ids": db.nodes.ids, "element_ids": db.elements.ids})
+
+
+def lswrite(s: SessionState, c: Call) -> None:
+    """LSWRITE,LSNUM: the current loads and options as load step LSNUM (in memory)."""
+    steps = s.load_steps
+    num = c.int(1, max(steps, default=0) + 1, what="LSNUM")
+    if not 1 <= num <= 9999:
+        raise ApdlError(f"field 1 (LSNUM) must lie in 1..9999, got {num}")
+    steps[num] = _load_state(s)
+    s.budget.unsolved = None  # written loads are solved by LSSOLVE
+
+
+def _restore(s: SessionState, num: int) -> None:
+    saved = s.load_steps.get(num)
+    if saved is None:
+        raise ApdlError(f"load step {num} was never written (LSWRITE)")
+    db = s.db
+    if not (np.array_equal(saved["node_ids"], db.nodes.ids) and
+            np.array_equal(saved["element_ids"], db.elements.ids)):
+        raise ApdlError(f"the mesh changed since load step {num} was written")
+    saved = copy.deepcopy(saved)
+    db.nodes.arrays.update(saved["nodes"])
+    db.elements.arrays.update(saved["elements"])
+    db.faces, db.settings, db.real_sets = saved["faces"], saved["settings"], saved["real_sets"]
+
+
+def lsread(s: SessionState, c: Call) -> None:
+    """LSREAD,LSNUM: make load step LSNUM's loads and options the current ones."""
+    _restore(s, c.int(1, 1, what="LSNUM"))
+
+
+def lssolve(s: SessionState, c: Call) -> None:
+    """LSSOLVE,LSMIN,LSMAX,LSINC: read and solve load steps in turn."""
+    first = c.int(1, what="LSMIN")
+    last = c.int(2, first, what="LSMAX")
+    step = c.int(3, 1, what="LSINC")
+    if step < 1:
+        raise ApdlError("field 3 (LSINC) must be ≥ 1")
+    for num in range(first, last + 1, step):
+        _restore(s, num)
+        solve(s, c)
+
+
 COMMANDS = (
+    CommandSpec("LSWRITE", LOADS, 2, lswrite),
+    CommandSpec("LSREAD", LOADS, 2, lsread),
+    CommandSpec("LSSOLVE", SOLU, 3, lssolve),
     # load-step options: MAPDL accepts them in /PREP7 too
     CommandSpec("ANTYPE", LOADS, 4, antype),
     CommandSpec("TIME", LOADS, 1, time),
