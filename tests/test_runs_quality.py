@@ -157,3 +157,18 @@ def test_time_offset_and_ignored_and_empty_columns(tmp_path):
     assert run.time_s[0] == 0.0 and run.duration_s == 299.0
     assert kinds(run) == {"time_offset", "ignored_column", "empty_column"}
     assert run.disp_um is None
+
+
+@pytest.mark.parametrize("size", [3, 11, 21])
+def test_running_median_is_scipys_median_filter(size):
+    # the spike filter's running median must be exactly scipy.ndimage's, edges included
+    from scipy.ndimage import median_filter
+
+    from twin.runs.quality import running_median
+
+    rng = np.random.default_rng(size)
+    for n in (size, size + 1, 600):
+        v = np.round(rng.normal(20.0, 3.0, n), 1)  # rounded: ties, as in a 0.1 °C logger
+        v[n // 2] += 50.0  # a spike
+        np.testing.assert_array_equal(running_median(v, size),
+                                      median_filter(v, size=size, mode="nearest"))
