@@ -7,6 +7,7 @@ vtk          the one field-file writer (VTU per time + ParaView .pvd) and the na
 destinations the checks on every --out before any work starts (inputs, folders, devices)
 html_pages   HTML pages from the jinja2 templates in `templates/` (package data): the
              replay, training and drift reports
+figures      report figures as PNG bytes: a matplotlib Figure on the Agg canvas, no pyplot
 
 Imports are per module (`from twin.io.atomic import write_json`): this package imports
 nothing itself, so a writer never pulls in the plotting or FEM stack it does not need.

@@ -11,7 +11,6 @@ can rebuild it at any time:
 from __future__ import annotations
 
 import csv
-import io
 import json
 from pathlib import Path
 
@@ -19,6 +18,7 @@ import numpy as np
 
 from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.io.atomic import write_bytes, write_json, write_text
+from twin.io.figures import new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
 from twin.loop.summary import collect_summary, run_folder
@@ -41,15 +41,10 @@ def _floats(values: list[str]) -> np.ndarray:
 PLOTS = ("temperatures.png", "drift_corrections.png")
 
 
-def _png(fig) -> bytes:  # noqa: ANN001
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
+def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
     # fixed margins: a "tight" bounding box draws the figure twice (a third of a replay)
     fig.subplots_adjust(left=0.05, right=0.99, bottom=0.17, top=0.9, wspace=0.25)
-    fig.savefig(buf, format="png", dpi=80)
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, dpi=80)
 
 
 def _shade_band(ax, kp: dict, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,  # noqa: ANN001
@@ -66,11 +61,6 @@ def _shade_band(ax, kp: dict, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: s
 def render_run_plots(run_dir: Path) -> list[Path]:
     """Draw a run's report figures into run_dir/plots/ (done by the batch worker that
     replayed the run, so a parallel batch also draws in parallel)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     out: list[bytes] = []
     kp = _read_csv(run_dir / "keypoints.csv")
     if not kp:
@@ -79,7 +69,8 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     method_col = np.array(kp["method"])
     t_min = _floats(kp["time_s"]) / 60.0
 
-    fig, axes = plt.subplots(1, 5, figsize=(17, 3.2), sharex=True)
+    fig = new_figure(figsize=(17, 3.2))
+    axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
         first = method_col == methods[0]
@@ -101,7 +92,8 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     axes[0].legend(fontsize=7)
     out.append(_png(fig))
 
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 3.2))
+    fig = new_figure(figsize=(13, 3.2))
+    ax1, ax2 = fig.subplots(1, 2)
     first = method_col == methods[0]
     meas = _floats(kp["disp_z_meas_um"])[first]
     if np.isfinite(meas).any():
