@@ -22,6 +22,7 @@ MODULES = [
     "bench.synth",
     "bench.correction",
     "bench.loop",
+    "bench.replay_cli",
     "bench.estimator",
     "bench.drift",
 ]
