@@ -63,8 +63,9 @@ class _Base:
 
     def __init__(self, solver: DirichletSolver, U: sp.csc_matrix) -> None:
         self.solver = solver
+        self.Ut = U.T  # once: building it at every time step was a tenth of the solve time
         self.Z = solver.lu.solve(U.toarray()) if U.shape[1] else np.zeros((U.shape[0], 0))
-        self.UtZ = U.T @ self.Z
+        self.UtZ = self.Ut @ self.Z
 
 
 class WoodburySolver:
@@ -73,14 +74,14 @@ class WoodburySolver:
         x = y − Z (I + W Uᵀ Z)⁻¹ W Uᵀ y,   y = A₀⁻¹ b,  Z = A₀⁻¹ U.
     """
 
-    def __init__(self, base: _Base, U: sp.csc_matrix, W: np.ndarray) -> None:
-        self._base, self._U, self._W = base, U, W
+    def __init__(self, base: _Base, W: np.ndarray) -> None:
+        self._base, self._W = base, W
         self._lu = sla.lu_factor(np.eye(W.shape[0]) + W @ base.UtZ)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         y = self._base.solver.solve(rhs)
         base = self._base
-        return y - base.Z @ sla.lu_solve(self._lu, self._W @ (self._U.T @ y))
+        return y - base.Z @ sla.lu_solve(self._lu, self._W @ (base.Ut @ y))
 
 
 class LowRankUpdate:
@@ -109,4 +110,4 @@ class LowRankUpdate:
             if len(self._bases) >= self.max_bases:  # bound memory: drop the oldest
                 self._bases.pop(next(iter(self._bases)))
             cached = self._bases[key] = _Base(base(), self.U)
-        return WoodburySolver(cached, self.U, W)
+        return WoodburySolver(cached, W)
