@@ -85,7 +85,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
                 label=m,
             )
             _shade_band(ax, kp, sel, t_min, f"{s}_twin_lo_C", f"{s}_twin_hi_C", m)
-        ax.set_title(s)
+        ax.set_title(s, y=1.0)
         ax.set_xlabel("time [min]")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("temperature [°C]")
@@ -104,7 +104,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
             t_min[sel], _floats(kp["disp_z_twin_um"])[sel], color=METHOD_COLORS.get(m), label=m
         )
         _shade_band(ax1, kp, sel, t_min, "disp_z_twin_lo_um", "disp_z_twin_hi_um", m)
-    ax1.set_title("axial nose drift")
+    ax1.set_title("axial nose drift", y=1.0)
     ax1.set_xlabel("time [min]")
     ax1.set_ylabel("drift [µm]")
     ax1.grid(alpha=0.3)
@@ -130,7 +130,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
                     color=METHOD_COLORS.get(m),
                     label=f"{m} {key}",
                 )
-    ax2.set_title("correction factors per window")
+    ax2.set_title("correction factors per window", y=1.0)
     ax2.set_xlabel("window")
     ax2.grid(alpha=0.3)
     if ax2.get_lines():  # open loop alone has no factors to show
