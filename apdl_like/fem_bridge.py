@@ -87,6 +87,7 @@ class FemModel:
         self._region_names = {self._key(c): name for name, c in mesh.regions.items()}
         self._boundary_names = {self._key(f): name for name, f in mesh.boundaries.items()}
         self.version = 0
+        self.used_materials: list[int] | None = None  # MAT numbers of the cells (solve.py)
 
     @staticmethod
     def _facets_of(facets: np.ndarray, n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -93,9 +93,10 @@ def _material_key(mats: dict[str, Material]) -> tuple:
 def _material_inputs(session: SessionState, fem: FemModel) -> tuple:
     """What `_materials` reads, cheaply: a window deck re-solves with unchanged materials."""
     db = session.db
-    used = np.unique(db.elements.mat[fem.cell_element]).tolist()
-    props = tuple((m, tuple(sorted(db.materials[m].props.items())) if m in db.materials
-                   else None) for m in used)
+    if fem.used_materials is None:  # the element materials of a FemModel never change
+        fem.used_materials = np.unique(db.elements.mat[fem.cell_element]).tolist()
+    props = tuple((m, tuple(db.materials[m].props.items()) if m in db.materials else None)
+                  for m in fem.used_materials)
     return id(fem), db.settings.antype, props
 
 
