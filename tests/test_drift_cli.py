@@ -111,7 +111,7 @@ def test_out_refuses_an_input_and_a_folder(machine, tmp_path):
     result = run("fit", str(data), "--target", "drift_um", "--out", str(tmp_path))
     assert result.exit_code == 2 and "--out" in result.output
     result = run("select", str(data), "--target", "drift_um", "--out", str(data))
-    assert result.exit_code == 2 and "replace an input" in result.output
+    assert result.exit_code == 2 and "also an input" in result.output
 
 
 def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):

@@ -33,19 +33,12 @@ def _targets(text: str) -> list[str]:
 
 def _check_out_file(out: Path, inputs: Sequence[Path], suffixes: Sequence[str]) -> None:
     """Refuse an --out that is a folder, a special file or one of the inputs (exit 2)."""
-    if out.exists() and not out.is_file():
-        raise InputError("--out must be a regular file, not a folder or a special file",
-                         file=str(out), column="--out")
-    if any(out.resolve() == Path(p).resolve() for p in inputs):
-        raise InputError("--out would replace an input file", file=str(out), column="--out")
+    from twin.io.destinations import check_out_file
+
+    check_out_file(out, inputs=inputs)
     if suffixes and out.suffix.lower() not in suffixes:
         raise InputError(f"--out must end in {' or '.join(suffixes)}", file=str(out),
                          column="--out")
-
-
-def _check_out_dir(out: Path) -> None:
-    if out.exists() and not out.is_dir():
-        raise InputError("--out must be a folder", file=str(out), column="--out")
 
 
 def _check_inputs(paths: Sequence[Path]) -> None:
@@ -161,8 +154,9 @@ def report(
     from twin.drift.data import read_drift_data
     from twin.drift.modelfile import load_drift_model
     from twin.drift.report import write_drift_report
+    from twin.io.destinations import check_out_dir
 
-    _check_out_dir(out)
+    check_out_dir(out, inputs=[model_file, *data], owned=["metrics.json", "report.html"])
     _check_inputs([model_file, *data])
     model = load_drift_model(model_file)
     drift_data = read_drift_data(data, sensors=model.spec.sensors, targets=model.targets,
