@@ -174,3 +174,40 @@ def test_profile_cells_read_like_run_cells(tmp_path, cell):
     with pytest.raises(InputError) as info:
         read_speed_profile(path)
     assert info.value.row == 2 and info.value.column == "speed_rpm"
+
+
+@FAST
+@given(ambient=st.integers(-3500, 6000).map(lambda v: v / 100.0),
+       nan_from=st.integers(0, 150), nan_len=st.integers(0, 150),
+       spike=st.integers(-10_000, 10_000).map(lambda v: v / 100.0),
+       speed=st.sampled_from([0.0, 9000.0, 15000.0, 15001.0]))
+def test_what_the_synth_check_accepts_replay_reads(tmp_path_factory, ambient, nan_from,
+                                                   nan_len, spike, speed):
+    """`check_replayable` (run by `twin synth` before writing) agrees with `read_run` on
+    the written file: synth never writes a run replay refuses, nor refuses one it reads."""
+    import numpy as np
+
+    from twin.runs import check_replayable, write_run
+
+    cols = warmup(n=150)
+    cols["ambient_C"] = np.full(150, ambient)
+    cols["speed_rpm"] = np.full(150, speed)
+    for k in range(1, 6):
+        cols[f"T{k}_C"] = cols[f"T{k}_C"] - 25.0 + ambient
+    cols["T4_C"][nan_from:nan_from + nan_len] = np.nan
+    cols["T1_C"][75] += spike
+    path = tmp_path_factory.mktemp("synth") / "r.csv"
+    try:
+        check_replayable(cols, str(path), max_speed_rpm=15000.0)
+    except InputError:
+        checked = False
+    else:
+        checked = True
+    write_run(path, cols)
+    try:
+        read_run(path, max_speed_rpm=15000.0)
+    except InputError:
+        read = False
+    else:
+        read = True
+    assert checked == read
