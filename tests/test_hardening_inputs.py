@@ -138,3 +138,16 @@ def test_defect5_unbounded_work_from_arguments_refused(tmp_path, args):
                    else a for a in args])
     assert result.exit_code == 2, result.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_synth_profile_with_an_ambient_column(tmp_path):
+    profile = tmp_path / "p.csv"
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,24\n60,9000,25\n")
+    result = cli("synth", "--profile", profile, "--minutes", 2, "--ambient", 25, "--seed", 1,
+                 "--out", tmp_path / "r.csv", "--quiet")
+    assert result.exit_code == 0, result.output
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,50\n")
+    result = cli("synth", "--profile", profile, "--minutes", 2, "--ambient", 25, "--seed", 1,
+                 "--out", tmp_path / "r2.csv", "--quiet")
+    assert result.exit_code == 2 and "p.csv" in result.output and "Fahrenheit" in result.output
+    assert not (tmp_path / "r2.csv").exists()

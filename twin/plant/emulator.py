@@ -149,7 +149,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     duration = float(minutes) * 60.0
     if profile is not None:
         speed = profile.speed_rpm
-        ambient_base = profile.ambient_C.shifted(0.0) if profile.ambient_C else None
+        ambient_base = profile.ambient_C  # a StepTable, or None: then --ambient holds
     else:
         speed = StepTable.constant(float(speed_rpm))
         ambient_base = None
