@@ -126,7 +126,8 @@ def test_model_file_corruption(tmp_path_factory, flips, cut):
     only_input_errors(load_model, path)
 
 
-def _with_metadata(change) -> bytes:  # noqa: ANN001
+def model_with_metadata(change) -> bytes:  # noqa: ANN001
+    """The bundled model's bytes with its metadata dict changed in place by `change`."""
     n = int.from_bytes(_MODEL[:8], "little")
     header = json.loads(_MODEL[8:8 + n])
     meta = json.loads(header["__metadata__"]["spindle_twin"])
@@ -148,7 +149,7 @@ METADATA_VALUES = st.one_of(st.none(), st.integers(-5, 5), st.text(max_size=5),
                         "sha256", "inputs", "outputs", "version", "config"]), METADATA_VALUES)
 def test_model_metadata_of_any_type(tmp_path_factory, key, value):
     path = tmp_path_factory.mktemp("model") / "m.safetensors"
-    path.write_bytes(_with_metadata(lambda m: m.__setitem__(key, value)))
+    path.write_bytes(model_with_metadata(lambda m: m.__setitem__(key, value)))
     only_input_errors(load_model, path)
 
 

@@ -7,24 +7,7 @@ import pytest
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
-
-GOOD = """/PREP7
-ET,1,PLANE55,,,1
-MP,KXX,1,50
-*DO,I,0,4
-N,I+1,0.01+0.01*I,0
-N,I+11,0.01+0.01*I,0.01
-*ENDDO
-*DO,I,1,4
-E,I,I+1,I+11,I+10
-*ENDDO
-/SOLU
-NSEL,S,LOC,X,0.01
-SF,ALL,HFLUX,1E4
-NSEL,S,LOC,X,0.05
-D,ALL,TEMP,20
-ALLSEL
-"""
+from tests.test_apdl_language import VALID_DECK
 
 
 @pytest.mark.timeout(60)
@@ -49,10 +32,10 @@ def test_bad_block_and_number_refused(tmp_path, deck, line, message):
 
 @pytest.mark.timeout(60)
 def test_deltim_cannot_bypass_the_substep_cap(tmp_path):
-    deck = GOOD + "ANTYPE,TRANS\nTIME,100\nDELTIM,1e-9\nSOLVE\n"
+    deck = VALID_DECK.replace("SOLVE\n", "ANTYPE,TRANS\nTIME,100\nDELTIM,1e-9\nSOLVE\n")
     with pytest.raises(ApdlError) as info:
         Session(base_dir=tmp_path).run_text(deck, "deck.inp")
-    assert info.value.line is not None and info.value.line > GOOD.count("\n")
+    assert info.value.line == VALID_DECK.count("\n") - 1 + 3
 
 
 @pytest.mark.timeout(60)

@@ -4,22 +4,19 @@ warnings go to the log."""
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
+from tests.test_fuzz_inputs import model_with_metadata
 from twin.cli import app
 from twin.correction.modelfile import load_model
 from twin.errors import InputError
 from twin.plant.scenario import parse_scenario
 from twin.spindle.spec import load_spec
-
-MODEL = Path(__file__).resolve().parent.parent / "examples" / "correction_model.safetensors"
 
 
 def cli(*args):
@@ -29,16 +26,8 @@ def cli(*args):
 
 
 def with_metadata(tmp_path, change):
-    raw = MODEL.read_bytes()
-    n = int.from_bytes(raw[:8], "little")
-    header = json.loads(raw[8:8 + n])
-    meta = json.loads(header["__metadata__"]["spindle_twin"])
-    change(meta)
-    header["__metadata__"]["spindle_twin"] = json.dumps(meta)
-    text = json.dumps(header).encode()
-    text += b" " * (-len(text) % 8)
     path = tmp_path / "m.safetensors"
-    path.write_bytes(len(text).to_bytes(8, "little") + text + raw[8 + n:])
+    path.write_bytes(model_with_metadata(change))
     return path
 
 
