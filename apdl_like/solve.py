@@ -65,6 +65,14 @@ def _materials(session: SessionState, fem: FemModel, kind: str) -> dict[str, Mat
         if props is None:
             raise ApdlError(f"material {m} is used by elements but has no MP properties")
         p = props.props
+        # twin.fem takes constant, isotropic properties: say so rather than drop the rest
+        for label in ("KXX", "DENS", "C", "EX", "PRXY", "ALPX"):
+            if props.temperature_dependent(label):
+                raise ApdlError(f"material {m}: temperature-dependent {label} is not supported "
+                                "on the spindle session's mesh")
+        if "KYY" in p and p["KYY"] != p.get("KXX"):
+            raise ApdlError(f"material {m}: orthotropic KYY is not supported on the spindle "
+                            "session's mesh")
         # the region of these cells: the mesh's own name when it has exactly this set
         region = fem.region_for(np.nonzero(cell_mat == m)[0])
         try:

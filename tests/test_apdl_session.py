@@ -265,3 +265,13 @@ def test_cli_warns_on_unknown_commands_and_strict_makes_them_errors(tmp_path):
     strict = subprocess.run([*run, "--strict"], capture_output=True, text=True, timeout=120)
     assert strict.returncode == 2 and "d.inp:2: BOGUS" in strict.stderr
     assert "Traceback" not in strict.stderr
+
+
+def test_spindle_session_refuses_what_twin_fem_cannot_solve(mesh):
+    """The spindle session solves on twin.fem (constant, isotropic k): a k(T) or a KYY
+    is an error naming the material, never silently dropped."""
+    for change in ("MP,KXX,1,45,0.01", "MP,KYY,1,3"):
+        s = Session.from_mesh(mesh, {"shaft": STEEL, "sleeve": BRONZE})
+        with pytest.raises(ApdlError, match="material 1"):
+            s.run_text(f"/PREP7\n{change}\nFINISH\n" + window_deck(loadset(0), s.layout),
+                       "w.inp")
