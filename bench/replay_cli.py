@@ -17,7 +17,10 @@ waiting for a core); `load_1min` records how busy the machine was.
 One further run under `python -X importtime` gives the import breakdown: the top-level
 imports by cumulative time and the self time summed per top-level package.  Import times
 under `-X importtime` are wall times and include the tracing overhead: read them as shares,
-not as absolute costs.
+not as absolute costs.  A module shared by several packages is charged to whichever imports
+it first (scipy.ndimage was charged with scipy's array-API layer and numpy.f2py, which
+scipy.sparse loads anyway): check a removal by the CPU time of the cold run, not by the
+importer's cumulative figure.
 
 `python -m bench.replay_cli [--repeats N]` prints the figures as JSON.
 """
