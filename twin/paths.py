@@ -19,24 +19,38 @@ MAX_INPUT_BYTES = 512 * 2**20
 """Largest input file read (512 MiB): a day of 10 Hz samples as CSV is under 100 MiB."""
 
 
-def check_input_file(path: str | os.PathLike[str], *, column: str | None = None,
-                     max_bytes: int = MAX_INPUT_BYTES) -> Path:
-    """`path` if it names an existing regular file of at most `max_bytes`, else InputError."""
-    file = Path(path)
+def regular_file_info(path: str | os.PathLike[str], *, use: str, column: str | None = None,
+                      missing_ok: bool = False) -> os.stat_result | None:
+    """`path`'s stat (through symlinks) if it names a regular file, else InputError.
+
+    `use` says what the command wants the file for ("read file", "use as output") and
+    starts the message when the file cannot be looked at; with `missing_ok` a path with
+    nothing there (or a dangling symlink) gives None instead.
+    """
     try:
-        info = file.stat()
+        info = Path(path).stat()
     except OSError as exc:
-        raise InputError(f"cannot read file: {exc.strerror or exc}", file=str(path),
+        if missing_ok and isinstance(exc, FileNotFoundError):
+            return None
+        raise InputError(f"cannot {use}: {exc.strerror or exc}", file=str(path),
                          column=column) from None
     if stat.S_ISDIR(info.st_mode):
         raise InputError("is a folder, not a file", file=str(path), column=column)
     if not stat.S_ISREG(info.st_mode):
-        raise InputError("is not a regular file (a device, fifo or socket)", file=str(path),
-                         column=column)
+        raise InputError(f"is not a regular file (a device, fifo or socket); cannot {use}",
+                         file=str(path), column=column)
+    return info
+
+
+def check_input_file(path: str | os.PathLike[str], *, column: str | None = None,
+                     max_bytes: int = MAX_INPUT_BYTES) -> Path:
+    """`path` if it names an existing regular file of at most `max_bytes`, else InputError."""
+    info = regular_file_info(path, use="read file", column=column)
+    assert info is not None  # None only with missing_ok
     if info.st_size > max_bytes:
         raise InputError(f"file of {info.st_size} bytes is larger than the {max_bytes} bytes "
                          "an input may have", file=str(path), column=column)
-    return file
+    return Path(path)
 
 
 def read_input_bytes(path: str | os.PathLike[str], *, column: str | None = None,

@@ -21,6 +21,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from twin.errors import InputError
+from twin.paths import regular_file_info
 
 StrPath = str | os.PathLike[str]
 
@@ -51,18 +52,8 @@ def _check_ancestors(target: Path, option: str) -> None:
 
 def refuse_special(target: Path, option: str = "--out") -> None:
     """InputError if `target` exists (through any symlink) and is not a regular file."""
-    try:
-        info = target.stat()
-    except FileNotFoundError:
-        return  # nothing there (or a dangling symlink, which the rename replaces)
-    except OSError as exc:
-        raise InputError(f"cannot use as output: {exc.strerror or exc}", file=str(target),
-                         column=option) from None
-    if stat.S_ISDIR(info.st_mode):
-        raise InputError("is a folder; a file is expected", file=str(target), column=option)
-    if not stat.S_ISREG(info.st_mode):
-        raise InputError("is not a regular file (a device, fifo or socket); refusing to "
-                         "replace it", file=str(target), column=option)
+    # nothing there (or a dangling symlink, which the rename replaces) is fine
+    regular_file_info(target, use="use as output", column=option, missing_ok=True)
 
 
 def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
