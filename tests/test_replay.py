@@ -75,20 +75,17 @@ def invoke(*args):
     return CliRunner().invoke(app, list(args), catch_exceptions=False)
 
 
+def replay(*runs, out, methods, snapshots="none"):
+    """`twin replay RUNS --out OUT --methods M --snapshots S --quiet`."""
+    return invoke("replay", *map(str, runs), "--out", str(out), "--methods", methods,
+                  "--snapshots", snapshots, "--quiet")
+
+
 @pytest.fixture(scope="module")
 def replayed(runs_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("replay")
-    result = invoke(
-        "replay",
-        str(runs_dir / "hot_9000.csv"),
-        "--out",
-        str(out),
-        "--methods",
-        "open_loop,ratio",
-        "--snapshots",
-        "end",
-        "--quiet",
-    )
+    result = replay(runs_dir / "hot_9000.csv", out=out, methods="open_loop,ratio",
+                    snapshots="end")
     assert result.exit_code == 0, result.output
     return out
 
@@ -186,18 +183,7 @@ def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path
     bad.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C\n0,9000,25,25,25,25,25\n")
     before = bad.read_bytes()
     out = tmp_path / "out"
-    result = invoke(
-        "replay",
-        str(bad),
-        str(runs_dir / "hot_9000.csv"),
-        "--out",
-        str(out),
-        "--methods",
-        "open_loop",
-        "--snapshots",
-        "none",
-        "--quiet",
-    )
+    result = replay(bad, runs_dir / "hot_9000.csv", out=out, methods="open_loop")
     assert result.exit_code == 2
     assert "bad.csv" in result.output and "T5_C" in result.output
     assert "Traceback" not in result.output
@@ -209,18 +195,8 @@ def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path
 
 def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_path):
     out = tmp_path / "out"
-    args = [
-        str(runs_dir / "hot_9000.csv"),
-        str(runs_dir / "hot_12000.csv"),
-        "--out",
-        str(out),
-        "--methods",
-        "open_loop",
-        "--snapshots",
-        "none",
-        "--quiet",
-    ]
-    assert invoke("replay", *args).exit_code == 0
+    runs = [runs_dir / "hot_9000.csv", runs_dir / "hot_12000.csv"]
+    assert replay(*runs, out=out, methods="open_loop").exit_code == 0
     # an interrupted run: its done-token never got written
     (out / "hot_12000" / ".done.json").unlink()
     stamp = (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns
@@ -228,7 +204,7 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
 
     seen = []
     result = replay_batch(
-        [runs_dir / "hot_9000.csv", runs_dir / "hot_12000.csv"],
+        runs,
         out,
         ["open_loop"],
         None,
