@@ -82,7 +82,8 @@ def test_monotone_warm_up_at_constant_speed(truth_spindle):
     # more than the sensor noise below the running maximum
     drop = np.maximum.accumulate(T, axis=0) - T
     assert drop.max() < 0.05
-    assert np.all(T[-1] - T[0] > 0.5)
+    # the housing (T5) warms least: about 0.5 K in 30 min, less with a strong housing film
+    assert np.all(T[-1] - T[0] > 0.3)
     assert np.all(np.diff(truth.disp_z_um) >= -1e-9)
     assert 4.0 < truth.disp_z_um[-1] < 15.0  # the reference system: 8.47 µm
 

@@ -7,7 +7,10 @@ The truth differs from the twin's nominal model the way a real spindle does (see
 `twin.plant.truth`): a finer mesh (`Scenario.model.size_factor`), shorter steps (2 s
 instead of 4 s), bearing heat and contact resistance multiplied by time-varying truth
 factors, coolant inlet and ambient drifting, X/Y drift the axisymmetric model cannot
-produce.  The nominal loads themselves follow the truth's own state as in the twin
+produce, and model-form error the twin's corrections cannot express: motor loss and
+film-group factors, scaled material conductivity and expansion, thermocouples a little
+off their nominal points.  A stop (speed 0) has no bearing or motor heat and the
+standstill film coefficients; the truth simply cools down.  The nominal loads themselves follow the truth's own state as in the twin
 (`nominal_conditions` with the ring and sleeve temperatures: oil viscosity, Eq. 5 fit),
 re-evaluated every `UPDATE_S`.  The sensors then add thermocouple lag, noise and faults.
 
@@ -30,12 +33,48 @@ from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
 from twin.plant.sensors import add_noise, apply_faults, first_order_lag
 from twin.plant.timetable import StepTable
-from twin.plant.truth import TruthTables, default_tables, truth_tables
+from twin.plant.truth import (
+    FILM_GROUPS,
+    ModelForm,
+    TruthTables,
+    default_model_form,
+    default_tables,
+    sensor_offsets_mm,
+    truth_tables,
+)
 
 DT_S = 2.0
 """Truth time step, s (the twin uses 4 s)."""
 UPDATE_S = 20.0
 """The truth's loads are re-evaluated this often, s (the twin corrects every 60 s)."""
+
+
+
+def truth_model(nominal, form: ModelForm | None = None):  # noqa: ANN001, ANN201 - SpindleModel
+    """The truth's spindle model: the nominal one (`nominal`, a SpindleModel) with the
+    material factors and sensor offsets of `form` (None or all neutral: `nominal` itself).
+
+    Conductivity and expansion multiply every material's value, so the contact resistance
+    of Eq. 4/5 (harmonic-mean conductivity, ring and sleeve expansion) follows them too.
+    The mesh is the nominal one; only the operators are assembled again (about 0.5 s).
+    """
+    if form is None or (form.conductivity == 1.0 and form.expansion == 1.0
+                        and not any(any(o) for o in form.sensor_offsets_mm.values())):
+        return nominal
+    spec = nominal.spec
+    materials = {
+        name: m.model_copy(update={
+            "conductivity_W_per_mK": m.conductivity_W_per_mK * form.conductivity,
+            "expansion_per_K": m.expansion_per_K * form.expansion})
+        for name, m in spec.materials.items()}
+    sensors = dict(spec.sensors)
+    for name, (dr, dz) in form.sensor_offsets_mm.items():
+        p = sensors[name]
+        sensors[name] = p.model_copy(update={"r_mm": p.r_mm + dr, "z_mm": p.z_mm + dz})
+    truth_spec = spec.model_copy(update={"materials": materials, "sensors": sensors})
+    return type(nominal).from_mesh_file(truth_spec, nominal.spec_path, nominal.mesh_path,
+                                        nominal.order)
+
 
 @dataclass
 class TruthRun:
@@ -47,6 +86,7 @@ class TruthRun:
     loads: dict[str, np.ndarray]  # per step (n+1,): H/R nominal and true, speed, ...
     heat_in_W: np.ndarray  # (n,)
     residual_W: np.ndarray  # (n,) energy balance of each step
+    final_field_C: np.ndarray | None = None  # (n_dofs,) the temperature field at the end
 
 
 @dataclass
@@ -88,9 +128,11 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
     sensors = np.empty((n + 1, S.shape[0]))
     disp = np.zeros(n + 1)
     sensors[0] = S @ T
+    form = tables.form
     names = ("speed_rpm", "H_front_nominal", "H_rear_nominal", "R_front_nominal",
              "R_rear_nominal", "H_front", "H_rear", "R_front", "R_rear", "coolant_C",
-             "ambient_C")
+             "ambient_C", "factor_H_front", "factor_H_rear", "factor_R_front", "factor_R_rear",
+             "factor_motor", *(f"factor_film_{g}" for g in FILM_GROUPS))
     loads_log = {k: np.empty(n + 1) for k in names}
     heat_in, residual = np.empty(n), np.empty(n)
     films_at_speed: dict[float, dict[str, float]] = {}
@@ -105,16 +147,26 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
         # (≪ 1 % per K): hold them per speed so that the drift of the ambient and coolant
         # moves only the bulk temperatures, and the step matrix factorization is reused.
         h = films_at_speed.setdefault(bc.speed_rpm, {k: v[0] for k, v in bc.convection.items()})
-        bc = replace(bc, convection={k: (h[k], v[1]) for k, v in bc.convection.items()})
-        true = {"H_front": bc.H_front * float(tables.H_front(t[a])),
-                "H_rear": bc.H_rear * float(tables.H_rear(t[a])),
-                "R_front": bc.R_front * float(tables.R_front(t[a])),
-                "R_rear": bc.R_rear * float(tables.R_rear(t[a]))}
+        # model-form error: film groups and motor loss off their correlations/catalogue
+        bc = replace(bc, convection={k: (h[k] * form.film_factor(k, t[a]), v[1])
+                                     for k, v in bc.convection.items()},
+                     motor_heat={r: q * float(form.motor_heat(t[a]))
+                                 for r, q in bc.motor_heat.items()})
+        factors = {"factor_H_front": float(tables.H_front(t[a])),
+                   "factor_H_rear": float(tables.H_rear(t[a])),
+                   "factor_R_front": float(tables.R_front(t[a])),
+                   "factor_R_rear": float(tables.R_rear(t[a])),
+                   "factor_motor": float(form.motor_heat(t[a])),
+                   **{f"factor_film_{g}": float(form.film[g](t[a])) for g in FILM_GROUPS}}
+        true = {"H_front": bc.H_front * factors["factor_H_front"],
+                "H_rear": bc.H_rear * factors["factor_H_rear"],
+                "R_front": bc.R_front * factors["factor_R_front"],
+                "R_rear": bc.R_rear * factors["factor_R_rear"]}
         loads = bc.to_thermal_loads(**true)
         row = {"speed_rpm": bc.speed_rpm, "H_front_nominal": bc.H_front,
                "H_rear_nominal": bc.H_rear, "R_front_nominal": bc.R_front,
                "R_rear_nominal": bc.R_rear, **true, "coolant_C": bc.coolant_C,
-               "ambient_C": bc.ambient_C}
+               "ambient_C": bc.ambient_C, **factors}
         for k, v in row.items():
             loads_log[k][a:b] = v
         stepper = thermal.transient(loads, dt=dt, theta=1.0)
@@ -127,7 +179,7 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
     for k in names:
         loads_log[k][n] = loads_log[k][n - 1]
     return TruthRun(time_s=t, sensors_C=sensors, disp_z_um=disp * 1e6, loads=loads_log,
-                    heat_in_W=heat_in, residual_W=residual)
+                    heat_in_W=heat_in, residual_W=residual, final_field_C=T)
 
 
 def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float | None = None,
@@ -139,8 +191,9 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
 
     Exactly one of `speed_rpm` (constant) and `profile` is given.  `coolant_C` is the
     coolant inlet at the start (default: the ambient, like the nominal model).  `model`
-    overrides the truth's SpindleModel (default: the reference spindle at the scenario's
-    size factor).
+    is the truth's nominal SpindleModel, loaded once by a caller that synthesizes many
+    runs (default: the reference spindle at the scenario's size factor, loaded here); the
+    run's material factors and sensor offsets are applied on top (`truth_model`).
     """
     start = time.perf_counter()
     if (speed_rpm is None) == (profile is None):
@@ -159,17 +212,24 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         from twin.spindle import SpindleModel
 
         model = SpindleModel.load(size_factor=scenario.model.size_factor)
-    limit = model.spec.spindle.max_speed_rpm
+    spec = model.spec
+    limit = spec.spindle.max_speed_rpm
     if np.max(speed.values) > limit:
         raise InputError(f"speed {np.max(speed.values):g} rpm exceeds the spindle's limit "
                          f"{limit:g} rpm", file=profile_name, column="speed_rpm")
 
-    truth_seed, noise_seed = np.random.SeedSequence(seed).spawn(2)
+    # the first two streams are those of the runs before model-form error existed
+    truth_seed, noise_seed, form_seed, place_seed = np.random.SeedSequence(seed).spawn(4)
     coolant0 = float(ambient_base(0.0)) if coolant_C is None else float(coolant_C)
     defaults = default_tables(np.random.default_rng(truth_seed), duration, speed,
                               ambient_base, coolant0)
-    tables = truth_tables(scenario, defaults)
-    truth = run_truth(model, duration, speed, tables)
+    nominal_points = {n: (p.r_mm, p.z_mm) for n, p in spec.sensors.items()}
+    offsets = sensor_offsets_mm(np.random.default_rng(place_seed),
+                                scenario.sensors.placement_mm, nominal_points, spec.inside_body)
+    form = replace(default_model_form(np.random.default_rng(form_seed)),
+                   sensor_offsets_mm=offsets)
+    tables = truth_tables(scenario, replace(defaults, form=form))
+    truth = run_truth(truth_model(model, tables.form), duration, speed, tables)
 
     # --- what the test stand records -------------------------------------------------
     rng = np.random.default_rng(noise_seed)
@@ -197,9 +257,6 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     truth_cols = {"time_s": t_out}
     for k, v in truth.loads.items():
         truth_cols[k] = v[step_index]  # held over each update interval
-    for side in ("front", "rear"):
-        truth_cols[f"factor_H_{side}"] = truth_cols[f"H_{side}"] / truth_cols[f"H_{side}_nominal"]
-        truth_cols[f"factor_R_{side}"] = truth_cols[f"R_{side}"] / truth_cols[f"R_{side}_nominal"]
     for j, s in enumerate(SENSOR_NAMES):
         truth_cols[f"{s}_true_C"] = np.interp(t_out, truth.time_s, truth.sensors_C[:, j])
     truth_cols.update(disp_z_true_um=disp_z, disp_x_true_um=x_true, disp_y_true_um=y_true)
@@ -212,25 +269,34 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         "name": f"synth_{label}_{minutes:g}min_seed{seed}",
         "source": "twin synth (emulated spindle)",
         "speed_rpm": f"{speed_rpm:g}" if speed_rpm is not None else "profile",
-        "profile": profile_name or "",
+        # file names only: the run must not depend on the folder it was made from
+        "profile": Path(profile_name).name if profile_name else "",
         "minutes": f"{minutes:g}",
         "ambient_C": f"{float(tables.ambient_C(0.0)):g}",
-        "coolant_C": f"{coolant0:g}",
+        "coolant_C": f"{float(tables.coolant_C(0.0)):g}",
         "seed": str(seed),
         "rate_hz": f"{rate_hz:g}",
-        "scenario": scenario_name or "",
+        "scenario": Path(scenario_name).name if scenario_name else "",
         "truth_mesh_size_factor": f"{scenario.model.size_factor:g}",
         "thermocouple_lag_s": f"{sensors.lag_s:g}",
         "noise_C": f"{sensors.noise_C:g}",
         "noise_um": f"{sensors.noise_um:g}",
         "displacement_reference": "probes zeroed at t = 0 (cold start)",
     }
+    truth_metadata = {
+        "conductivity_factor": f"{tables.form.conductivity:.6g}",
+        "expansion_factor": f"{tables.form.expansion:.6g}",
+        **{f"{n}_offset_mm": f"{dr + 0.0:.4f} {dz + 0.0:.4f}"  # + 0.0: no "-0.0000"
+           for n, (dr, dz) in sorted(tables.form.sensor_offsets_mm.items())},
+    }
     metadata = {k: v for k, v in metadata.items() if v != ""}
-    rel = np.abs(truth.residual_W) / np.maximum(np.abs(truth.heat_in_W), 1e-12)
+    # relative to the run's peak heat input: a stop has no heat input to compare with
+    rel = np.abs(truth.residual_W) / max(float(np.abs(truth.heat_in_W).max()), 1e-12)
     return SynthRun(columns=columns, metadata=metadata, truth=truth_cols,
                     elapsed_s=time.perf_counter() - start,
                     max_relative_residual=float(rel.max()),
-                    extra={"truth_run": truth, "tables": tables})
+                    extra={"truth_run": truth, "tables": tables,
+                           "truth_metadata": truth_metadata})
 
 
 def truth_path_for(run_path: Path) -> Path:
@@ -251,7 +317,8 @@ def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:
     formats = {k: "%.6g" for k in run.truth if k.startswith(("H_", "R_"))}
     formats.update({k: "%.5f" for k in run.truth if k.startswith("factor_")})
     write_csv_table(truth_path, run.truth,
-                    {"run": out.name, "note": "evaluation only: the twin never reads this file"},
+                    {"run": out.name, "note": "evaluation only: the twin never reads this file",
+                     **run.extra.get("truth_metadata", {})},
                     formats)
     # the run is named after its file, as every command names its outputs
     write_run(out, run.columns, {**run.metadata, "name": out.stem})

@@ -1,22 +1,45 @@
 """Scenario TOML of the emulated spindle (shared DESIGN.md, "Emulator inputs").
 
 Every table is a time series linearly interpolated in time; anything left out takes the
-emulator's default (see `twin.plant.truth`), so an evaluator can pin exactly the truth
-factors a test case needs:
+emulator's seeded default (see `twin.plant.truth`), so an evaluator can pin exactly the
+truth factors a test case needs.  The first group moves the four values the twin's
+corrections estimate:
 
     [bearing_heat.front]            # multiplier on the nominal (Palmgren) heat
     time_s = [0, 300, 1800]
     factor = [1.00, 1.12, 1.04]
-    [contact_resistance.rear]       # multiplier on the nominal ring/sleeve resistance
+    [bearing_heat.rear]             # same form
+    [contact_resistance.front]      # multiplier on the nominal ring/sleeve resistance
+    [contact_resistance.rear]
     [coolant]      time_s, inlet_C  # inlet temperature °C
     [ambient]      time_s, ambient_C   (overrides --ambient)
     [xy_drift]     time_s, x_um, y_um  (radial drift an axisymmetric model cannot explain)
-    [sensors]      noise_C, lag_s, noise_um
+
+The second group is *model-form error*: what a real spindle gets wrong that those four
+values cannot express (REFERENCE.md §7).  It applies to the truth only; the twin keeps
+its nominal model:
+
+    [motor_heat]   time_s, factor   multiplier on the motor loss (rotor and stator)
+    [film.coolant] time_s, factor   multiplier on the film coefficients of a surface group:
+    [film.housing]                    coolant = jacket channels; housing = outer housing
+    [film.air_gap]                    and mount; air_gap = rotor and stator gap faces;
+    [film.rotor]                      rotor = rotor ends, shaft ends, nose, internal air
+    [material]     conductivity = 0.92, expansion = 1.05
+                   constant multipliers on every material's conductivity and expansion
+                   coefficient (the contact resistance of Eq. 4/5 follows them)
+
+Sensors and faults:
+
+    [sensors]      noise_C, lag_s, noise_um,
+                   placement_mm   each thermocouple sits up to this far from its nominal
+                                  point (a seeded offset that stays inside the solid)
     [faults]       stuck = ["T2"], dropouts = [{sensor, start_s, end_s}],
                    spikes = [{sensor, time_s, size}]   (size in °C or µm)
     [model]        size_factor     (mesh refinement of the truth model; < 1 is finer)
 
-Unknown keys are errors (a typo must not silently fall back to a default).
+Unknown keys are errors naming the file and line (a typo must not silently fall back to
+a default).  `dump_scenario` writes a `Scenario` back as TOML that parses to the same
+values (the `twin synth --suite` files).
 """
 
 from __future__ import annotations
@@ -125,10 +148,30 @@ class PerBearing(_Strict):
     rear: FactorTable | None = None
 
 
+class FilmGroups(_Strict):
+    """Multipliers on the film coefficients of the four surface groups (`FILM_GROUPS`)."""
+
+    coolant: FactorTable | None = None
+    housing: FactorTable | None = None
+    air_gap: FactorTable | None = None
+    rotor: FactorTable | None = None
+
+
+Multiplier = Annotated[float, Field(ge=0.5, le=2.0)]
+
+
+class MaterialFactors(_Strict):
+    """Constant multipliers on the truth's material data (None: the seeded default)."""
+
+    conductivity: Multiplier | None = None
+    expansion: Multiplier | None = None
+
+
 class Sensors(_Strict):
     noise_C: Annotated[float, Field(ge=0.0, le=5.0)] = 0.05
     lag_s: Annotated[float, Field(ge=0.0, le=600.0)] = 8.0
     noise_um: Annotated[float, Field(ge=0.0, le=10.0)] = 0.1
+    placement_mm: Annotated[float, Field(ge=0.0, le=10.0)] = 1.0
 
 
 class _SensorRef(_Strict):
@@ -183,6 +226,9 @@ class Scenario(_Strict):
     coolant: CoolantTable | None = None
     ambient: AmbientTable | None = None
     xy_drift: XYDriftTable | None = None
+    motor_heat: FactorTable | None = None
+    film: FilmGroups = FilmGroups()
+    material: MaterialFactors = MaterialFactors()
     sensors: Sensors = Sensors()
     faults: Faults = Faults()
     model: ModelOptions = ModelOptions()
@@ -224,6 +270,19 @@ def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
             message = "unknown key (check the spelling)"
         raise InputError(message, file=file, row=_line_of(text, loc),
                          column=".".join(str(k) for k in loc) or None) from None
+
+
+def dump_scenario(scenario: Scenario, header: str = "") -> str:
+    """TOML text of a scenario (tables left at their default are left out).
+
+    Floats are written with `repr`, so `parse_scenario(dump_scenario(s)) == s` exactly;
+    `header` becomes leading `#` comment lines.
+    """
+    import tomli_w
+
+    data = scenario.model_dump(exclude_none=True, exclude_defaults=True)
+    comments = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
+    return comments + tomli_w.dumps(data)
 
 
 def load_scenario(path: str | os.PathLike[str] | None) -> Scenario:

@@ -16,12 +16,34 @@ coolant        inlet temperature drifts up as the chiller loads, with a small hy
                oscillation; ambient drifts slowly; both as time tables.
 X/Y drift      a few µm of radial drift an axisymmetric model cannot produce (asymmetric
                housing, motor cable side), growing like the warm-up.
+
+Model-form error (REFERENCE.md §7): what the four corrected values cannot express.  With
+no scenario table, each is a constant drawn once per run (`default_model_form`):
+
+    =====================  ==========================  ==================================
+    factor                 default (uniform)           applies to
+    =====================  ==========================  ==================================
+    motor_heat             0.85 – 1.15  (±15 %)        motor loss, rotor and stator
+    film.coolant           0.75 – 1.25  (±25 %)        jacket channels
+    film.housing           0.75 – 1.25                 outer housing, mount
+    film.air_gap           0.75 – 1.25                 rotor and stator gap faces
+    film.rotor             0.75 – 1.25                 rotor/shaft ends, nose, internal air
+    material.conductivity  0.95 – 1.05  (±5 %)         every material's k (and Eq. 4's k)
+    material.expansion     0.97 – 1.03  (±3 %)         every material's α (and Eq. 5's α)
+    sensors.placement_mm   1.0 mm (scenario default)   each thermocouple's point
+    =====================  ==========================  ==================================
+
+The spread follows the published uncertainty of each input (catalogue motor efficiency
+±20–30 %, film correlations ±20–40 %, material data ±5–10 %) taken at about two thirds,
+so a default run is a plausible spindle rather than a worst case.  A stop (speed 0) has
+no bearing or motor heat and standstill film coefficients whatever the factors.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,6 +52,48 @@ from twin.plant.timetable import TimeTable
 
 REFERENCE_SPEED_RPM = 9000.0
 TABLE_STEP_S = 10.0
+
+FILM_GROUPS: dict[str, tuple[str, ...]] = {
+    "coolant": ("coolant",),
+    "housing": ("housing_outer", "mount"),
+    "air_gap": ("air_gap_rotor", "air_gap_stator"),
+    "rotor": ("rotor_end_front", "rotor_end_rear", "nose_face", "nose_outer", "shaft_rear",
+              "shaft_internal", "internal_air"),
+}
+"""Surface groups of the `[film.*]` factors → the spec's boundary names."""
+
+DEFAULT_FORM_RANGES: dict[str, tuple[float, float]] = {
+    "motor_heat": (0.85, 1.15),
+    "film": (0.75, 1.25),
+    "conductivity": (0.95, 1.05),
+    "expansion": (0.97, 1.03),
+}
+"""Uniform ranges of the default model-form factors (see the module doc)."""
+
+
+@dataclass(frozen=True)
+class ModelForm:
+    """Model-form error of the truth: factors the twin's corrections do not estimate.
+
+    motor_heat, film[group]: multipliers as functions of time (s); conductivity,
+    expansion: constant multipliers on every material; sensor_offsets_mm: name → (Δr, Δz)
+    of each thermocouple from its nominal point (set by the emulator, which knows the
+    solid).
+    """
+
+    motor_heat: TimeTable = field(default_factory=lambda: TimeTable.constant(1.0))
+    film: Mapping[str, TimeTable] = field(
+        default_factory=lambda: {g: TimeTable.constant(1.0) for g in FILM_GROUPS})
+    conductivity: float = 1.0
+    expansion: float = 1.0
+    sensor_offsets_mm: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+
+    def film_factor(self, boundary: str, t_s: float) -> float:
+        """Multiplier on the film coefficient of a spec boundary at time t_s."""
+        for group, boundaries in FILM_GROUPS.items():
+            if boundary in boundaries:
+                return float(self.film[group](t_s))
+        raise ValueError(f"boundary {boundary!r} belongs to no film group")
 
 
 @dataclass(frozen=True)
@@ -44,6 +108,7 @@ class TruthTables:
     ambient_C: TimeTable
     x_um: TimeTable
     y_um: TimeTable
+    form: ModelForm = field(default_factory=ModelForm)
 
 
 def speed_scale(speed_rpm: np.ndarray) -> np.ndarray:
@@ -93,12 +158,55 @@ def default_tables(rng: np.random.Generator, duration_s: float,
                        y_um=TimeTable(t, drift[1]))
 
 
+def default_model_form(rng: np.random.Generator) -> ModelForm:
+    """Seeded default model-form factors, constant over the run (`DEFAULT_FORM_RANGES`)."""
+    r = DEFAULT_FORM_RANGES
+    motor = TimeTable.constant(rng.uniform(*r["motor_heat"]))
+    film = {g: TimeTable.constant(rng.uniform(*r["film"])) for g in FILM_GROUPS}
+    return ModelForm(motor_heat=motor, film=film, conductivity=float(rng.uniform(*r["conductivity"])),
+                     expansion=float(rng.uniform(*r["expansion"])))
+
+
+def sensor_offsets_mm(rng: np.random.Generator, placement_mm: float,
+                      sensors: Mapping[str, tuple[float, float]],
+                      inside: Callable[[float, float], bool]) -> dict[str, tuple[float, float]]:
+    """(Δr, Δz) mm per thermocouple, uniform over the disk of radius `placement_mm`.
+
+    An offset that would leave the solid (`inside(r_mm, z_mm)` false) is drawn again; after
+    50 misses (a sensor on a thin wall) the offset is halved until the point is inside.
+    Always draws the same number of random numbers per sensor, so one sensor's fate does
+    not reshuffle the others.
+    """
+    out = {}
+    for name, (r, z) in sensors.items():
+        tries = rng.uniform(size=(50, 2))
+        radius = placement_mm * np.sqrt(tries[:, 0])
+        angle = 2.0 * math.pi * tries[:, 1]
+        offsets = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+        hit = next((o for o in offsets if r + o[0] >= 0 and inside(r + o[0], z + o[1])), None)
+        if hit is None:
+            hit = offsets[0]
+            while not (r + hit[0] >= 0 and inside(r + hit[0], z + hit[1])):
+                hit = 0.5 * hit
+        out[name] = (float(hit[0]), float(hit[1]))
+    return out
+
+
 def truth_tables(scenario: Scenario, defaults: TruthTables) -> TruthTables:
     """The scenario's tables where given, the defaults elsewhere."""
     def pick(table, default: TimeTable) -> TimeTable:
         return default if table is None else table.table()
 
     xy = scenario.xy_drift
+    d = defaults.form
+    material = scenario.material
+    form = ModelForm(
+        motor_heat=pick(scenario.motor_heat, d.motor_heat),
+        film={g: pick(getattr(scenario.film, g), d.film[g]) for g in FILM_GROUPS},
+        conductivity=d.conductivity if material.conductivity is None else material.conductivity,
+        expansion=d.expansion if material.expansion is None else material.expansion,
+        sensor_offsets_mm=d.sensor_offsets_mm,
+    )
     return TruthTables(
         H_front=pick(scenario.bearing_heat.front, defaults.H_front),
         H_rear=pick(scenario.bearing_heat.rear, defaults.H_rear),
@@ -108,4 +216,5 @@ def truth_tables(scenario: Scenario, defaults: TruthTables) -> TruthTables:
         ambient_C=pick(scenario.ambient, defaults.ambient_C),
         x_um=defaults.x_um if xy is None else TimeTable(xy.time_s, xy.x_um),
         y_um=defaults.y_um if xy is None else TimeTable(xy.time_s, xy.y_um),
+        form=form,
     )
