@@ -98,6 +98,11 @@ class WindowFeatures:
     nominal: Eq. 1 / Eq. 4 values at the current speed; previous: last window's values
     (equal to nominal for window 0); previous_nominal: the nominal values the previous
     window had (None: unchanged), so a correction can carry over a speed change as a factor.
+
+    A stop (speed 0) is an ordinary window: the nominal bearing heat is 0 and so is any
+    corrected heat (a stopped bearing has no heat to correct).  `previous_factors` carries
+    each value's correction factor (value / nominal) through the stop, so the correction
+    the spindle had before the stop resumes when it restarts.
     """
 
     window: int
@@ -118,6 +123,10 @@ class WindowFeatures:
     measured_drift_um: np.ndarray | None = None
     """(n,) the recorded axial nose drift at `measured_time_s` (NaN: invalid; None: not
     recorded).  Only an estimator told to assimilate it reads it."""
+    previous_factors: tuple[float, float, float, float] | None = None
+    """Per value, the factor value / nominal of the last window in which the value was not
+    0 (a stopped bearing keeps the factor it had before the stop).  None: derived from
+    `previous` and `previous_nominal`, 1 where those are 0."""
 
     def __post_init__(self) -> None:
         pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))
@@ -125,10 +134,26 @@ class WindowFeatures:
             values = getattr(self, f"{name}_C")
             if np.ndim(values) != 2 or np.shape(values)[1] != 5 or len(values) != len(rows):
                 raise ValueError(f"WindowFeatures.{name}_C must be ({len(rows)}, 5)")
-        if not all(v > 0 for v in self.nominal):
-            raise ValueError("WindowFeatures.nominal values must be positive")
-        if not all(v > 0 for v in self.previous):
-            raise ValueError("WindowFeatures.previous values must be positive")
+        for name in ("nominal", "previous", "previous_nominal"):
+            values = getattr(self, name)
+            if values is not None and not values_allowed(values):
+                raise ValueError(f"WindowFeatures.{name}: heats must be ≥ 0 (0 at a stop) "
+                                 "and resistances positive")
+        if self.previous_factors is not None and not all(
+                np.isfinite(v) and v > 0 for v in self.previous_factors):
+            raise ValueError("WindowFeatures.previous_factors must be positive")
+
+    def previous_factor(self) -> np.ndarray:
+        """Per value, the previous window's correction factor (see `previous_factors`)."""
+        if self.previous_factors is not None:
+            return np.asarray(self.previous_factors, dtype=float)
+        return correction_factors(self.previous, self.previous_nominal or self.nominal)
+
+    def carried_previous(self) -> np.ndarray:
+        """The previous window's values carried to the current nominal values: a speed
+        change moves them with the nominal (a factor), a stop takes the heat to 0 and a
+        restart brings back the factor from before the stop."""
+        return self.previous_factor() * np.asarray(self.nominal, dtype=float)
 
     def measured_now(self) -> np.ndarray:
         """T1..T5 measured: the last finite sample at or before the window start (°C)."""
@@ -152,6 +177,21 @@ class WindowFeatures:
             simulated_C=self.simulated_now()[None, :],
             nominal=np.asarray(self.nominal, dtype=float)[None, :],
         )
+
+
+def values_allowed(values: ArrayLike) -> bool:
+    """True for four boundary values with heats ≥ 0 (0 at a stop) and resistances > 0."""
+    v = np.asarray(values, dtype=float)
+    return bool(np.all(np.isfinite(v)) and np.all(v[:2] >= 0) and np.all(v[2:] > 0))
+
+
+def correction_factors(values: ArrayLike, nominal: ArrayLike,
+                       fallback: ArrayLike | float = 1.0) -> np.ndarray:
+    """values / nominal, or `fallback` where the nominal value is 0 (a stopped bearing)."""
+    v = np.asarray(values, dtype=float)
+    nom = np.asarray(nominal, dtype=float)
+    running = nom > 0
+    return np.where(running, v / np.where(running, nom, 1.0), fallback)
 
 
 def last_at_or_before(time_s: ArrayLike, values: ArrayLike, t_s: float) -> np.ndarray:

@@ -235,11 +235,12 @@ def limit_to_nominal(
 ) -> np.ndarray:
     """Clip a corrected heat or resistance into `guards.value_limits` × its nominal value.
 
-    Non-finite values become the nominal value.
+    Non-finite values become the nominal value.  A nominal value of 0 (the heat of a
+    stopped bearing) gives 0: there is no heat to correct.
     """
     nom = np.asarray(nominal, dtype=float)
-    if np.any(~(nom > 0)):
-        raise ValueError("nominal heat and resistance must be positive")
+    if np.any(~(nom >= 0)):
+        raise ValueError("nominal heat and resistance must be ≥ 0")
     low, high = guards.value_limits
     val = np.asarray(value, dtype=float)
     # a non-finite value (e.g. a network fed a NaN) falls back to the nominal value

@@ -107,16 +107,17 @@ class RatioCorrection:
         nominal = np.asarray(f.nominal, dtype=float)
         a, b, c = self.gains
         values = np.empty(4)
+        # the previous window's values, carried to the current nominal level (a speed
+        # change moves them with the nominal, a stop takes the heat to 0)
+        carried = f.carried_previous()
         for k, bearing in enumerate(BEARINGS):
             ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
-            # the previous window's value, carried to the current speed's nominal level
-            prev_nominal = f.nominal if f.previous_nominal is None else f.previous_nominal
-            speed_scale = nominal / np.asarray(prev_nominal, dtype=float)
-            H_prev = f.previous[k] * _carry(speed_scale[k])
-            R_prev = f.previous[2 + k] * _carry(speed_scale[2 + k])
+            H_prev, R_prev = carried[k], carried[2 + k]
             H1 = H_prev * total_rise_ratio(meas_now[ring], sim_now[ring], f.ambient_C, g) ** a
             C_H = window_rise_ratio(meas_rise[ring], sim_rise[ring], g) ** b
             values[k] = limit_to_nominal(heat_second_correction(H1, C_H), nominal[k], g)
+            # a stopped bearing (no heat): its heat change explains none of the drop
+            heat_change = values[k] / H_prev if H_prev > 0 else 1.0
             fp_now = contact_pressure_factor(
                 meas_now[ring] - meas_initial[ring], meas_now[sleeve] - meas_initial[sleeve],
                 self.fits[k], g,
@@ -131,14 +132,9 @@ class RatioCorrection:
             ) ** c
             # the drop is heat flux × resistance: the part of the drop ratio explained by
             # this window's heat correction is not put on the resistance
-            values[2 + k] = resistance_second_correction(R1, C_C / (values[k] / H_prev) ** c)
+            values[2 + k] = resistance_second_correction(R1, C_C / heat_change ** c)
         values = limit_to_nominal(values, nominal, g)
         return Correction.relative_to(values, f.previous)
-
-
-def _carry(scale: float) -> float:
-    # nominal values follow the speed; the previous values follow them proportionally
-    return float(scale) if np.isfinite(scale) and scale > 0 else 1.0
 
 
 @dataclass(frozen=True)
@@ -148,7 +144,7 @@ class BpnnCorrection:
     Inference is plain numpy on the loaded weights (no torch needed at replay time).
     Non-finite network inputs (a dead sensor) fall back to the previous window's correction
     factor on the current nominal value; the output is kept within the guards' band around
-    the nominal value.
+    the nominal value.  A stopped bearing has no heat: its heat network is not asked.
     """
 
     model: object = field(repr=False)
@@ -158,16 +154,18 @@ class BpnnCorrection:
     def correct(self, features: WindowFeatures) -> Correction:
         inputs = features.network_inputs()
         nominal = np.asarray(features.nominal, dtype=float)
-        previous = np.asarray(features.previous, dtype=float)
-        previous_nominal = np.asarray(features.previous_nominal or features.nominal, dtype=float)
+        carried = features.carried_previous()
         values = np.empty(4)
         for i, output in enumerate(OUTPUTS):
             x = inputs[output]
+            if nominal[i] == 0.0:
+                values[i] = 0.0  # a stopped bearing: no heat to correct
+                continue
             if not np.all(np.isfinite(x)):
                 # keep the previous window's correction *factor*: the nominal value moves
                 # with speed and with the fit's temperatures (Eq. 5), a held absolute value
                 # would drift away from it (a stuck sleeve sensor held R at its cold value)
-                values[i] = previous[i] / previous_nominal[i] * nominal[i]
+                values[i] = carried[i]
                 continue
             values[i] = float(self.model.predict(output, x)[0])
         values = limit_to_nominal(values, nominal, self.guards)

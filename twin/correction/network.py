@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from twin.correction.features import correction_factors
+
 LEARNING_RATE = 0.05
 MAX_EPOCHS = 5000
 GOAL_MSE = 1e-6
@@ -183,7 +185,8 @@ def train_network(
         raise ValueError("epochs must be at least 1")
     x = np.asarray(x, dtype=float)
     value = np.asarray(value, dtype=float)
-    y = value / x[:, 5] if config.target == "factor" else value
+    # rows of a stopped bearing (nominal 0) carry no factor; the caller leaves them out
+    y = correction_factors(value, x[:, 5]) if config.target == "factor" else value
     x_off, x_sc, y_off, y_sc = fit_scaling(config, x[train], y[train])
     shell = TrainedNet(config, np.zeros((hidden, 6)), np.zeros(hidden), np.zeros((1, hidden)),
                        np.zeros(1), x_off, x_sc, y_off, y_sc)

@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from twin.correction.features import BoundaryValues, WindowFeatures
+from twin.correction.features import BoundaryValues, WindowFeatures, correction_factors
 
 
 @dataclass(frozen=True)
@@ -53,11 +53,11 @@ class Correction:
     def relative_to(
         cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
     ) -> Correction:
-        """These values with C_H, C_C on `previous`; `extra`: factors, state_C, band_sd."""
+        """These values with C_H, C_C on `previous` (1 where that was 0: a stop);
+        `extra`: factors, state_C, band_sd."""
         v = [float(x) for x in values]
-        p = [float(x) for x in previous]
-        return cls(*v, C_H=(v[0] / p[0], v[1] / p[1]), C_C=(v[2] / p[2], v[3] / p[3]),
-                   **extra)
+        c = [float(x) for x in correction_factors(v, previous)]
+        return cls(*v, C_H=(c[0], c[1]), C_C=(c[2], c[3]), **extra)
 
 
 class Corrector(Protocol):

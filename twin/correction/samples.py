@@ -19,6 +19,9 @@ the measurement over the window [t0, t0 + 60 s) that the value will be used for:
 ratios are taken at the window end on the fitted curves (the fits may look ahead, they are
 only used to build targets).  Samples lie every 60 s, and more densely early in the run
 where the temperatures change fastest (the paper's weak spot near 200 s).
+
+A stopped bearing (nominal heat 0) gets the heat target 0; `twin.correction.training`
+leaves such samples out of its heat network (there is no heat to learn a factor for).
 """
 
 from __future__ import annotations
@@ -35,8 +38,10 @@ from twin.correction.features import (
     RING_SENSOR,
     SLEEVE_SENSOR,
     WINDOW_S,
+    correction_factors,
     last_at_or_before,
     network_inputs,
+    values_allowed,
 )
 from twin.correction.formulas import (
     ContactFit,
@@ -99,8 +104,9 @@ class RunCurves:
             if getattr(self, name) is None and name == "fitted":
                 continue
             v = np.asarray(getattr(self, name), dtype=float)
-            if v.shape[-1] != 4 or v.ndim > 2 or np.any(~(v > 0)):
-                raise ValueError(f"RunCurves.{name} must be positive, shape (windows, 4) or (4,)")
+            if v.shape[-1] != 4 or v.ndim > 2 or not values_allowed(v.reshape(-1, 4).T):
+                raise ValueError(f"RunCurves.{name} must have shape (windows, 4) or (4,), "
+                                 "heats ≥ 0 (0 at a stop) and resistances positive")
 
     def per_window(self, name: str, window: np.ndarray) -> np.ndarray:
         v = np.asarray(getattr(self, name), dtype=float)
@@ -218,7 +224,7 @@ def build_samples(
         )
         # the drop is heat flux × resistance: the part of the drop ratio that the heat
         # correction of the same window already explains is taken out
-        heat_factor = targets[f"heat_{bearing}"] / used[:, k]
+        heat_factor = correction_factors(targets[f"heat_{bearing}"], used[:, k])
         resistance = used[:, 2 + k] * fp_end / fp_start * (C_C / heat_factor) ** g_c
         targets[f"resistance_{bearing}"] = limit_to_nominal(
             resistance, nominal[:, 2 + k], guards

@@ -62,10 +62,14 @@ def train_model(
     if len(samples) < 5:
         raise ValueError(f"too few training samples ({len(samples)}); need at least 5")
     start = time.perf_counter()
-    train, test = split_indices(len(samples), seed, TEST_FRACTION)
+    split = split_indices(len(samples), seed, TEST_FRACTION)
     nets, results = {}, {}
     for i, output in enumerate(OUTPUTS):
         x, y = samples.inputs[output], samples.targets[output]
+        # a stopped bearing (nominal heat 0) has no heat factor to learn
+        train, test = (rows[x[rows, 5] > 0] for rows in split)
+        if len(train) < 2:
+            raise ValueError(f"too few running samples for {output} ({len(train)})")
         net, history = train_network(
             x, y, train, test, config=config, hidden=HIDDEN_SIZES[kind_of(output)],
             epochs=epochs, seed=seed + i,

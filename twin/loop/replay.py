@@ -9,9 +9,13 @@ window starts:
       → window deck (apdl_like) → 15 backward-Euler steps of 4 s in the persistent session
       → T1..T5 and the nose drift per step (probes), fields at the window end
 
-The temperature state carries over from window to window.  The run starts from a uniform
-field at the mean of the first measured T1..T5 (a spindle at rest has equalised), which
-is also the zero of the drift: the recorded drift is taken as measured from the start.
+The temperature state carries over from window to window.  A stop (speed 0) is an
+ordinary window: no bearing or motor heat, the twin cools; each value's correction factor
+is held through the stop and resumes at the restart (`WindowFeatures.previous_factors`).
+
+The run starts from a uniform field at the mean of the first measured T1..T5 (a spindle
+at rest has equalised), which is also the zero of the drift: the recorded drift is taken
+as measured from the start.
 """
 
 from __future__ import annotations
@@ -23,7 +27,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
-from twin.correction.features import BoundaryValues, TwinState, WindowFeatures
+from twin.correction.features import (
+    BoundaryValues,
+    TwinState,
+    WindowFeatures,
+    correction_factors,
+)
 from twin.correction.result import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
@@ -195,6 +204,7 @@ def replay_method(
     previous: BoundaryValues | None = None
     previous_nominal: BoundaryValues | None = None
     band: np.ndarray | None = None
+    factors = np.ones(4)  # each value's last correction factor; a stop holds it
 
     for k in range(windows):
         start = float(starts[k])
@@ -229,6 +239,7 @@ def replay_method(
             previous_nominal=previous_nominal,
             twin_state=TwinState(T, bc),
             measured_drift_um=None if measured_drift is None else measured_drift[upto],
+            previous_factors=tuple(factors),
         )
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
@@ -250,6 +261,7 @@ def replay_method(
         elif keep_fields and field_step is None:
             fields[start + WINDOW_S] = T.copy()
         previous, previous_nominal = corr.values, nominal
+        factors = correction_factors(corr.values, nominal, fallback=factors)
         if on_window is not None:
             on_window(k + 1, windows)
 

@@ -10,7 +10,9 @@ factors, coolant inlet and ambient drifting, X/Y drift the axisymmetric model ca
 produce, and model-form error the twin's corrections cannot express: motor loss and
 film-group factors, scaled material conductivity and expansion, thermocouples a little
 off their nominal points.  A stop (speed 0) has no bearing or motor heat and the
-standstill film coefficients; the truth simply cools down.  The nominal loads themselves follow the truth's own state as in the twin
+standstill film coefficients; the truth simply cools down.
+
+The nominal loads themselves follow the truth's own state as in the twin
 (`nominal_conditions` with the ring and sleeve temperatures: oil viscosity, Eq. 5 fit),
 re-evaluated every `UPDATE_S`.  The sensors then add thermocouple lag, noise and faults.
 

@@ -163,7 +163,8 @@ def default_model_form(rng: np.random.Generator) -> ModelForm:
     r = DEFAULT_FORM_RANGES
     motor = TimeTable.constant(rng.uniform(*r["motor_heat"]))
     film = {g: TimeTable.constant(rng.uniform(*r["film"])) for g in FILM_GROUPS}
-    return ModelForm(motor_heat=motor, film=film, conductivity=float(rng.uniform(*r["conductivity"])),
+    return ModelForm(motor_heat=motor, film=film,
+                     conductivity=float(rng.uniform(*r["conductivity"])),
                      expansion=float(rng.uniform(*r["expansion"])))
 
 
