@@ -155,4 +155,4 @@ def test_summary_keeps_earlier_failures_until_the_run_is_retried(replayed, tmp_p
     failed = [{"run": "c", "error": "x", "kind": "input"}]
     (out / "summary.json").write_text(json.dumps({"runs": [], "failed": failed}))
     assert collect_summary(out)["failed"] == failed
-    assert "failed" not in collect_summary(out, attempted=["c"])
+    assert collect_summary(out, attempted=["c"])["failed"] == []  # DESIGN: always listed

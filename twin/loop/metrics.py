@@ -109,13 +109,50 @@ def band_coverage(measured: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float
     return float(100.0 * np.sum(inside & ok) / np.sum(ok))
 
 
-def mean_metrics(runs: list[dict]) -> dict:
-    """Per method, the mean of each scalar metric over the runs that have it."""
+LOWER_IS_BETTER = ("rmse_um", "max_abs_C")
+"""Error metrics (the worst run has the largest value); every other metric is an accuracy
+or a coverage in % (the worst run has the smallest)."""
+
+DISTRIBUTION_METRICS = ("temperature_accuracy_pct", "temperature_rise_accuracy_pct",
+                        "deformation_accuracy_pct")
+"""The accuracies a batch report shows as a distribution over runs."""
+
+
+def metric_values(runs: list[dict]) -> dict[str, dict[str, list[float]]]:
+    """Per method and scalar metric, the finite values over the runs that have them."""
     methods: dict[str, dict[str, list[float]]] = {}
     for run in runs:
         for method, metrics in run.get("methods", {}).items():
             bucket = methods.setdefault(method, {})
             for key, value in metrics.items():
-                if isinstance(value, int | float) and value is not None and math.isfinite(value):
+                if isinstance(value, int | float) and math.isfinite(value):
                     bucket.setdefault(key, []).append(float(value))
-    return {m: {k: float(np.mean(v)) for k, v in d.items()} for m, d in methods.items()}
+    return methods
+
+
+def _reduce(runs: list[dict], reduce) -> dict:  # noqa: ANN001 - (key, values) -> float
+    return {m: {k: float(reduce(k, v)) for k, v in d.items()}
+            for m, d in metric_values(runs).items()}
+
+
+def mean_metrics(runs: list[dict]) -> dict:
+    """Per method, the mean of each scalar metric over the runs that have it."""
+    return _reduce(runs, lambda key, v: np.mean(v))
+
+
+def median_metrics(runs: list[dict]) -> dict:
+    """Per method, the median of each scalar metric over the runs that have it."""
+    return _reduce(runs, lambda key, v: np.median(v))
+
+
+def worst_metrics(runs: list[dict]) -> dict:
+    """Per method, the worst run's value of each scalar metric (lowest accuracy or
+    coverage, largest error)."""
+    return _reduce(runs, lambda key, v: max(v) if key in LOWER_IS_BETTER else min(v))
+
+
+def batch_summary(runs: list[dict], failed: list[dict]) -> dict:
+    """summary.json: every run's accuracy.json, the failed runs and the statistics over
+    the runs per method (shared DESIGN.md, "Replay output")."""
+    return {"runs": runs, "failed": list(failed), "mean": mean_metrics(runs),
+            "median": median_metrics(runs), "worst": worst_metrics(runs)}

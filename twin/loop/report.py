@@ -21,6 +21,7 @@ from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.figures import new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
+from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
 from twin.loop.summary import collect_summary, run_folder
 
 METHOD_COLORS = {
@@ -154,6 +155,51 @@ def _plots(run_dir: Path) -> list[dict[str, str]]:
     return [_image(p) for p in paths]
 
 
+DISTRIBUTION_MIN_RUNS = 5
+"""A batch of at least this many runs gets the per-method distribution (table and plot)."""
+METRIC_LABELS = {"temperature_accuracy_pct": "T acc [%]",
+                 "temperature_rise_accuracy_pct": "rise acc [%]",
+                 "deformation_accuracy_pct": "deform acc [%]"}
+
+
+def distribution_plot(runs: list[dict], methods: list[str]) -> bytes:
+    """One small box plot per metric, every run's value drawn over it as a point."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    values = metric_values(runs)
+    fig, axes = plt.subplots(1, len(DISTRIBUTION_METRICS), figsize=(12, 3.2))
+    jitter = np.random.default_rng(0)  # fixed: the same folder draws the same picture
+    for ax, key in zip(axes, DISTRIBUTION_METRICS, strict=True):
+        data = [values.get(m, {}).get(key, []) for m in methods]
+        shown = [i for i, d in enumerate(data) if d]
+        if shown:
+            ax.boxplot([data[i] for i in shown], positions=shown, widths=0.5,
+                       showfliers=False)
+        for i in shown:
+            x = i + jitter.uniform(-0.15, 0.15, len(data[i]))
+            ax.plot(x, data[i], "o", ms=4, alpha=0.7,
+                    color=METHOD_COLORS.get(methods[i], "k"))
+        ax.set_xticks(range(len(methods)), methods)
+        ax.set_title(METRIC_LABELS[key], fontsize=10)
+        ax.grid(axis="y", alpha=0.3)
+    return _png(fig)
+
+
+def distribution_rows(summary: dict, methods: list[str]) -> list[list[str]]:
+    """Rows (method, then median / worst / mean of each distribution metric)."""
+    rows = []
+    for m in methods:
+        cells = []
+        for key in DISTRIBUTION_METRICS:
+            cells += [_fmt(summary.get(stat, {}).get(m, {}).get(key))
+                      for stat in ("median", "worst", "mean")]
+        rows.append([m, *cells])
+    return rows
+
+
 def _fmt(v: float | None, digits: int = 2) -> str:
     return "–" if v is None else f"{v:.{digits}f}"
 
@@ -182,6 +228,17 @@ def _summary_of_batch(out_root: Path) -> dict | None:
     except (OSError, ValueError):
         return None
     return summary if isinstance(summary, dict) else None
+
+
+def _distribution(summary: dict, runs: list[dict], methods: list[str]) -> dict | None:
+    """The batch's per-method distribution for the page (None for a batch of a few runs)."""
+    if len(runs) < DISTRIBUTION_MIN_RUNS or not methods:
+        return None
+    if "median" not in summary:  # a summary.json written before the statistics existed
+        summary = {**summary, **batch_summary(runs, summary.get("failed", []))}
+    return {"n_runs": len(runs), "labels": [METRIC_LABELS[k] for k in DISTRIBUTION_METRICS],
+            "rows": distribution_rows(summary, methods),
+            "plot": png_data_uri(distribution_plot(runs, methods))}
 
 
 def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
@@ -220,6 +277,7 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
         failed=[{"run": f.get("run", "?"), "error": f.get("error", "")}
                 for f in summary.get("failed", [])],
         runs=page_runs,
+        distribution=_distribution(summary, runs, methods),
     )
     path = out_root / "report.html"
     write_text(path, page)

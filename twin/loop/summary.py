@@ -3,7 +3,8 @@
 A run is listed when its folder holds a readable accuracy.json; the folder's name is the
 run's name (the `run` field inside the file is never used as a path).  An unreadable
 accuracy.json is listed under "failed" instead of stopping the summary, and failures
-recorded earlier stay listed until that run is replayed again.
+recorded earlier stay listed until that run is replayed again.  Per method, the summary
+holds the mean, median and worst run of each metric (`twin.loop.metrics.batch_summary`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from twin.loop.metrics import mean_metrics
+from twin.loop.metrics import batch_summary
 
 
 def read_accuracy(path: Path) -> dict | None:
@@ -73,7 +74,4 @@ def collect_summary(out_root: Path, failed: Sequence[dict] = (),
     now = list(failed) + unreadable
     seen = {f["run"] for f in now} | set(attempted) | done
     earlier = [f for f in _previous_failures(out_root) if f["run"] not in seen]
-    summary = {"runs": runs, "mean": mean_metrics(runs)}
-    if now or earlier:
-        summary["failed"] = now + earlier
-    return summary
+    return batch_summary(runs, now + earlier)
