@@ -309,7 +309,12 @@ def truth_path_for(run_path: Path) -> Path:
 def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:
     """Write RUN (CSV or Parquet) and RUN.truth.csv beside it, each atomically.
 
-    The run's `name` metadata becomes the file stem.
+    The run's `name` metadata becomes the file stem.  RUN.truth.csv holds, per sample,
+    the applied loads (`H_*`, `R_*`), their nominal values *of the truth* (its own
+    materials: with a conductivity factor c the truth's Eq. 4 resistance is the twin's
+    divided by c), every truth factor (`factor_H_*`, `factor_R_*`, `factor_motor`,
+    `factor_film_<group>`), the metal temperatures and drifts; its `#` lines give the
+    material factors and each thermocouple's offset (Δr Δz, mm).
     """
     from twin.runs import write_run
     from twin.runs.csv_format import write_csv_table
