@@ -25,10 +25,23 @@ inlet_C = [22.0, 23.5]
 [ambient]
 time_s = [0, 1800]
 ambient_C = [24.0, 25.0]
+[motor_heat]                    # multiplier on the motor loss (rotor and stator)
+time_s = [0]
+factor = [1.2]
+[film.housing]
+time_s = [0, 1800]
+factor = [0.7, 0.8]
+[film.coolant]
+time_s = [0]
+factor = [0.8]
+[material]
+conductivity = 0.92
+expansion = 1.05
 [sensors]
 noise_C = 0.05
 lag_s = 8.0
 noise_um = 0.1
+placement_mm = 0.0
 [faults]
 stuck = ["T2"]
 dropouts = [{sensor = "T4", start_s = 600, end_s = 660}]
@@ -44,6 +57,10 @@ def test_design_example_scenario_parses(tmp_path):
     assert s.bearing_heat.rear is None
     assert s.coolant.table()(900.0) == pytest.approx(22.75)
     assert s.faults.stuck == ["T2_C"] and s.faults.dropouts[0].sensor == "T4_C"
+    assert s.motor_heat.table()(0.0) == pytest.approx(1.2)
+    assert s.film.housing.table()(900.0) == pytest.approx(0.75) and s.film.rotor is None
+    assert (s.material.conductivity, s.material.expansion) == (0.92, 1.05)
+    assert s.sensors.placement_mm == 0.0
     assert load_scenario(None).sensors.lag_s == 8.0
 
 
@@ -59,6 +76,12 @@ def test_design_example_scenario_parses(tmp_path):
     ("[faults]\ndropouts = [{sensor = \"T1\", start_s = 60, end_s = 10}]\n", 2,
      "faults.dropouts.0", "end_s"),
     ("x = [\n", 1, None, "not valid TOML"),
+    # model-form error tables (issue 12)
+    ("[film.housng]\ntime_s = [0]\nfactor = [1]\n", 1, "film.housng", "unknown key"),
+    ("[material]\nconductivty = 0.9\n", 2, "material.conductivty", "unknown key"),
+    ("\n[sensors]\nplacement_mm = -1\n", 3, "sensors.placement_mm", "greater than or equal"),
+    ("[motor_heat]\ntime_s = [0]\nfactor = [0]\n", 3, "motor_heat.factor.0", "greater than 0"),
+    ("[material]\nexpansion = 3\n", 2, "material.expansion", "less than or equal to 2"),
 ])
 def test_bad_scenarios(text, row, column, words):
     with pytest.raises(InputError) as info:
