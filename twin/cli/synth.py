@@ -8,28 +8,58 @@ import typer
 
 from twin.errors import InputError
 
+SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
+
+One run: --speed RPM or --profile CSV, with --minutes, --ambient, --seed
+and --out RUN.csv.  A suite: --suite N --seed S [--minutes M] --out DIR
+draws N scenarios (speed steps and stops, ambient, coolant, every truth
+factor below, sensor faults) and writes per run NAME.csv, NAME.truth.csv,
+NAME.scenario.toml and NAME.profile.csv; each scenario's header gives the
+command that reproduces its run byte for byte.
+
+Scenario TOML (--scenario): every table is time_s plus values, linear in
+time; anything left out takes a seeded default.
+  \[bearing_heat.front|rear]        factor on the Palmgren heat
+  \[contact_resistance.front|rear]  factor on the ring/sleeve resistance
+  \[coolant] inlet_C, \[ambient] ambient_C, \[xy_drift] x_um, y_um
+Model-form error (the truth only; the twin keeps its nominal model):
+  \[motor_heat]                     factor on the motor loss
+  \[film.coolant|housing|air_gap|rotor]  factor on that group's films
+  \[material] conductivity, expansion  constant multipliers
+  \[sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple offset)
+  \[faults] stuck, dropouts, spikes;  \[model] size_factor
+Unknown keys are errors naming the file and line.  Without a scenario the
+truth still differs from the twin: motor ±15 %, films ±25 %, conductivity
+±5 %, expansion ±3 %, thermocouples up to 1 mm off (twin.plant.truth)."""
+
 
 def synth(
     out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
-                             "RUN.parquet); the truth goes to RUN.truth.csv beside it."),
-    minutes: float = typer.Option(..., "--minutes", min=2.0, max=24 * 60.0,
-                                  help="Run length, minutes (two 60 s windows at least)."),
-    ambient: float = typer.Option(..., "--ambient", min=-30.0,
-                                  help="Ambient temperature at the start, °C."),
+                             "RUN.parquet; the truth goes to RUN.truth.csv beside it), or "
+                             "with --suite the folder of the suite's files."),
     seed: int = typer.Option(..., "--seed", min=0,
                              help="Seed of every random choice (deterministic)."),
+    minutes: float | None = typer.Option(None, "--minutes", min=2.0, max=24 * 60.0,
+                                         help="Run length, minutes (two 60 s windows at "
+                                         "least; --suite: default 40)."),
+    ambient: float | None = typer.Option(None, "--ambient", min=-30.0,
+                                         help="Ambient temperature at the start, °C (not "
+                                         "with --suite)."),
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
-                                        "(time_s, speed_rpm[, ambient_C])."),
+                                        "(time_s, speed_rpm[, ambient_C]); 0 rpm is a stop."),
     scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
-                                         "factors, sensors, faults)."),
+                                         "factors, model-form error, sensors, faults; "
+                                         "see above)."),
+    suite: int | None = typer.Option(None, "--suite", min=1, max=10000,
+                                     help="Draw this many runs from the seeded scenario "
+                                     "distribution (twin.plant.suite) into the --out folder."),
     rate: float = typer.Option(1.0, "--rate", min=0.1, max=10.0, help="Sample rate, Hz."),
     coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
                                          "at the start, °C (default: the ambient, as the "
                                          "nominal model assumes)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
-    """Emulate a recorded run: the truth model plus sensor lag, noise and faults."""
     from twin.io.destinations import check_out_file
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
@@ -39,12 +69,21 @@ def synth(
     from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
 
+    if suite is not None:
+        _synth_suite(suite, seed, 40.0 if minutes is None else minutes, rate, out,
+                     given={"--speed": speed, "--profile": profile, "--scenario": scenario,
+                            "--ambient": ambient, "--coolant": coolant}, quiet=quiet)
+        return
     if (speed is None) == (profile is None):
-        raise InputError("give exactly one of --speed and --profile", column="--speed")
+        raise InputError("give exactly one of --speed and --profile (or --suite)",
+                         column="--speed")
+    for name, value in (("--minutes", minutes), ("--ambient", ambient)):
+        if value is None:
+            raise InputError("missing: a single run needs it", column=name)
     # replay reads an air or coolant temperature from 45 °C up as Fahrenheit: synth must not
     # write what replay refuses
     fahrenheit = FAHRENHEIT_AIR_RANGE_C[0]
-    if not ambient < fahrenheit:
+    if not -30.0 <= ambient < fahrenheit:
         raise InputError(f"ambient must lie in -30..{fahrenheit:g} °C (replay reads warmer air "
                          f"as Fahrenheit), got {ambient:g}", column="--ambient")
     if coolant is not None and not coolant < fahrenheit:
@@ -79,3 +118,34 @@ def synth(
     if not quiet:
         typer.echo(f"wrote {run_path} ({run.n_samples} samples, {run.elapsed_s:.1f} s) "
                    f"and {truth_path}")
+
+
+synth.__doc__ = SYNTH_HELP
+
+
+def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
+                 given: dict[str, object], quiet: bool) -> None:
+    """`--suite N`: draw N cases and write each one's four files into the folder `out`."""
+    import time
+
+    from twin.io.destinations import check_out_dir
+    from twin.plant.emulator import truth_model
+    from twin.plant.suite import draw_suite, write_case
+
+    clash = next((name for name, value in given.items() if value is not None), None)
+    if clash:
+        raise InputError("--suite draws every run's conditions itself; leave this out",
+                         column=clash)
+    check_out_dir(out)
+    limit = truth_model(0.7).spec.spindle.max_speed_rpm
+    cases = draw_suite(n, seed, minutes, max_speed_rpm=limit, rate_hz=rate)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    for k, case in enumerate(cases, start=1):
+        t0 = time.perf_counter()
+        paths = write_case(case, out)
+        if not quiet:
+            typer.echo(f"[{k}/{n}] wrote {paths['run']} ({time.perf_counter() - t0:.1f} s)")
+    if not quiet:
+        per_minute = (time.perf_counter() - start) / (n * minutes)
+        typer.echo(f"{n} runs in {out} ({per_minute:.2f} s per run-minute)")

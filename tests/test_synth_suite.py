@@ -1,0 +1,152 @@
+"""`twin synth --suite` (issue 12): the seeded scenario distribution, byte-for-byte
+reproduction of any run from its written files, and a property test that whatever
+`twin synth` writes, `twin replay` accepts."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from twin.cli import app
+from twin.plant.scenario import parse_scenario
+from twin.plant.suite import RANGES, draw_case, draw_suite, scenario_text
+from twin.plant.truth import FILM_GROUPS
+
+
+def invoke(*args: str):  # noqa: ANN201
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def cases():
+    return draw_suite(30, suite_seed=5, minutes=40)
+
+
+def within(values, name: str) -> bool:  # noqa: ANN001
+    low, high = RANGES[name]
+    return bool(np.all((np.asarray(values) >= low - 1e-9) & (np.asarray(values) <= high + 1e-9)))
+
+
+def test_speed_profiles_steps_and_stops(cases):
+    for case in cases:
+        times = [t for t, _ in case.profile_rows]
+        speeds = [s for _, s in case.profile_rows]
+        assert times[0] == 0.0 and all(b > a for a, b in zip(times, times[1:], strict=False))
+        assert times[-1] < case.minutes * 60.0
+        running = [s for s in speeds if s > 0]
+        assert running and all(3000.0 <= s <= 15000.0 for s in running)
+        assert 1 <= len(set(running)) <= 4
+        assert case.has_stop == (case.index % 3 == 2)
+    assert sum(c.has_stop for c in cases) == 10
+    # some stop runs end stopped (a cool-down), some restart
+    assert {c.profile_rows[-1][1] == 0.0 for c in cases if c.has_stop} == {True, False}
+
+
+def test_every_factor_within_its_documented_range(cases):
+    for case in cases:
+        s = case.scenario
+        assert within(s.ambient.ambient_C[0], "ambient_C")
+        assert within(s.ambient.ambient_C[-1] - s.ambient.ambient_C[0], "ambient_drift_K")
+        assert within(s.coolant.inlet_C[0] - s.ambient.ambient_C[0], "coolant_offset_K")
+        for side in ("front", "rear"):
+            assert within(getattr(s.bearing_heat, side).factor, "bearing_heat")
+            assert within(getattr(s.contact_resistance, side).factor, "contact_resistance")
+        assert within(s.motor_heat.factor, "motor_heat")
+        assert all(within(getattr(s.film, g).factor, "film") for g in FILM_GROUPS)
+        assert within(s.material.conductivity, "conductivity")
+        assert within(s.material.expansion, "expansion")
+        for key in ("lag_s", "noise_C", "noise_um", "placement_mm"):
+            assert within(getattr(s.sensors, key), key)
+    # the draws spread over the ranges, not a single value
+    motor = [c.scenario.motor_heat.factor[0] for c in cases]
+    assert max(motor) - min(motor) > 0.3
+    assert any(c.scenario.faults.stuck for c in cases)
+    assert any(c.scenario.faults.dropouts for c in cases)
+    assert any(c.scenario.faults.spikes for c in cases)
+    assert not all(c.scenario.faults.stuck or c.scenario.faults.dropouts for c in cases)
+
+
+def test_a_case_depends_only_on_its_seed_and_index(cases):
+    again = draw_case(5, 7, minutes=40)
+    assert again == cases[7]
+    assert draw_case(6, 7, minutes=40) != cases[7]
+    assert len({c.seed for c in cases}) == len(cases)
+
+
+def test_scenario_text_parses_back_to_the_same_scenario(cases):
+    for case in cases[:6]:
+        text = scenario_text(case)
+        assert text.startswith("# suite 5, run")
+        assert parse_scenario(text, "x.toml") == case.scenario
+
+
+def test_suite_cli_writes_four_files_and_reproduces_byte_for_byte(tmp_path, monkeypatch):
+    out = tmp_path / "suite"
+    result = invoke("synth", "--suite", 3, "--seed", 2, "--minutes", 3, "--rate", 0.5,
+                    "--out", out, "--quiet")
+    assert result.exit_code == 0, result.output
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(f"suite2_00{i}{ext}" for i in (1, 2, 3)
+                           for ext in (".csv", ".truth.csv", ".scenario.toml", ".profile.csv"))
+    # run 3 has a stop; reproduce it from its own files with the command in its header
+    case = out / "suite2_003.scenario.toml"
+    command = case.read_text().splitlines()[1].removeprefix("# reproduce: twin ").split()
+    assert command[0] == "synth" and "--profile" in command and "--seed" in command
+    again = tmp_path / "again"
+    again.mkdir()
+    for suffix in (".scenario.toml", ".profile.csv"):
+        (again / f"suite2_003{suffix}").write_bytes((out / f"suite2_003{suffix}").read_bytes())
+    monkeypatch.chdir(again)
+    result = invoke(*command, "--quiet")
+    assert result.exit_code == 0, result.output
+    for suffix in (".csv", ".truth.csv"):
+        assert (again / f"suite2_003{suffix}").read_bytes() == \
+            (out / f"suite2_003{suffix}").read_bytes()
+    assert "0" in [r.split(",")[1] for r in
+                   (out / "suite2_003.profile.csv").read_text().splitlines()[2:]]
+
+
+@pytest.mark.parametrize("args, column", [
+    (["--suite", "2", "--speed", "9000"], "--speed"),
+    (["--suite", "2", "--ambient", "20"], "--ambient"),
+    (["--suite", "0"], "--suite"),
+    (["--suite", "2", "--minutes", "1"], "--minutes"),
+    (["--speed", "9000", "--minutes", "3"], "--ambient"),
+])
+def test_suite_cli_bad_input_exits_2(tmp_path, args, column):
+    result = invoke("synth", "--seed", "1", "--out", tmp_path / "x", *args)
+    assert result.exit_code == 2, result.output
+    assert column in result.output and "Traceback" not in result.output
+
+
+def test_suite_out_must_be_a_folder(tmp_path):
+    file = tmp_path / "taken.csv"
+    file.write_text("keep me")
+    result = invoke("synth", "--suite", "1", "--seed", "1", "--out", file)
+    assert result.exit_code == 2 and "a folder is expected" in result.output
+    assert file.read_text() == "keep me"
+
+
+@settings(max_examples=3, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(suite_seed=st.integers(0, 2**31 - 1), index=st.integers(0, 8),
+       minutes=st.sampled_from([2.5, 4.0]), rate=st.sampled_from([0.1, 0.5, 1.0]))
+def test_whatever_synth_writes_replay_accepts(tmp_path_factory, suite_seed, index, minutes,
+                                              rate):
+    from twin.plant.suite import write_case
+
+    folder = tmp_path_factory.mktemp("prop")
+    case = draw_case(suite_seed, index, minutes=minutes, rate_hz=rate)
+    paths = write_case(case, folder)
+    result = invoke("replay", paths["run"], "--out", folder / "replay", "--methods",
+                    "open_loop,ratio,bpnn", "--snapshots", "none", "--quiet")
+    assert result.exit_code == 0, result.output
+    summary = json.loads((folder / "replay" / "summary.json").read_text())
+    assert not summary.get("failed")
+    accuracy = summary["runs"][0]["methods"]
+    assert all(np.isfinite(m["temperature_accuracy_pct"]) for m in accuracy.values())
