@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.contract import SENSOR_NAMES
 from twin.plant.scenario import Scenario, dump_scenario, parse_scenario
 from twin.plant.truth import FILM_GROUPS
 
@@ -52,7 +53,7 @@ STOP_EVERY = 3
 """Every third run (index 2, 5, 8, …) has a stop: a third of the suite."""
 DEFAULT_MINUTES = 40.0
 DEFAULT_RATE_HZ = 1.0
-TEMPERATURE_SENSORS = ("T1", "T2", "T3", "T4", "T5")
+TEMPERATURE_SENSORS = SENSOR_NAMES
 
 RANGES: dict[str, tuple[float, float]] = {
     "ambient_C": (18.0, 30.0),
