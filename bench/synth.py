@@ -41,7 +41,7 @@ def run() -> dict:
         suite = draw_suite(3, suite_seed=1, minutes=20)
         t0 = time.perf_counter()
         for case in suite:
-            write_case(case, Path(tmp) / "suite")
+            write_case(case, Path(tmp) / "suite", model)
         per_run_minute = (time.perf_counter() - t0) / (len(suite) * 20)
     return {
         "synth_30min_s": min(times),

@@ -37,21 +37,33 @@ def pinned(**changes) -> Scenario:  # noqa: ANN003
     return Scenario(**base)
 
 
-def truth_of(scenario: Scenario, speed_rpm: float = 9000.0, profile=None):  # noqa: ANN001, ANN201
-    kwargs = {"profile": profile} if profile is not None else {"speed_rpm": speed_rpm}
-    return synthesize(minutes=MINUTES, ambient_C=AMBIENT, seed=7, scenario=scenario,
-                      **kwargs)
+@pytest.fixture(scope="module")
+def nominal_truth():
+    """The truth's nominal spindle (the default scenario's mesh), built once for the module."""
+    from twin.spindle import SpindleModel
+
+    return SpindleModel.load(size_factor=Scenario().model.size_factor)
 
 
 @pytest.fixture(scope="module")
-def reference():
+def truth_of(nominal_truth):
+    def run(scenario: Scenario, speed_rpm: float = 9000.0, profile=None):  # noqa: ANN001, ANN202
+        kwargs = {"profile": profile} if profile is not None else {"speed_rpm": speed_rpm}
+        return synthesize(minutes=MINUTES, ambient_C=AMBIENT, seed=7, scenario=scenario,
+                          model=nominal_truth, **kwargs)
+
+    return run
+
+
+@pytest.fixture(scope="module")
+def reference(truth_of):
     return truth_of(pinned())
 
 
-def region_spread_C(run, region: str) -> float:  # noqa: ANN001
-    """max − min of the final truth field over a region's dofs, K."""
-    tables = run.extra["tables"]
-    model = truth_model(0.7, tables.form)
+def region_spread_C(run, nominal) -> float:  # noqa: ANN001
+    """max − min of the final truth field over the shaft's dofs, K."""
+    region = "shaft"
+    model = truth_model(nominal, run.extra["tables"].form)
     cells = model.mesh.region(region)
     dofs = np.unique(model.thermal.basis.element_dofs[:, cells])
     T = run.extra["truth_run"].final_field_C[dofs]
@@ -63,7 +75,7 @@ def test_film_groups_cover_every_convective_boundary():
     assert sorted(grouped) == sorted(b for b in BOUNDARY_NAMES if b != "axis")
 
 
-def test_more_motor_heat_raises_T5_and_the_drift(reference):
+def test_more_motor_heat_raises_T5_and_the_drift(reference, truth_of):
     hot = truth_of(pinned(motor_heat=_one(1.3)))
     T5 = hot.truth["T5_true_C"][-1] - reference.truth["T5_true_C"][-1]
     drift = hot.truth["disp_z_true_um"][-1] - reference.truth["disp_z_true_um"][-1]
@@ -79,7 +91,7 @@ def housing_film(factor: float) -> FilmGroups:
     return FilmGroups(**{**{g: _one(1.0) for g in FILM_GROUPS}, "housing": _one(factor)})
 
 
-def test_weaker_housing_film_raises_T5(reference):
+def test_weaker_housing_film_raises_T5(reference, truth_of):
     # The housing sits on the coolant jacket, so its surface film (natural convection and
     # radiation, ~10 W/m²K) moves T5 by thousandths of a kelvin in a short run: small, but
     # a million times the solver's precision, and ordered with the film.
@@ -88,29 +100,30 @@ def test_weaker_housing_film_raises_T5(reference):
     assert T5[0] > T5_ref + 5e-4 > T5_ref > T5[1] + 5e-4
 
 
-def test_weaker_coolant_film_heats_the_stator_side(reference):
+def test_weaker_coolant_film_heats_the_stator_side(reference, truth_of, nominal_truth):
     weak = truth_of(pinned(film=FilmGroups(**{**{g: _one(1.0) for g in FILM_GROUPS},
                                               "coolant": _one(0.6)})))
     assert weak.truth["T5_true_C"][-1] > reference.truth["T5_true_C"][-1] + 0.01
     def stator_C(run) -> float:  # noqa: ANN001
         field = run.extra["truth_run"].final_field_C
-        return truth_model(0.7).region_mean_C(field)["stator"]
+        return nominal_truth.region_mean_C(field)["stator"]
 
     assert stator_C(weak) > stator_C(reference) + 0.1
 
 
-def test_lower_conductivity_widens_ring_sleeve_and_shaft_gradients(reference):
+def test_lower_conductivity_widens_ring_sleeve_and_shaft_gradients(reference, truth_of,
+                                                                  nominal_truth):
     poor = truth_of(pinned(material=MaterialFactors(conductivity=0.9, expansion=1.0)))
     drop = {name: run.truth["T1_true_C"][-1] - run.truth["T2_true_C"][-1]
             for name, run in (("ref", reference), ("poor", poor))}
     assert drop["poor"] > drop["ref"] > 0.0
-    assert region_spread_C(poor, "shaft") > region_spread_C(reference, "shaft")
+    assert region_spread_C(poor, nominal_truth) > region_spread_C(reference, nominal_truth)
     # Eq. 4: the contact resistance scales with 1/k
     R0 = {n: r.truth["R_front_nominal"][0] for n, r in (("ref", reference), ("poor", poor))}
     np.testing.assert_allclose(R0["poor"] / R0["ref"], 1 / 0.9, rtol=1e-6)
 
 
-def test_larger_expansion_scales_the_drift(reference):
+def test_larger_expansion_scales_the_drift(reference, truth_of):
     wide = truth_of(pinned(material=MaterialFactors(conductivity=1.0, expansion=1.05)))
     # same temperatures up to the (small) Eq. 5 change of the fit's resistance;
     # linear thermo-elasticity: u ∝ α
@@ -118,11 +131,11 @@ def test_larger_expansion_scales_the_drift(reference):
     assert ratio == pytest.approx(1.05, rel=0.01)
 
 
-def test_placement_moves_sensors_inside_the_solid(reference):
+def test_placement_moves_sensors_inside_the_solid(reference, truth_of, nominal_truth):
     moved = truth_of(pinned(sensors=Sensors(noise_C=0.0, noise_um=0.0, lag_s=0.0,
                                             placement_mm=3.0)))
     offsets = moved.extra["tables"].form.sensor_offsets_mm
-    spec = truth_model(0.7).spec
+    spec = nominal_truth.spec
     assert set(offsets) == {"T1", "T2", "T3", "T4", "T5"}
     for name, (dr, dz) in offsets.items():
         assert 0.0 < np.hypot(dr, dz) <= 3.0
@@ -137,18 +150,19 @@ def test_placement_moves_sensors_inside_the_solid(reference):
     assert again.extra["tables"].form.sensor_offsets_mm == offsets
 
 
-def test_default_truth_carries_model_form_error():
-    run = synthesize(speed_rpm=9000, minutes=3, ambient_C=AMBIENT, seed=11)
+def test_default_truth_carries_model_form_error(nominal_truth):
+    run = synthesize(speed_rpm=9000, minutes=3, ambient_C=AMBIENT, seed=11, model=nominal_truth)
     form = run.extra["tables"].form
     assert 0.85 <= float(form.motor_heat(0.0)) <= 1.15
     assert all(0.75 <= float(form.film[g](0.0)) <= 1.25 for g in FILM_GROUPS)
     assert 0.95 <= form.conductivity <= 1.05 and 0.97 <= form.expansion <= 1.03
     assert float(form.motor_heat(0.0)) != 1.0 and form.conductivity != 1.0
-    other = synthesize(speed_rpm=9000, minutes=3, ambient_C=AMBIENT, seed=12)
+    other = synthesize(speed_rpm=9000, minutes=3, ambient_C=AMBIENT, seed=12,
+                       model=nominal_truth)
     assert other.extra["tables"].form.conductivity != form.conductivity
 
 
-def test_a_stop_has_no_heat_and_cools_down():
+def test_a_stop_has_no_heat_and_cools_down(truth_of):
     profile = SpeedProfile(StepTable([0.0, 360.0], [9000.0, 0.0]))
     run = truth_of(pinned(), profile=profile)
     truth = run.extra["truth_run"]

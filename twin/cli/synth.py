@@ -129,21 +129,24 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     import time
 
     from twin.io.destinations import check_out_dir
-    from twin.plant.emulator import truth_model
+    from twin.plant.scenario import Scenario
     from twin.plant.suite import draw_suite, write_case
+    from twin.spindle import SpindleModel
 
     clash = next((name for name, value in given.items() if value is not None), None)
     if clash:
         raise InputError("--suite draws every run's conditions itself; leave this out",
                          column=clash)
     check_out_dir(out)
-    limit = truth_model(0.7).spec.spindle.max_speed_rpm
+    # one nominal truth model for the whole suite (each run adds its own material factors)
+    model = SpindleModel.load(size_factor=Scenario().model.size_factor)
+    limit = model.spec.spindle.max_speed_rpm
     cases = draw_suite(n, seed, minutes, max_speed_rpm=limit, rate_hz=rate)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     for k, case in enumerate(cases, start=1):
         t0 = time.perf_counter()
-        paths = write_case(case, out)
+        paths = write_case(case, out, model)
         if not quiet:
             typer.echo(f"[{k}/{n}] wrote {paths['run']} ({time.perf_counter() - t0:.1f} s)")
     if not quiet:

@@ -234,8 +234,11 @@ def speed_profile(case: SuiteCase):  # noqa: ANN201 - SpeedProfile
     return SpeedProfile(StepTable(np.array(times), np.array(speeds)))
 
 
-def synthesize_case(case: SuiteCase):  # noqa: ANN201 - SynthRun
-    """The case's run, synthesized exactly as `twin synth` does from the case's files."""
+def synthesize_case(case: SuiteCase, model=None):  # noqa: ANN001, ANN201 - SynthRun
+    """The case's run, synthesized exactly as `twin synth` does from the case's files.
+
+    `model`: the truth's nominal SpindleModel, loaded once for a whole suite (None: loaded
+    here)."""
     from twin.plant.emulator import synthesize
 
     name = case.name
@@ -243,16 +246,17 @@ def synthesize_case(case: SuiteCase):  # noqa: ANN201 - SynthRun
     return synthesize(profile=speed_profile(case), minutes=case.minutes,
                       ambient_C=case.ambient_C, seed=case.seed, scenario=scenario,
                       rate_hz=case.rate_hz, scenario_name=f"{name}.scenario.toml",
-                      profile_name=f"{name}.profile.csv")
+                      profile_name=f"{name}.profile.csv", model=model)
 
 
-def write_case(case: SuiteCase, out_dir: Path) -> dict[str, Path]:
-    """Write the case's profile and scenario, then its run and truth; paths by kind."""
+def write_case(case: SuiteCase, out_dir: Path, model=None) -> dict[str, Path]:  # noqa: ANN001
+    """Write the case's profile and scenario, then its run and truth; paths by kind
+    (`model` as in `synthesize_case`)."""
     from twin.io.atomic import write_text
     from twin.plant.emulator import write_synth
 
     out_dir = Path(out_dir)
     profile = write_text(out_dir / f"{case.name}.profile.csv", profile_text(case))
     scenario = write_text(out_dir / f"{case.name}.scenario.toml", scenario_text(case))
-    run, truth = write_synth(synthesize_case(case), out_dir / f"{case.name}.csv")
+    run, truth = write_synth(synthesize_case(case, model), out_dir / f"{case.name}.csv")
     return {"run": run, "truth": truth, "scenario": scenario, "profile": profile}
