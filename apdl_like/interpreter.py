@@ -13,7 +13,7 @@ from apdl_like.call import Call
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import compile_expression, is_parameter_name
 from apdl_like.params import store, subscripts, value_of
-from apdl_like.parser import Program, Statement, read_deck, split_fields
+from apdl_like.parser import BAD_LINE, Program, Statement, read_deck, split_fields
 from apdl_like.registry import lookup
 
 if TYPE_CHECKING:
@@ -117,7 +117,7 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
             raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
         name = st.name
         try:
-            if name == "ERROR":
+            if name == BAD_LINE:
                 raise st.error(st.fields[0])
             if name == "=":
                 _assign(session, st)

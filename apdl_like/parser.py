@@ -8,7 +8,7 @@ the line as text; text in single quotes is a character value (commas and `!` ins
 text).  Fields stay text here; the command that uses a field decides whether it is a label,
 an expression or a character value.  `*VWRITE`/`*MWRITE` carry their format line.
 
-A line that cannot be lexed becomes an `ERROR` statement holding the message, so a bad line
+A line that cannot be lexed becomes a `BAD_LINE` statement holding the message, so a bad line
 stops the deck where it stands, not before the lines ahead of it have run.  Blocks
 (`*DO/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) are matched up front; a block that does not close
 truncates the program at its opening line, with the error raised there.
@@ -32,15 +32,21 @@ _COMMAND_NAME = re.compile(r"[/*]?[A-Za-z][A-Za-z0-9_\-]*\Z")
 _TEXT_COMMANDS = ("/COM", "/TITLE", "/STITLE", "/EOF")
 
 
+# The name of a statement that stands for a line the parser refused. It starts with "!",
+# which begins a comment in APDL, so no deck line can produce it as a command name (a user
+# command spelled ERROR is an ordinary unknown command).
+BAD_LINE = "!BAD_LINE"
+
+
 @dataclass(frozen=True, slots=True)
 class Statement:
     """A command or an assignment, where it came from and its text fields."""
 
     file: str
     line: int
-    name: str  # upper-case command name, "=" for an assignment, "ERROR" for a bad line
+    name: str  # upper-case command name, "=" for an assignment, BAD_LINE for a bad line
     # text after the name, split at commas; an assignment: (name, subscripts text, value 1,
-    # value 2, ...); an ERROR: (message,)
+    # value 2, ...); BAD_LINE: (message, command shown)
     fields: tuple[str, ...]
     text: str = ""  # the raw line (for /COM, /TITLE and messages)
     # NBLOCK/EBLOCK/CMBLOCK: the format line and the data lines; *VWRITE: the format line
@@ -51,7 +57,7 @@ class Statement:
 
     @property
     def shown(self) -> str:
-        if self.name == "ERROR":
+        if self.name == BAD_LINE:
             return self.fields[1]
         return f"{self.fields[0]}=" if self.name == "=" else self.name
 
@@ -105,7 +111,7 @@ def lex_line(raw: str, file: str, number: int) -> Statement | None:
     try:
         lexed = _lex(raw)
     except ApdlError as exc:
-        lexed = ("ERROR", (exc.reason, exc.command or ""))
+        lexed = (BAD_LINE, (exc.reason, exc.command or ""))
     if lexed is None:
         return None
     return Statement(file, number, lexed[0], lexed[1], raw)
@@ -247,13 +253,13 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
             try:
                 data, used = _block_lines(st, lines, number)
             except ApdlError as exc:
-                statements.append(Statement(file, st.line, "ERROR", (exc.reason, st.name)))
+                statements.append(Statement(file, st.line, BAD_LINE, (exc.reason, st.name)))
                 break
             st = Statement(st.file, st.line, st.name, st.fields, st.text, data)
             number += used
         elif st.name in FORMAT_COMMANDS:
             if number >= len(lines):
-                statements.append(Statement(file, st.line, "ERROR",
+                statements.append(Statement(file, st.line, BAD_LINE,
                                             ("the format line is missing", st.name)))
                 break
             st = Statement(st.file, st.line, st.name, st.fields, st.text, (lines[number],))
@@ -266,7 +272,7 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
         # run what comes before the bad block, then stop there with its message
         bad = next(i for i, st in enumerate(statements) if st.line == exc.line)
         program = Program(file, statements[:bad] + [
-            Statement(file, statements[bad].line, "ERROR", (exc.reason, exc.command or ""))])
+            Statement(file, statements[bad].line, BAD_LINE, (exc.reason, exc.command or ""))])
         _match_blocks(program)
     return program
 

@@ -293,3 +293,12 @@ def test_results_table_idiom_writes_fortran_formatted_rows():
     assert s.log[-4:] == rows  # *LIST copies the file into the output
     assert "header line" in s.log[0]
     assert s.params["_T2"] == -0.6712
+
+
+def test_a_command_spelled_error_is_an_unknown_command_not_a_crash():
+    # found by the arbitrary-text fuzz: a deck line `ERROR` used to index the fields of the
+    # parser's own bad-line statement (IndexError, exit 1)
+    s = run("ERROR\nB = 2\n")
+    assert s.params["B"] == 2.0
+    assert s.state.listing.warnings == [
+        "warning: deck.inp:1: ERROR: unknown or unsupported command ERROR; ignored"]
