@@ -10,7 +10,14 @@ from twin.plant.profile import read_speed_profile
 from twin.plant.scenario import load_scenario, parse_scenario
 from twin.plant.sensors import add_noise, apply_faults, first_order_lag
 from twin.plant.timetable import StepTable, TimeTable
-from twin.plant.truth import default_tables, preload_factor, truth_tables
+from twin.plant.truth import (
+    XY_GAIN_UM_PER_K,
+    XY_LAG_S,
+    default_tables,
+    preload_factor,
+    truth_tables,
+    xy_drift_um,
+)
 
 SCENARIO = """\
 [bearing_heat.front]            # multiplier on the nominal (Palmgren) heat of that bearing
@@ -187,8 +194,24 @@ def test_default_truth_is_seeded_and_overridable():
     assert not np.array_equal(a.H_front.values, c.H_front.values)
     for table in (a.H_front, a.H_rear, a.R_front, a.R_rear):
         assert np.all(np.abs(table.values - 1.0) <= 0.15)
-    assert 0.0 < np.abs(a.x_um.values).max() < 5.0
+    # X/Y come from the spindle's own temperatures (xy_drift_um), scaled per run
+    assert a.x_um is None and a.y_um is None
+    assert all(0.9 <= g <= 1.1 for g in a.xy_gain_scale)
     assert a.coolant_C(0.0) == pytest.approx(22.0) and a.ambient_C(0.0) == pytest.approx(25.0)
     merged = truth_tables(parse_scenario(SCENARIO), a)
     assert merged.H_front(300.0) == pytest.approx(1.12)
     assert merged.H_rear is a.H_rear and merged.R_rear(1800.0) == pytest.approx(0.8)
+
+
+def test_xy_drift_is_the_lagged_linear_response_to_the_temperature_rises():
+    # a step of +10 K at T1 only: x(t) = 0.22 µm/K · 10 K · (1 − e^(−t/τ)) with τ = 120 s
+    # (the first-order lag of a step held from the first sample), y untouched by T1
+    time_s = np.arange(0.0, 1200.0 + 1e-9, 2.0)
+    sensors = np.full((time_s.size, 5), 25.0)
+    sensors[1:, 0] += 10.0
+    xy = xy_drift_um(time_s, sensors, (1.1, 0.9))
+    exact_x = 1.1 * XY_GAIN_UM_PER_K[0, 0] * 10.0 * (1.0 - np.exp(-(time_s - 2.0) / XY_LAG_S))
+    # the lag sees the step as a ramp over the first 2 s: compare after it
+    assert np.abs(xy[0, 5:] - exact_x[5:]).max() < 0.02 * xy[0, -1]
+    assert xy[0, -1] == pytest.approx(1.1 * 0.22 * 10.0, rel=1e-3)
+    assert np.allclose(xy[1], 0.0)

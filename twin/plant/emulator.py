@@ -43,6 +43,7 @@ from twin.plant.truth import (
     default_tables,
     sensor_offsets_mm,
     truth_tables,
+    xy_drift_um,
 )
 
 DT_S = 2.0
@@ -240,7 +241,11 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     lagged = first_order_lag(truth.sensors_C, DT_S, sensors.lag_s)
     T_meas = np.stack([np.interp(t_out, truth.time_s, lagged[:, j]) for j in range(5)], axis=1)
     disp_z = np.interp(t_out, truth.time_s, truth.disp_z_um)
-    x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
+    if tables.x_um is None or tables.y_um is None:  # the spindle's own X/Y response
+        xy = xy_drift_um(truth.time_s, truth.sensors_C, tables.xy_gain_scale)
+        x_true, y_true = (np.interp(t_out, truth.time_s, axis) for axis in xy)
+    else:  # a scenario's prescribed [xy_drift]
+        x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
     columns = {
         "time_s": t_out,
         "speed_rpm": speed(t_out).astype(float),

@@ -14,8 +14,14 @@ contact R      R_true = R_nominal · f_R(t): the fit tightens more than Eq. 5 pr
                (roundness, preload), f_R falling by 5–15 % over ~5–15 min.
 coolant        inlet temperature drifts up as the chiller loads, with a small hysteresis
                oscillation; ambient drifts slowly; both as time tables.
-X/Y drift      a few µm of radial drift an axisymmetric model cannot produce (asymmetric
-               housing, motor cable side), growing like the warm-up.
+X/Y drift      a few µm of radial drift an axisymmetric model cannot produce: the housing
+               is stiffer on the motor-cable side, so the warm-up tilts the nose.  It is
+               a property of this spindle, the same in every run: a fixed linear response
+               to the true temperature rises at T1..T5 (`XY_GAIN_UM_PER_K`) through a
+               120 s first-order lag, scaled per run by U(0.9, 1.1) (clamping, fixture).
+               So X/Y can be learned from the temperatures, as on a real machine
+               (`twin drift`), but not from the axisymmetric FEM.  A scenario's
+               [xy_drift] table replaces it with a prescribed time series.
 
 Model-form error (REFERENCE.md §7): what the four corrected values cannot express.  With
 no scenario table, each is a constant drawn once per run (`default_model_form`):
@@ -48,7 +54,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.plant.scenario import Scenario
+from twin.plant.sensors import first_order_lag
 from twin.plant.timetable import TimeTable
+
+# X/Y response of the emulated spindle, µm per K of rise at (T1, T2, T3, T4, T5): the front
+# ring's warm-up tilts the nose towards +x and the housing's pulls it back; the rear ring
+# and front sleeve push +y.  With typical rises (T1 10–15 K, T5 2–4 K) it gives a few µm,
+# the size the previous seeded tables had.
+XY_GAIN_UM_PER_K = np.array([[0.22, 0.0, 0.05, 0.0, -0.35],
+                             [0.0, 0.10, 0.12, 0.0, -0.10]])
+XY_LAG_S = 120.0
 
 REFERENCE_SPEED_RPM = 9000.0
 TABLE_STEP_S = 10.0
@@ -106,9 +121,10 @@ class TruthTables:
     R_rear: TimeTable
     coolant_C: TimeTable
     ambient_C: TimeTable
-    x_um: TimeTable
-    y_um: TimeTable
+    x_um: TimeTable | None  # None: the spindle's own response to its temperatures
+    y_um: TimeTable | None
     form: ModelForm = field(default_factory=ModelForm)
+    xy_gain_scale: tuple[float, float] = (1.0, 1.0)  # per-run scale of XY_GAIN_UM_PER_K
 
 
 def speed_scale(speed_rpm: np.ndarray) -> np.ndarray:
@@ -148,14 +164,32 @@ def default_tables(rng: np.random.Generator, duration_s: float,
         + 0.15 * (np.sin(2 * np.pi * t / period + phase) - np.sin(phase))
     ambient_trend = u(-0.3, 0.8) / max(duration_s, 1.0)
     ambient = ambient_of(t) + ambient_trend * t
-    drift = []
+    # Per-run X/Y gain scales.  The three draws per axis replay those of the earlier
+    # random X/Y tables (sign, amplitude, time constant), so every seeded run keeps its
+    # bearing and contact tables, which are drawn after these: the amplitude's uniform
+    # becomes the scale, the other two are spent.
+    xy_scale = []
     for _ in range(2):
-        amplitude = rng.choice([-1.0, 1.0]) * u(1.0, 4.0)
-        drift.append(amplitude * speed_scale(n) * (1.0 - np.exp(-t / u(300.0, 900.0))))
+        rng.choice([-1.0, 1.0])
+        xy_scale.append(0.9 + 0.2 * (u(1.0, 4.0) - 1.0) / 3.0)
+        u(300.0, 900.0)
     return TruthTables(H_front=bearing(1.0), H_rear=bearing(0.6), R_front=contact(),
                        R_rear=contact(), coolant_C=TimeTable(t, coolant),
-                       ambient_C=TimeTable(t, ambient), x_um=TimeTable(t, drift[0]),
-                       y_um=TimeTable(t, drift[1]))
+                       ambient_C=TimeTable(t, ambient), x_um=None, y_um=None,
+                       xy_gain_scale=(xy_scale[0], xy_scale[1]))
+
+
+def xy_drift_um(time_s: np.ndarray, sensors_C: np.ndarray,
+                gain_scale: tuple[float, float]) -> np.ndarray:
+    """(2, n) true X/Y nose drift in µm from the true T1..T5 history (n, 5) in °C.
+
+    The response to each sensor's rise since the start, lagged by `XY_LAG_S` (the tilt
+    follows the housing, which warms more slowly than the bearing rings).
+    """
+    rise = np.asarray(sensors_C, float) - np.asarray(sensors_C, float)[0]
+    dt = float(time_s[1] - time_s[0]) if len(time_s) > 1 else 1.0
+    lagged = first_order_lag(rise, dt, XY_LAG_S)
+    return np.asarray(gain_scale, float)[:, None] * (XY_GAIN_UM_PER_K @ lagged.T)
 
 
 def default_model_form(rng: np.random.Generator) -> ModelForm:
@@ -218,4 +252,5 @@ def truth_tables(scenario: Scenario, defaults: TruthTables) -> TruthTables:
         x_um=defaults.x_um if xy is None else TimeTable(xy.time_s, xy.x_um),
         y_um=defaults.y_um if xy is None else TimeTable(xy.time_s, xy.y_um),
         form=form,
+        xy_gain_scale=defaults.xy_gain_scale,
     )
