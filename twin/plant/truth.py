@@ -56,6 +56,7 @@ import numpy as np
 from twin.plant.scenario import Scenario
 from twin.plant.sensors import first_order_lag
 from twin.plant.timetable import TimeTable
+from twin.spindle.conditions import FILM_GROUPS, film_group
 
 # X/Y response of the emulated spindle, µm per K of rise at (T1, T2, T3, T4, T5): the front
 # ring's warm-up tilts the nose towards +x and the housing's pulls it back; the rear ring
@@ -68,14 +69,6 @@ XY_LAG_S = 120.0
 REFERENCE_SPEED_RPM = 9000.0
 TABLE_STEP_S = 10.0
 
-FILM_GROUPS: dict[str, tuple[str, ...]] = {
-    "coolant": ("coolant",),
-    "housing": ("housing_outer", "mount"),
-    "air_gap": ("air_gap_rotor", "air_gap_stator"),
-    "rotor": ("rotor_end_front", "rotor_end_rear", "nose_face", "nose_outer", "shaft_rear",
-              "shaft_internal", "internal_air"),
-}
-"""Surface groups of the `[film.*]` factors → the spec's boundary names."""
 
 DEFAULT_FORM_RANGES: dict[str, tuple[float, float]] = {
     "motor_heat": (0.85, 1.15),
@@ -105,10 +98,10 @@ class ModelForm:
 
     def film_factor(self, boundary: str, t_s: float) -> float:
         """Multiplier on the film coefficient of a spec boundary at time t_s."""
-        for group, boundaries in FILM_GROUPS.items():
-            if boundary in boundaries:
-                return float(self.film[group](t_s))
-        raise ValueError(f"boundary {boundary!r} belongs to no film group")
+        group = film_group(boundary)
+        if group is None:
+            raise ValueError(f"boundary {boundary!r} belongs to no film group")
+        return float(self.film[group](t_s))
 
 
 @dataclass(frozen=True)
