@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import os
 import re
-from typing import Annotated
+from typing import Annotated, ClassVar, Self
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
@@ -81,23 +81,23 @@ Times = Annotated[list[Annotated[float, Field(ge=0.0)]], Field(min_length=1)]
 
 class _Table(_Strict):
     time_s: Times
+    columns: ClassVar[tuple[str, ...]] = ()
+    """The value lists given at the `time_s` times (each as long as time_s)."""
 
-    def _check_lengths(self, *names: str) -> None:
+    @model_validator(mode="after")
+    def _check_lengths(self) -> Self:
         if any(t1 <= t0 for t0, t1 in zip(self.time_s, self.time_s[1:], strict=False)):
             raise ValueError("time_s must be strictly increasing")
-        for name in names:
+        for name in self.columns:
             if len(getattr(self, name)) != len(self.time_s):
                 raise ValueError(f"{name} has {len(getattr(self, name))} values for "
                                  f"{len(self.time_s)} times")
+        return self
 
 
 class FactorTable(_Table):
     factor: list[Annotated[float, Field(gt=0.0, le=10.0)]]
-
-    @model_validator(mode="after")
-    def _lengths(self) -> FactorTable:
-        self._check_lengths("factor")
-        return self
+    columns: ClassVar[tuple[str, ...]] = ("factor",)
 
     def table(self) -> TimeTable:
         return TimeTable(self.time_s, self.factor)
@@ -108,11 +108,7 @@ Celsius = Annotated[float, Field(ge=-30.0, le=60.0)]
 
 class CoolantTable(_Table):
     inlet_C: list[Celsius]
-
-    @model_validator(mode="after")
-    def _lengths(self) -> CoolantTable:
-        self._check_lengths("inlet_C")
-        return self
+    columns: ClassVar[tuple[str, ...]] = ("inlet_C",)
 
     def table(self) -> TimeTable:
         return TimeTable(self.time_s, self.inlet_C)
@@ -120,11 +116,7 @@ class CoolantTable(_Table):
 
 class AmbientTable(_Table):
     ambient_C: list[Celsius]
-
-    @model_validator(mode="after")
-    def _lengths(self) -> AmbientTable:
-        self._check_lengths("ambient_C")
-        return self
+    columns: ClassVar[tuple[str, ...]] = ("ambient_C",)
 
     def table(self) -> TimeTable:
         return TimeTable(self.time_s, self.ambient_C)
@@ -136,11 +128,7 @@ Microns = Annotated[float, Field(ge=-100.0, le=100.0)]
 class XYDriftTable(_Table):
     x_um: list[Microns]
     y_um: list[Microns]
-
-    @model_validator(mode="after")
-    def _lengths(self) -> XYDriftTable:
-        self._check_lengths("x_um", "y_um")
-        return self
+    columns: ClassVar[tuple[str, ...]] = ("x_um", "y_um")
 
 
 class PerBearing(_Strict):
