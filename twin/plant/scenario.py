@@ -95,31 +95,30 @@ class _Table(_Strict):
         return self
 
 
-class FactorTable(_Table):
-    factor: list[Annotated[float, Field(gt=0.0, le=10.0)]]
-    columns: ClassVar[tuple[str, ...]] = ("factor",)
+class _Series(_Table):
+    """A table of one value list, read at any time as a piecewise-linear `TimeTable`."""
 
     def table(self) -> TimeTable:
-        return TimeTable(self.time_s, self.factor)
+        (name,) = self.columns
+        return TimeTable(self.time_s, getattr(self, name))
+
+
+class FactorTable(_Series):
+    factor: list[Annotated[float, Field(gt=0.0, le=10.0)]]
+    columns: ClassVar[tuple[str, ...]] = ("factor",)
 
 
 Celsius = Annotated[float, Field(ge=-30.0, le=60.0)]
 
 
-class CoolantTable(_Table):
+class CoolantTable(_Series):
     inlet_C: list[Celsius]
     columns: ClassVar[tuple[str, ...]] = ("inlet_C",)
 
-    def table(self) -> TimeTable:
-        return TimeTable(self.time_s, self.inlet_C)
 
-
-class AmbientTable(_Table):
+class AmbientTable(_Series):
     ambient_C: list[Celsius]
     columns: ClassVar[tuple[str, ...]] = ("ambient_C",)
-
-    def table(self) -> TimeTable:
-        return TimeTable(self.time_s, self.ambient_C)
 
 
 Microns = Annotated[float, Field(ge=-100.0, le=100.0)]
