@@ -223,8 +223,13 @@ def _enhanced_matrices(xy: np.ndarray, mode: str, xi: float, eta: float,
     J0 = np.einsum("ak,ekb->eab", dN0, xy)
     det0 = np.linalg.det(J0)
     dP = np.array([[-2.0 * xi, 0.0], [0.0, -2.0 * eta]])  # d(P1, P2)/d(ξ, η): rows ξ, η
-    dPdx = np.linalg.solve(J0, np.broadcast_to(dP, (xy.shape[0], 2, 2))) * \
-        (det0 / det)[:, None, None]
+    # scaled by dV0/dV so that ∫ G dV = 0 and the element passes the patch test; the volume
+    # element of an axisymmetric ring carries the radius (r0 at the centre)
+    scale = det0 / det
+    if mode == "axisymmetric":
+        N0, _ = _quad_shapes(0.0, 0.0)
+        scale = scale * (xy[:, :, 0] @ N0) / np.where(r == 0.0, 1.0, r)
+    dPdx = np.linalg.solve(J0, np.broadcast_to(dP, (xy.shape[0], 2, 2))) * scale[:, None, None]
     ne = xy.shape[0]
     B = np.zeros((ne, 4, 8))
     G = np.zeros((ne, 4, 4))

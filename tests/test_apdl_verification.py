@@ -453,3 +453,24 @@ SET,2
 """)
     for t0, name in ((100.0, "T_ONE"), (200.0, "T_TWO")):
         assert s.params[name] == pytest.approx(20.0 + (t0 - 20.0) / 1.25, rel=1e-9)
+
+
+@pytest.mark.parametrize("mode", ["axisymmetric", "plane_strain"])
+def test_enhanced_quad_passes_the_patch_test_when_distorted(mode):
+    """Patch test (Taylor, Simo & Zienkiewicz): a linear displacement field u = 1e-3 r,
+    v = 2e-3 z on a distorted PLANE182 enhanced-strain quad must give the exact uniform
+    stress σ = D ε, with ε = (1e-3, 2e-3, 1e-3 (hoop u/r; 0 in plane strain), 0).  The
+    incompatible modes must not pick up energy from it: in an axisymmetric ring they are
+    scaled by the centre's r·detJ over the point's (an element scaled by detJ alone was
+    off by 30 % here)."""
+    from apdl_like.plane_elastic import elasticity_matrix, enhanced_quads
+
+    xy = np.array([[[1.0, 0.0], [2.2, 0.1], [2.0, 1.3], [1.1, 0.9]]])
+    E, nu = 2e5, 0.3
+    u_e = np.concatenate([1e-3 * xy[0, :, 0], 2e-3 * xy[0, :, 1]])[None]
+    _, _, recover = enhanced_quads(xy, mode, np.array([E]), np.array([nu]), np.zeros((1, 4)))
+    hoop = 1e-3 if mode == "axisymmetric" else 0.0
+    exact = elasticity_matrix(np.array(E), np.array(nu), mode) @ np.array(
+        [1e-3, 2e-3, hoop, 0.0])
+    np.testing.assert_allclose(recover(u_e)[:, 0, :], np.repeat(exact[:, None], 4, axis=1),
+                               atol=1e-9 * E)
