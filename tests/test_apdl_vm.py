@@ -62,11 +62,14 @@ def test_vm111_sphere_center_matches_the_exact_series_solution(tmp_path):
     assert computed == pytest.approx(exact, rel=0.005)
 
 
-def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_5_percent(
+def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_percent(
         tmp_path):
     """VM32 (long cylinder): the thermal rows meet the 2 % target; the thermal-stress rows
     (7 axisymmetric PLANE182 quads with enhanced strain, nodal stresses extrapolated from
-    the 2 × 2 points) come within 3.5 % of Timoshenko's 420.42 / −194.58 psi, not 2 %."""
+    the 2 × 2 points) come within 3 % of Timoshenko's 420.42 / −194.58 psi (worst: the
+    inner axial stress, 432.6, +2.9 %), not 2 %: the corner stress of this element
+    converges as O(h) (0.8 % on 40 elements, 0.17 % on 200), so the coarse published mesh
+    decides it."""
     out = tmp_path / "out"
     done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(DECKS / "vm32.dat"),
                            "--out", str(out)], capture_output=True, text=True, timeout=600)
@@ -76,4 +79,4 @@ def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_5
     for label, target, computed in rows[:3]:
         assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), label
     for label, target, computed in rows[3:]:
-        assert computed == pytest.approx(target, rel=0.035), label
+        assert computed == pytest.approx(target, rel=0.03), label
