@@ -40,6 +40,24 @@ class CommandSpec:
     handler: Handler
 
 
+def command(name: str, processors: frozenset[str],
+            max_fields: int) -> Callable[[Handler], Handler]:
+    """Decorator: the handler runs APDL command `name` (in `processors`, with at most
+    `max_fields` fields); its family lists it in `COMMANDS` through `specs_of`."""
+
+    def mark(handler: Handler) -> Handler:
+        spec = CommandSpec(name, processors, max_fields, handler)
+        handler.apdl_spec = spec  # type: ignore[attr-defined]
+        return handler
+
+    return mark
+
+
+def specs_of(*handlers: Handler) -> tuple[CommandSpec, ...]:
+    """The specs of handlers marked by `command`, in order (a family's table)."""
+    return tuple(h.apdl_spec for h in handlers)  # type: ignore[attr-defined]
+
+
 def ignored(s: SessionState, c: Call) -> None:
     """Handler of commands that are accepted and change nothing here (output controls)."""
 

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import ANY, Call, CommandSpec, ignored
+from apdl_like.call import ANY, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.commands.post26 import get_variable
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
@@ -24,10 +24,12 @@ def _enter(processor: str):  # noqa: ANN202
     return enter
 
 
+@command("/COM", ANY, 1)
 def com(s: SessionState, c: Call) -> None:
     s.say(" " + c.statement.fields[0])  # MAPDL prints comments one column in
 
 
+@command("/TITLE", ANY, 1)
 def title(s: SessionState, c: Call) -> None:
     s.db.title = c.raw(1)
 
@@ -51,6 +53,7 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
 _STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
 
 
+@command("*GET", ANY, 8)
 def star_get(s: SessionState, c: Call) -> None:
     """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM ...)."""
     name = c.raw(1).upper()
@@ -108,14 +111,10 @@ def star_get(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("/COM", ANY, 1, com),
-    CommandSpec("/TITLE", ANY, 1, title),
-    CommandSpec("*GET", ANY, 8, star_get),
-    CommandSpec("/PREP7", ANY, 0, _enter("PREP7")),
-    CommandSpec("/SOLU", ANY, 0, _enter("SOLU")),
-    CommandSpec("/POST1", ANY, 0, _enter("POST1")),
-    CommandSpec("/POST26", ANY, 0, _enter("POST26")),
-    CommandSpec("FINISH", ANY, 0, _enter("BEGIN")),
+    *specs_of(com, title, star_get),
+    *(CommandSpec(name, ANY, 0, _enter(processor)) for name, processor in (
+        ("/PREP7", "PREP7"), ("/SOLU", "SOLU"), ("/POST1", "POST1"), ("/POST26", "POST26"),
+        ("FINISH", "BEGIN"))),
     CommandSpec("/STITLE", ANY, 1, ignored),
     *(CommandSpec(name, ANY, 10, ignored) for name in OUTPUT_CONTROLS),
 )

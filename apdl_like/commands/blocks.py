@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec
+from apdl_like.call import PREP7, Call, command, specs_of
 from apdl_like.cdb import parse_cmblock, parse_eblock, parse_nblock
 from apdl_like.commands.prep7 import MAX_ENTITY_NUMBER
 from apdl_like.errors import ApdlError
@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 
+@command("NBLOCK", PREP7, 6)
 def nblock(s: SessionState, c: Call) -> None:
     ids, xyz = parse_nblock(c.statement.block)
     if ids.size and (ids.min() < 1 or ids.max() > MAX_ENTITY_NUMBER):
@@ -27,6 +28,7 @@ def nblock(s: SessionState, c: Call) -> None:
     s.db.nodes.flush()
 
 
+@command("EBLOCK", PREP7, 6)
 def eblock(s: SessionState, c: Call) -> None:
     db = s.db
     rows = parse_eblock(c.statement.block)
@@ -47,6 +49,7 @@ def eblock(s: SessionState, c: Call) -> None:
     db.elements.flush()
 
 
+@command("CMBLOCK", PREP7 | {"BEGIN", "SOLU"}, 4)
 def cmblock(s: SessionState, c: Call) -> None:
     name = c.raw(1).upper()
     if not name or not name[0].isalpha() or len(name) > 32:
@@ -63,7 +66,5 @@ def cmblock(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("NBLOCK", PREP7, 6, nblock),
-    CommandSpec("EBLOCK", PREP7, 6, eblock),
-    CommandSpec("CMBLOCK", PREP7 | {"BEGIN", "SOLU"}, 4, cmblock),
+    *specs_of(nblock, eblock, cmblock),
 )

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec
+from apdl_like.call import PREP7, Call, command, specs_of
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
@@ -39,6 +39,7 @@ def from_cartesian(csys: int, xy: np.ndarray) -> np.ndarray:
                             np.degrees(np.arctan2(xy[:, 1], xy[:, 0]))])
 
 
+@command("CSYS", PREP7 | {"SOLU", "POST1", "BEGIN", "POST26"}, 1)
 def csys(s: SessionState, c: Call) -> None:
     kcn = c.int(1, 0, what="KCN")
     if kcn not in (0, 1):
@@ -68,6 +69,7 @@ def _spacing(n: int, space: float) -> np.ndarray:
     return np.cumsum(lengths)[:-1] / lengths.sum()
 
 
+@command("FILL", PREP7, 8)
 def fill(s: SessionState, c: Call) -> None:
     """FILL,NODE1,NODE2,NFILL,NSTRT,NINC,ITIME,INC,SPACE: nodes between two nodes."""
     history = s.db.node_history
@@ -95,6 +97,7 @@ def fill(s: SessionState, c: Call) -> None:
             s.db.nodes.add(nstrt + k * inc + j * ninc, x, y)
 
 
+@command("NGEN", PREP7, 9)
 def ngen(s: SessionState, c: Call) -> None:
     """NGEN,ITIME,INC,NODE1,NODE2,NINC,DX,DY,DZ: copies of a node pattern, offset."""
     itime = c.int(1, what="ITIME")
@@ -123,6 +126,7 @@ def ngen(s: SessionState, c: Call) -> None:
             nodes.add(num + k * inc, x, y)
 
 
+@command("EGEN", PREP7, 14)
 def egen(s: SessionState, c: Call) -> None:
     """EGEN,ITIME,NINC,IEL1,IEL2,IEINC,MINC,TINC,RINC: copies of an element pattern with
     node numbers (and attributes) incremented."""
@@ -166,6 +170,7 @@ def egen(s: SessionState, c: Call) -> None:
             number += 1
 
 
+@command("EMID", PREP7, 2)
 def emid(s: SessionState, c: Call) -> None:
     """EMID: mid-side nodes at the edge midpoints of quadratic elements that lack them."""
     db = s.db
@@ -201,6 +206,7 @@ def emid(s: SessionState, c: Call) -> None:
     s.say(f"EMID: {len(made)} mid-side nodes")
 
 
+@command("NUMMRG", PREP7, 5)
 def nummrg(s: SessionState, c: Call) -> None:
     """NUMMRG,NODE|ALL[,TOLER]: elements use the lowest-numbered of coincident nodes."""
     label = c.label(1, "ALL")
@@ -232,6 +238,7 @@ def nummrg(s: SessionState, c: Call) -> None:
     s.say(f"NUMMRG: {int(np.sum(keep != np.arange(keep.size)))} coincident nodes merged")
 
 
+@command("ESURF", PREP7, 3)
 def esurf(s: SessionState, c: Call) -> None:
     """ESURF: surface elements (the active TYPE, e.g. SURF151) on the exterior faces of the
     selected solid elements whose nodes are all selected."""
@@ -285,6 +292,7 @@ def _set_number(s: SessionState, c: Call) -> int:
     return c.int(1, what="NSET")
 
 
+@command("CP", PREP7, 19)
 def cp(s: SessionState, c: Call) -> None:
     """CP,NSET,Lab,NODE1,...,NODE17: the nodes share one value of Lab."""
     nset = _set_number(s, c)
@@ -309,6 +317,7 @@ def _add_coupling(s: SessionState, nset: int, label: str, numbers: np.ndarray) -
     s.db.couplings[nset] = (label, np.unique(merged))
 
 
+@command("CPNGEN", PREP7, 5)
 def cpngen(s: SessionState, c: Call) -> None:
     """CPNGEN,NSET,Lab,NODE1,NODE2,NINC: nodes NODE1..NODE2 into one coupled set."""
     nset = _set_number(s, c)
@@ -320,6 +329,7 @@ def cpngen(s: SessionState, c: Call) -> None:
     _add_coupling(s, nset, label, wanted[s.db.nodes.index(wanted) >= 0])
 
 
+@command("CPSGEN", PREP7, 6)
 def cpsgen(s: SessionState, c: Call) -> None:
     """CPSGEN,ITIME,INC,NSET1,NSET2,NINC: copies of coupled sets, node numbers + k·INC."""
     itime, inc = c.int(1, what="ITIME"), c.int(2, what="INC")
@@ -341,14 +351,5 @@ def cpsgen(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("CSYS", PREP7 | {"SOLU", "POST1", "BEGIN", "POST26"}, 1, csys),
-    CommandSpec("FILL", PREP7, 8, fill),
-    CommandSpec("NGEN", PREP7, 9, ngen),
-    CommandSpec("EGEN", PREP7, 14, egen),
-    CommandSpec("EMID", PREP7, 2, emid),
-    CommandSpec("NUMMRG", PREP7, 5, nummrg),
-    CommandSpec("ESURF", PREP7, 3, esurf),
-    CommandSpec("CP", PREP7, 19, cp),
-    CommandSpec("CPNGEN", PREP7, 5, cpngen),
-    CommandSpec("CPSGEN", PREP7, 6, cpsgen),
+    *specs_of(csys, fill, ngen, egen, emid, nummrg, esurf, cp, cpngen, cpsgen),
 )

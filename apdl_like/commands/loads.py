@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import LOADS, Call, CommandSpec
+from apdl_like.call import LOADS, Call, command, specs_of
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import pair_keys
@@ -82,6 +82,7 @@ def element_targets(s: SessionState, c: Call, i: int = 1) -> np.ndarray:
 _D_LABELS = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",), "ALL": ("d_ux", "d_uy")}
 
 
+@command("D", LOADS, 11)
 def d(s: SessionState, c: Call) -> None:
     labels = [c.label(2)] + [c.label(i) for i in range(7, 12) if c.given(i)]
     for lab in labels:
@@ -98,6 +99,7 @@ def d(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("DDELE", LOADS, 5)
 def ddele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     keys = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",),
@@ -133,6 +135,7 @@ def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | Non
         f.hflux_record[faces] = rec
 
 
+@command("SF", LOADS, 4)
 def sf(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab not in ("CONV", "HFLUX"):
@@ -146,6 +149,7 @@ def sf(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("SFDELE", LOADS, 2)
 def sfdele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     if lab not in ("CONV", "HFLUX", "ALL"):
@@ -188,6 +192,7 @@ def _element_faces(s: SessionState, elems: np.ndarray, lkey: int) -> np.ndarray:
     return faces
 
 
+@command("SFE", LOADS, 8)
 def sfe(s: SessionState, c: Call) -> None:
     lkey = c.int(2, 1, what="LKEY")
     if lkey not in (1, 2, 3, 4):
@@ -217,6 +222,7 @@ def _set_hgen(s: SessionState, elems: np.ndarray, value: float | None) -> None:
     arrays["hgen_record"][elems] = -1 if value is None else s.db.next_record()
 
 
+@command("BF", LOADS, 6)
 def bf(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab == "TEMP":
@@ -235,6 +241,7 @@ def bf(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("BFE", LOADS, 7)
 def bfe(s: SessionState, c: Call) -> None:
     lab = c.label(2)
     if lab != "HGEN":
@@ -250,6 +257,7 @@ def bfe(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("BFEDELE", LOADS, 2)
 def bfedele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
     if lab not in ("HGEN", "ALL"):
@@ -257,6 +265,7 @@ def bfedele(s: SessionState, c: Call) -> None:
     _set_hgen(s, element_targets(s, c, 1), None)
 
 
+@command("IC", LOADS, 5)
 def ic(s: SessionState, c: Call) -> None:
     lab = c.label(2, "TEMP")
     if lab != "TEMP":
@@ -265,31 +274,23 @@ def ic(s: SessionState, c: Call) -> None:
     s.db.nodes.arrays["ic_temp"][node_targets(s, c, 1)] = value
 
 
+@command("TUNIF", LOADS, 1)
 def tunif(s: SessionState, c: Call) -> None:
     s.db.settings.tunif = c.num(1, 0.0, what="TEMP")
 
 
+@command("BFUNIF", LOADS, 2)
 def bfunif(s: SessionState, c: Call) -> None:
     if c.label(1) != "TEMP":
         raise ApdlError(f"field 1: BFUNIF supports TEMP only, got {c.label(1) or '(empty)'!r}")
     s.db.settings.tunif = c.num(2, 0.0, what="VALUE")
 
 
+@command("TREF", LOADS, 1)
 def tref(s: SessionState, c: Call) -> None:
     s.db.settings.tref = c.num(1, 0.0, what="TREF")
 
 
 COMMANDS = (
-    CommandSpec("D", LOADS, 11, d),
-    CommandSpec("DDELE", LOADS, 5, ddele),
-    CommandSpec("SF", LOADS, 4, sf),
-    CommandSpec("SFDELE", LOADS, 2, sfdele),
-    CommandSpec("SFE", LOADS, 8, sfe),
-    CommandSpec("BF", LOADS, 6, bf),
-    CommandSpec("BFE", LOADS, 7, bfe),
-    CommandSpec("BFEDELE", LOADS, 2, bfedele),
-    CommandSpec("IC", LOADS, 5, ic),
-    CommandSpec("TUNIF", LOADS, 1, tunif),
-    CommandSpec("BFUNIF", LOADS, 2, bfunif),
-    CommandSpec("TREF", LOADS, 1, tref),
+    *specs_of(d, ddele, sf, sfdele, sfe, bf, bfe, bfedele, ic, tunif, bfunif, tref),
 )

@@ -6,13 +6,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import POST, Call, CommandSpec
+from apdl_like.call import POST, Call, command, specs_of
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 
+@command("SET", POST, 5)
 def set_(s: SessionState, c: Call) -> None:
     if not s.solution.results:
         raise ApdlError("there are no results (SOLVE first)")
@@ -41,6 +42,7 @@ _ITEMS = {
 }
 
 
+@command("PRNSOL", POST, 2)
 def prnsol(s: SessionState, c: Call) -> None:
     key = (c.label(1, "TEMP"), c.label(2))
     items = _ITEMS.get(key)
@@ -68,6 +70,5 @@ def prnsol(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("SET", POST, 5, set_),
-    CommandSpec("PRNSOL", POST, 2, prnsol),
+    *specs_of(set_, prnsol),
 )

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import POST, POST26, Call, CommandSpec, ignored
+from apdl_like.call import POST, POST26, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
@@ -57,6 +57,7 @@ def _variable(c: Call) -> int:
     return n
 
 
+@command("NSOL", POST26, 7)
 def nsol(s: SessionState, c: Call) -> None:
     """NSOL,NVAR,NODE,TEMP,,Name."""
     nvar = _variable(c)
@@ -71,6 +72,7 @@ def nsol(s: SessionState, c: Call) -> None:
     s.variables[nvar] = (c.label(5, "TEMP"), times, np.array([T[dof] for T in temps]))
 
 
+@command("ESOL", POST26, 7)
 def esol(s: SessionState, c: Call) -> None:
     """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes."""
     nvar = _variable(c)
@@ -90,6 +92,7 @@ def esol(s: SessionState, c: Call) -> None:
     s.variables[nvar] = (c.label(6, "HEAT"), times, values)
 
 
+@command("PRVAR", POST26, 6)
 def prvar(s: SessionState, c: Call) -> None:
     """PRVAR,NV1,...,NV6: the variables against TIME."""
     chosen = [c.int(i, what="NVAR") for i in range(1, c.count() + 1) if c.given(i)]
@@ -132,6 +135,7 @@ def reactions(s: SessionState) -> tuple[np.ndarray, np.ndarray]:
     return fixed, r[model.mesh.node_dof[fixed]]
 
 
+@command("PRNLD", POST, 6)
 def prnld(s: SessionState, c: Call) -> None:
     """PRNLD,HEAT: reaction heat at the selected nodes with a fixed temperature."""
     if c.label(1, "HEAT") not in ("HEAT", "ALL"):
@@ -144,6 +148,7 @@ def prnld(s: SessionState, c: Call) -> None:
     s.say(f"   TOTAL {float(heat[selected].sum()):16.6E}")
 
 
+@command("FSUM", POST, 2)
 def fsum(s: SessionState, c: Call) -> None:
     """FSUM: the total reaction heat of the selected nodes (*GET,Par,FSUM,,ITEM,HEAT)."""
     nodes, heat = reactions(s)
@@ -153,10 +158,6 @@ def fsum(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("NSOL", POST26, 7, nsol),
-    CommandSpec("ESOL", POST26, 7, esol),
+    *specs_of(nsol, esol, prvar, prnld, fsum),
     CommandSpec("STORE", POST26, 2, ignored),  # variables are computed when defined
-    CommandSpec("PRVAR", POST26, 6, prvar),
-    CommandSpec("PRNLD", POST, 6, prnld),
-    CommandSpec("FSUM", POST, 2, fsum),
 )

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec
+from apdl_like.call import PREP7, Call, CommandSpec, command, specs_of
 from apdl_like.commands.generate import to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
@@ -49,6 +49,7 @@ def _element_name(c: Call) -> str:
                     "PLANE183)")
 
 
+@command("ET", PREP7, 8)
 def et(s: SessionState, c: Call) -> None:
     itype = _entity_number(c, 1, "ITYPE")
     name = _element_name(c)
@@ -63,6 +64,7 @@ def et(s: SessionState, c: Call) -> None:
     s.db.element_types[itype] = ElementType(name, keyopt)
 
 
+@command("KEYOPT", PREP7, 3)
 def keyopt(s: SessionState, c: Call) -> None:
     itype = _entity_number(c, 1, "ITYPE")
     knum = c.int(2, what="KNUM")
@@ -75,6 +77,7 @@ def keyopt(s: SessionState, c: Call) -> None:
     et_.keyopt[knum] = value
 
 
+@command("ETCHG", PREP7, 1)
 def etchg(s: SessionState, c: Call) -> None:
     how = c.label(1)
     if how not in ("TTS", "STT"):
@@ -95,6 +98,7 @@ def _attribute(name: str):  # noqa: ANN202
 
 
 
+@command("MP", PREP7, 7)
 def mp(s: SessionState, c: Call) -> None:
     label = c.label(1)
     if label not in MP_LABELS:
@@ -117,6 +121,7 @@ def mp(s: SessionState, c: Call) -> None:
         material.coefficients.pop(label, None)
 
 
+@command("MPTEMP", PREP7, 7)
 def mptemp(s: SessionState, c: Call) -> None:
     """MPTEMP,STLOC,T1..T6: the temperatures of the next MPDATA tables (blank: erase)."""
     if c.count() == 0:
@@ -134,6 +139,7 @@ def mptemp(s: SessionState, c: Call) -> None:
     s.db.mp_temperatures = temps
 
 
+@command("MPDATA", PREP7, 9)
 def mpdata(s: SessionState, c: Call) -> None:
     """MPDATA,Lab,MAT,STLOC,C1..C6: property values at the MPTEMP temperatures."""
     label = c.label(1)
@@ -169,6 +175,7 @@ def _real_values(s: SessionState, nset: int, start: int, c: Call, first_field: i
             values[start + k] = c.num(first_field + k, what=f"R{start + k}")
 
 
+@command("R", PREP7, 7)
 def r(s: SessionState, c: Call) -> None:
     nset = _entity_number(c, 1, "NSET")
     s.db.real_sets[nset] = {}
@@ -176,6 +183,7 @@ def r(s: SessionState, c: Call) -> None:
     s.db.last_real = (nset, 7)
 
 
+@command("RMORE", PREP7, 6)
 def rmore(s: SessionState, c: Call) -> None:
     if s.db.last_real is None:
         raise ApdlError("RMORE needs a preceding R command")
@@ -184,6 +192,7 @@ def rmore(s: SessionState, c: Call) -> None:
     s.db.last_real = (nset, start + 6)
 
 
+@command("RMODIF", PREP7, 8)
 def rmodif(s: SessionState, c: Call) -> None:
     nset = _entity_number(c, 1, "NSET")
     stloc = c.int(2, what="STLOC")
@@ -195,6 +204,7 @@ def rmodif(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("N", PREP7, 7)
 def n(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     if c.given(1):
@@ -215,6 +225,7 @@ _NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (3, 4, 8),
                 "PLANE183": (3, 4, 8), "PLANE35": (3, 6), "SURF151": (2, 3)}
 
 
+@command("E", PREP7, 8)
 def e(s: SessionState, c: Call) -> None:
     db = s.db
     et_ = db.element_types.get(db.active_type)
@@ -247,6 +258,7 @@ def e(s: SessionState, c: Call) -> None:
     el.add(number, db.active_type, db.active_mat, db.active_real, tuple(nums))
 
 
+@command("EMODIF", PREP7, 3)
 def emodif(s: SessionState, c: Call) -> None:
     """EMODIF,IEL|ALL,MAT|TYPE|REAL,value: change an attribute of elements."""
     from apdl_like.commands.loads import element_targets
@@ -263,18 +275,7 @@ def emodif(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("ET", PREP7, 8, et),
-    CommandSpec("KEYOPT", PREP7, 3, keyopt),
-    CommandSpec("ETCHG", PREP7, 1, etchg),
-    CommandSpec("MP", PREP7, 7, mp),
-    CommandSpec("MPTEMP", PREP7, 7, mptemp),
-    CommandSpec("MPDATA", PREP7, 9, mpdata),
-    CommandSpec("R", PREP7, 7, r),
-    CommandSpec("RMORE", PREP7, 6, rmore),
-    CommandSpec("RMODIF", PREP7, 8, rmodif),
-    CommandSpec("N", PREP7, 7, n),
-    CommandSpec("E", PREP7, 8, e),
-    CommandSpec("EMODIF", PREP7, 3, emodif),
+    *specs_of(et, keyopt, etchg, mp, mptemp, mpdata, r, rmore, rmodif, n, e, emodif),
     CommandSpec("TYPE", PREP7, 1, _attribute("type")),
     CommandSpec("MAT", PREP7, 1, _attribute("mat")),
     CommandSpec("REAL", PREP7, 1, _attribute("real")),

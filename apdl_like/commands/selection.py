@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import MODEL, Call, CommandSpec
+from apdl_like.call import MODEL, Call, command, specs_of
 from apdl_like.commands.generate import from_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
@@ -34,6 +34,7 @@ def _range(c: Call) -> tuple[float, float, float]:
     return vmin, vmax, vinc
 
 
+@command("NSEL", _ANY_OR_BEGIN, 7)
 def nsel(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     mode = _mode(c)
@@ -60,6 +61,7 @@ def nsel(s: SessionState, c: Call) -> None:
     nodes.selected = combine(mode, current, picked)
 
 
+@command("ESEL", _ANY_OR_BEGIN, 7)
 def esel(s: SessionState, c: Call) -> None:
     el = s.db.elements
     mode = _mode(c)
@@ -105,6 +107,7 @@ def _element_node_indices(s: SessionState, element_mask: np.ndarray) -> np.ndarr
     return idx[idx >= 0]
 
 
+@command("NSLE", _ANY_OR_BEGIN, 3)
 def nsle(s: SessionState, c: Call) -> None:
     mode = _mode(c)
     nodes = s.db.nodes
@@ -113,6 +116,7 @@ def nsle(s: SessionState, c: Call) -> None:
     nodes.selected = combine(mode, nodes.selected, picked)
 
 
+@command("ESLN", _ANY_OR_BEGIN, 3)
 def esln(s: SessionState, c: Call) -> None:
     mode = _mode(c)
     key = c.int(2, 0, what="EKEY")
@@ -126,6 +130,7 @@ def esln(s: SessionState, c: Call) -> None:
     el.selected = combine(mode, el.selected, picked)
 
 
+@command("ALLSEL", _ANY_OR_BEGIN, 2)
 def allsel(s: SessionState, c: Call) -> None:
     s.db.nodes.selected = np.ones(len(s.db.nodes), bool)
     s.db.elements.selected = np.ones(len(s.db.elements), bool)
@@ -141,6 +146,7 @@ def _component_name(c: Call, i: int) -> str:
     return name
 
 
+@command("CM", _ANY_OR_BEGIN, 3)
 def cm(s: SessionState, c: Call) -> None:
     name = _component_name(c, 1)
     entity = c.label(2)
@@ -153,6 +159,7 @@ def cm(s: SessionState, c: Call) -> None:
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
 
 
+@command("CMDELE", _ANY_OR_BEGIN, 1)
 def cmdele(s: SessionState, c: Call) -> None:
     name = _component_name(c, 1)
     if s.db.components.pop(name, None) is None:
@@ -171,6 +178,7 @@ def component_mask(s: SessionState, comp: Component) -> np.ndarray:
     return comp.mask(s.db.nodes if comp.entity == "NODE" else s.db.elements)
 
 
+@command("CMSEL", _ANY_OR_BEGIN, 3)
 def cmsel(s: SessionState, c: Call) -> None:
     mode = c.label(1, "S")
     if mode in ("ALL", "NONE"):
@@ -188,12 +196,5 @@ def cmsel(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("NSEL", _ANY_OR_BEGIN, 7, nsel),
-    CommandSpec("ESEL", _ANY_OR_BEGIN, 7, esel),
-    CommandSpec("NSLE", _ANY_OR_BEGIN, 3, nsle),
-    CommandSpec("ESLN", _ANY_OR_BEGIN, 3, esln),
-    CommandSpec("ALLSEL", _ANY_OR_BEGIN, 2, allsel),
-    CommandSpec("CM", _ANY_OR_BEGIN, 3, cm),
-    CommandSpec("CMDELE", _ANY_OR_BEGIN, 1, cmdele),
-    CommandSpec("CMSEL", _ANY_OR_BEGIN, 3, cmsel),
+    *specs_of(nsel, esel, nsle, esln, allsel, cm, cmdele, cmsel),
 )

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec, ignored
+from apdl_like.call import PREP7, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.commands.generate import from_cartesian, to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped
@@ -32,6 +32,7 @@ def _number(c: Call, i: int, what: str) -> int:
     return n
 
 
+@command("K", PREP7, 4)
 def k(s: SessionState, c: Call) -> None:
     """K,NPT,X,Y: a keypoint (number 0 or blank: the next free one)."""
     kps = s.db.keypoints
@@ -43,6 +44,7 @@ def k(s: SessionState, c: Call) -> None:
     kps[num] = to_cartesian(s.db.csys, c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
 
 
+@command("KGEN", PREP7, 8)
 def kgen(s: SessionState, c: Call) -> None:
     """KGEN,ITIME,NP1,NP2,NINC,DX,DY,DZ,KINC: copies of keypoints, offset."""
     itime = c.int(1, what="ITIME")
@@ -64,6 +66,7 @@ def kgen(s: SessionState, c: Call) -> None:
             kps[new] = to_cartesian(s.db.csys, a + j * dx, b + j * dy)
 
 
+@command("L", PREP7, 4)
 def line(s: SessionState, c: Call) -> None:
     """L,P1,P2[,NDIV,SPACE]: a straight line between two keypoints."""
     p1, p2 = _number(c, 1, "P1"), _number(c, 2, "P2")
@@ -76,6 +79,7 @@ def line(s: SessionState, c: Call) -> None:
     s.db.lines[max(s.db.lines, default=0) + 1] = Line(p1, p2, ndiv, c.num(4, 1.0, what="SPACE"))
 
 
+@command("LESIZE", PREP7, 9)
 def lesize(s: SessionState, c: Call) -> None:
     """LESIZE,NL1,SIZE,ANGSIZ,NDIV,SPACE: divisions (or size) and spacing ratio of lines."""
     lines = s.db.lines
@@ -103,6 +107,7 @@ def lesize(s: SessionState, c: Call) -> None:
         ln.ndiv, ln.space = ndiv, space
 
 
+@command("A", PREP7, 18)
 def area(s: SessionState, c: Call) -> None:
     """A,P1,P2,...: an area through keypoints (in order around it)."""
     pts = [_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
@@ -114,6 +119,7 @@ def area(s: SessionState, c: Call) -> None:
     s.db.areas[max(s.db.areas, default=0) + 1] = pts
 
 
+@command("AL", PREP7, 10)
 def area_lines(s: SessionState, c: Call) -> None:
     """AL,L1,L2,...: an area bounded by lines (in order around it)."""
     nums = [_number(c, i, "line") for i in range(1, c.count() + 1) if c.given(i)]
@@ -137,6 +143,7 @@ def area_lines(s: SessionState, c: Call) -> None:
     s.db.areas[max(s.db.areas, default=0) + 1] = pts
 
 
+@command("RECTNG", PREP7, 4)
 def rectng(s: SessionState, c: Call) -> None:
     x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
     y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
@@ -150,6 +157,7 @@ def rectng(s: SessionState, c: Call) -> None:
     s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
 
 
+@command("ESIZE", PREP7, 2)
 def esize(s: SessionState, c: Call) -> None:
     """ESIZE,SIZE,NDIV: element edge length, or divisions per line when SIZE is blank."""
     if c.given(1):
@@ -166,6 +174,7 @@ def esize(s: SessionState, c: Call) -> None:
         raise ApdlError("ESIZE needs SIZE (field 1) or NDIV (field 2)")
 
 
+@command("MSHAPE", PREP7, 2)
 def mshape(s: SessionState, c: Call) -> None:
     """MSHAPE,KEY: 0 quads (mapped where the area allows), 1 triangles."""
     key = c.int(1, 0, what="KEY")
@@ -174,6 +183,7 @@ def mshape(s: SessionState, c: Call) -> None:
     s.db.mesh_triangles = key == 1
 
 
+@command("AMESH", PREP7, 3)
 def amesh(s: SessionState, c: Call) -> None:
     areas = s.db.areas
     if c.label(1, "ALL") == "ALL":
@@ -211,15 +221,6 @@ def amesh(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("K", PREP7, 4, k),
-    CommandSpec("KGEN", PREP7, 8, kgen),
-    CommandSpec("L", PREP7, 4, line),
-    CommandSpec("LESIZE", PREP7, 9, lesize),
-    CommandSpec("A", PREP7, 18, area),
-    CommandSpec("AL", PREP7, 10, area_lines),
-    CommandSpec("RECTNG", PREP7, 4, rectng),
-    CommandSpec("ESIZE", PREP7, 2, esize),
-    CommandSpec("MSHAPE", PREP7, 2, mshape),
+    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, esize, mshape, amesh),
     CommandSpec("MSHKEY", PREP7, 1, ignored),  # mapped wherever the area allows
-    CommandSpec("AMESH", PREP7, 3, amesh),
 )

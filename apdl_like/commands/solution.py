@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import LOADS, SOLU, Call, CommandSpec, ignored
+from apdl_like.call import LOADS, SOLU, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.errors import ApdlError
 from apdl_like.solve import solve_structural, solve_thermal
 
@@ -15,6 +15,8 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 
+# load-step options (ANTYPE to TINTP): MAPDL accepts them in /PREP7 too
+@command("ANTYPE", LOADS, 4)
 def antype(s: SessionState, c: Call) -> None:
     kind = c.label(1)
     status = c.label(2, "NEW")
@@ -40,6 +42,7 @@ def antype(s: SessionState, c: Call) -> None:
         s.solution.new_analysis = False
 
 
+@command("TIME", LOADS, 1)
 def time(s: SessionState, c: Call) -> None:
     t = c.num(1, what="TIME")
     if t < 0.0:
@@ -48,6 +51,7 @@ def time(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("DELTIM", LOADS, 4)
 def deltim(s: SessionState, c: Call) -> None:
     """DELTIM,DTIME,DTMIN,DTMAX: the (first) substep and, with AUTOTS, its bounds."""
     dt = c.num(1, what="DTIME")
@@ -63,6 +67,7 @@ def deltim(s: SessionState, c: Call) -> None:
         raise ApdlError(f"DTMAX must be ≥ DTIME, got {settings.dtmax!r}")
 
 
+@command("NSUBST", LOADS, 4)
 def nsubst(s: SessionState, c: Call) -> None:
     """NSUBST,NSBSTP,NSBMX,NSBMN: substeps and, with AUTOTS, their bounds."""
     n = c.int(1, what="NSBSTP")
@@ -79,6 +84,7 @@ def nsubst(s: SessionState, c: Call) -> None:
     settings.nsub_max, settings.nsub_min = nmax, nmin
 
 
+@command("KBC", LOADS, 1)
 def kbc(s: SessionState, c: Call) -> None:
     key = c.int(1, 0, what="KEY")
     if key not in (0, 1):
@@ -86,6 +92,7 @@ def kbc(s: SessionState, c: Call) -> None:
     s.db.settings.kbc = key
 
 
+@command("TIMINT", LOADS, 2)
 def timint(s: SessionState, c: Call) -> None:
     key = c.label(1, "ON")
     if key not in ("ON", "OFF", "1", "0"):
@@ -93,10 +100,12 @@ def timint(s: SessionState, c: Call) -> None:
     s.db.settings.timint = key in ("ON", "1")
 
 
+@command("OUTRES", LOADS, 3)
 def outres(s: SessionState, c: Call) -> None:
     s.db.settings.outres = c.label(2, "ALL")
 
 
+@command("AUTOTS", LOADS, 1)
 def autots(s: SessionState, c: Call) -> None:
     """AUTOTS,ON|OFF (blank: ON): time steps chosen by an error estimate within bounds."""
     key = c.label(1, "ON")
@@ -105,6 +114,7 @@ def autots(s: SessionState, c: Call) -> None:
     s.db.settings.autots = key in ("ON", "1", "PROG")
 
 
+@command("TINTP", LOADS, 6)
 def tintp(s: SessionState, c: Call) -> None:
     """TINTP,,,,THETA: the transient integration parameter (1 backward Euler, 0.5 CN)."""
     if c.given(4):
@@ -118,6 +128,7 @@ def tintp(s: SessionState, c: Call) -> None:
 # steps are uniform, as DELTIM/NSUBST ask
 
 
+@command("LDREAD", SOLU, 8)
 def ldread(s: SessionState, c: Call) -> None:
     """LDREAD,TEMP[,LSTEP]: the session's thermal result as body temperatures.
 
@@ -140,6 +151,7 @@ def ldread(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("SOLVE", SOLU, 0)
 def solve(s: SessionState, c: Call) -> None:
     s.budget.unsolved = None
     types = {s.db.element_types[int(t)].physics for t in np.unique(s.db.elements.type)
@@ -179,6 +191,7 @@ def _load_state(s: SessionState) -> dict:
         "node_ids": db.nodes.ids, "element_ids": db.elements.ids})
 
 
+@command("LSWRITE", LOADS, 2)
 def lswrite(s: SessionState, c: Call) -> None:
     """LSWRITE,LSNUM: the current loads and options as load step LSNUM (in memory)."""
     steps = s.load_steps
@@ -203,11 +216,13 @@ def _restore(s: SessionState, num: int) -> None:
     db.faces, db.settings, db.real_sets = saved["faces"], saved["settings"], saved["real_sets"]
 
 
+@command("LSREAD", LOADS, 2)
 def lsread(s: SessionState, c: Call) -> None:
     """LSREAD,LSNUM: make load step LSNUM's loads and options the current ones."""
     _restore(s, c.int(1, 1, what="LSNUM"))
 
 
+@command("LSSOLVE", SOLU, 3)
 def lssolve(s: SessionState, c: Call) -> None:
     """LSSOLVE,LSMIN,LSMAX,LSINC: read and solve load steps in turn."""
     first = c.int(1, what="LSMIN")
@@ -221,21 +236,8 @@ def lssolve(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("LSWRITE", LOADS, 2, lswrite),
-    CommandSpec("LSREAD", LOADS, 2, lsread),
-    CommandSpec("LSSOLVE", SOLU, 3, lssolve),
-    # load-step options: MAPDL accepts them in /PREP7 too
-    CommandSpec("ANTYPE", LOADS, 4, antype),
-    CommandSpec("TIME", LOADS, 1, time),
-    CommandSpec("DELTIM", LOADS, 4, deltim),
-    CommandSpec("NSUBST", LOADS, 4, nsubst),
-    CommandSpec("KBC", LOADS, 1, kbc),
-    CommandSpec("TIMINT", LOADS, 2, timint),
-    CommandSpec("OUTRES", LOADS, 3, outres),
-    CommandSpec("AUTOTS", LOADS, 1, autots),
-    CommandSpec("TINTP", LOADS, 6, tintp),
-    CommandSpec("LDREAD", SOLU, 8, ldread),
-    CommandSpec("SOLVE", SOLU, 0, solve),
+    *specs_of(lswrite, lsread, lssolve, antype, time, deltim, nsubst, kbc, timint, outres, autots,
+              tintp, ldread, solve),
     CommandSpec("TRNOPT", LOADS, 8, ignored),
     # solver and output options: the direct solve and its listing need none of them
     *(CommandSpec(name, LOADS, 10, ignored) for name in (

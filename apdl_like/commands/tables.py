@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import ANY, Call, CommandSpec
+from apdl_like.call import ANY, Call, CommandSpec, command, specs_of
 from apdl_like.errors import ApdlError
 from apdl_like.fortran_format import format_c_line, format_line, parse_format
 from apdl_like.params import column, dimension, split_target, store, subscripts, value_of
@@ -43,6 +43,7 @@ def file_name(c: Call, default_ext: str = "") -> str:
     return name
 
 
+@command("*DIM", ANY, 8)
 def star_dim(s: SessionState, c: Call) -> None:
     name, subs = split_target(c.raw(1))
     if subs:
@@ -56,6 +57,7 @@ def star_dim(s: SessionState, c: Call) -> None:
     dimension(s.params, name, kind, shape)
 
 
+@command("*VFILL", ANY, 20)
 def star_vfill(s: SessionState, c: Call) -> None:
     """*VFILL,Par(i,j),DATA,v1,v2,... or RAMP,start,increment (down the column)."""
     name, subs_text = split_target(c.raw(1))
@@ -78,6 +80,7 @@ def star_vfill(s: SessionState, c: Call) -> None:
     store(params, name, subs, values)
 
 
+@command("*VWRITE", ANY, 19)
 def star_vwrite(s: SessionState, c: Call) -> None:
     """*VWRITE,Par1,...: one line per row of the array arguments, by the format line."""
     params, funcs = s.params, s.model_functions
@@ -121,6 +124,7 @@ def _is_reference(text: str) -> bool:
     return bool(re.match(r"\s*[A-Za-z_][A-Za-z0-9_]*\s*(\(.*\))?\s*\Z", text, re.S))
 
 
+@command("/OUT", ANY, 4)
 def out(s: SessionState, c: Call) -> None:
     """/OUT,Fname,Ext,,APPEND: output to a file; /OUT alone (or TERM): back to the log."""
     listing = s.listing
@@ -133,6 +137,7 @@ def out(s: SessionState, c: Call) -> None:
     listing.target = name
 
 
+@command("*CFOPEN", ANY, 4)
 def cfopen(s: SessionState, c: Call) -> None:
     name = file_name(c, "" if c.given(1) else "cmd")
     if c.label(4) != "APPEND" or name not in s.listing.files:
@@ -140,6 +145,7 @@ def cfopen(s: SessionState, c: Call) -> None:
     s.listing.command_file = name
 
 
+@command("*CFWRITE", ANY, 40)
 def cfwrite(s: SessionState, c: Call) -> None:
     if s.listing.command_file is None:
         raise ApdlError("no command file is open (*CFOPEN first)")
@@ -147,10 +153,12 @@ def cfwrite(s: SessionState, c: Call) -> None:
     s.listing.files[s.listing.command_file].append(text.rstrip())
 
 
+@command("*CFCLOS", ANY, 0)
 def cfclos(s: SessionState, c: Call) -> None:
     s.listing.command_file = None
 
 
+@command("*LIST", ANY, 3)
 def star_list(s: SessionState, c: Call) -> None:
     """*LIST,Fname,Ext: a file this deck wrote, copied into the output."""
     name = file_name(c)
@@ -161,6 +169,7 @@ def star_list(s: SessionState, c: Call) -> None:
         s.say(line)
 
 
+@command("*STATUS", ANY, 5)
 def star_status(s: SessionState, c: Call) -> None:
     """*STATUS[,Par]: parameters, their type and value or dimensions."""
     wanted = c.raw(1).upper()
@@ -179,11 +188,13 @@ def star_status(s: SessionState, c: Call) -> None:
             s.say(f"{name:<32} {value:>20.10G}  SCALAR")
 
 
+@command("SAVE", ANY, 4)
 def save(s: SessionState, c: Call) -> None:
     """SAVE,Fname,Ext: a copy of the database and parameters, in memory."""
     s.saved[file_name(c, "db")] = (copy.deepcopy(s.db), copy.deepcopy(s.params))
 
 
+@command("RESUME", ANY, 4)
 def resume(s: SessionState, c: Call) -> None:
     name = file_name(c, "db")
     saved = s.saved.get(name)
@@ -192,6 +203,7 @@ def resume(s: SessionState, c: Call) -> None:
     s.db, s.params = copy.deepcopy(saved[0]), copy.deepcopy(saved[1])
 
 
+@command("*SET", ANY, 11)
 def star_set_values(s: SessionState, c: Call) -> None:
     """*SET,Par,v1[,v2,...]: a scalar or character value, or values down an array column."""
     name, subs_text = split_target(c.raw(1))
@@ -204,17 +216,7 @@ def star_set_values(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    CommandSpec("*DIM", ANY, 8, star_dim),
-    CommandSpec("*VFILL", ANY, 20, star_vfill),
-    CommandSpec("*VWRITE", ANY, 19, star_vwrite),
-    CommandSpec("/OUT", ANY, 4, out),
+    *specs_of(star_dim, star_vfill, star_vwrite, out, cfopen, cfwrite, cfclos, star_list,
+              star_status, save, resume, star_set_values),
     CommandSpec("/OUTPUT", ANY, 4, out),
-    CommandSpec("*CFOPEN", ANY, 4, cfopen),
-    CommandSpec("*CFWRITE", ANY, 40, cfwrite),
-    CommandSpec("*CFCLOS", ANY, 0, cfclos),
-    CommandSpec("*LIST", ANY, 3, star_list),
-    CommandSpec("*STATUS", ANY, 5, star_status),
-    CommandSpec("SAVE", ANY, 4, save),
-    CommandSpec("RESUME", ANY, 4, resume),
-    CommandSpec("*SET", ANY, 11, star_set_values),
 )
