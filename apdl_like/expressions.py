@@ -154,19 +154,20 @@ class _Parser:
             raise self.fail(f"unexpected {self.peek()[1]!r}")  # type: ignore[index]
         return node
 
-    def expr(self) -> Evaluator:
-        node = self.term()
-        while (tok := self.peek()) in (("op", "+"), ("op", "-")):
+    def _left_associative(self, ops: tuple[str, ...],
+                          operand: Callable[[], Evaluator]) -> Evaluator:
+        """operand (op operand)*, folded from the left: a - b - c is (a - b) - c."""
+        node = operand()
+        while (tok := self.peek()) is not None and tok[0] == "op" and tok[1] in ops:
             self.i += 1
-            node = _binary(tok[1], node, self.term())  # type: ignore[index]
+            node = _binary(tok[1], node, operand())
         return node
 
+    def expr(self) -> Evaluator:
+        return self._left_associative(("+", "-"), self.term)
+
     def term(self) -> Evaluator:
-        node = self.unary()
-        while (tok := self.peek()) in (("op", "*"), ("op", "/")):
-            self.i += 1
-            node = _binary(tok[1], node, self.unary())  # type: ignore[index]
-        return node
+        return self._left_associative(("*", "/"), self.unary)
 
     def unary(self) -> Evaluator:
         tok = self.peek()

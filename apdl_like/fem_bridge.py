@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from apdl_like.errors import ApdlError
-from apdl_like.model import Database
+from apdl_like.model import Database, element_corners
 from twin.fem import AxiMesh
 
 PAIR_BASE = np.int64(1) << 31  # node numbers are < 2^31: (lo, hi) packs into one int64
@@ -189,12 +189,7 @@ def triangulate(db: Database) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     nodes = el.nodes
     idx = db.nodes.index(nodes.ravel()).reshape(nodes.shape)
     idx[nodes == 0] = -1
-    corner = idx[:, :4].copy()
-    corner[tri6, 3] = corner[tri6, 2]
-    corner[corner[:, 3] < 0, 3] = corner[corner[:, 3] < 0, 2]
-    if np.any(corner[:, :3] < 0):
-        bad = el.ids[np.nonzero(np.any(corner[:, :3] < 0, axis=1))[0][0]]
-        raise ApdlError(f"element {bad} refers to a node that does not exist")
+    corner = element_corners(db, idx, tri6)
     is_tri = corner[:, 2] == corner[:, 3]
     first = corner[:, [0, 1, 2]]
     second = corner[~is_tri][:, [0, 2, 3]]

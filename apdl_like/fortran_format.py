@@ -14,6 +14,7 @@ import re
 from collections.abc import Sequence
 
 from apdl_like.errors import ApdlError
+from apdl_like.parser import split_fields
 
 Item = tuple[str, int, int]  # (kind, width, decimals): kind in A F E G I X ' /
 
@@ -22,23 +23,8 @@ _C_SPEC = re.compile(r"%(-?\d*)(?:\.(\d+))?([IGEFCSX/%])", re.I)
 
 
 def _split_top(text: str) -> list[str]:
-    parts, depth, start, quoted = [], 0, 0, False
-    for i, ch in enumerate(text):
-        if ch == "'":
-            quoted = not quoted
-        elif quoted:
-            continue
-        elif ch == "(":
-            depth += 1
-        elif ch == ")":
-            depth -= 1
-        elif ch in ",/" and depth == 0:
-            parts.append(text[start:i])
-            if ch == "/":
-                parts.append("/")
-            start = i + 1
-    parts.append(text[start:])
-    return [p.strip() for p in parts if p.strip()]
+    """The items of a format: split at top-level commas and slashes (a slash is an item)."""
+    return [p.strip() for p in split_fields(text, ",/", "/") if p.strip()]
 
 
 def parse_format(line: str) -> list[tuple[str, int, int, str]]:

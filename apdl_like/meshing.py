@@ -111,20 +111,10 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
         mid_of = None
         all_xy = xy_used
     # node numbers: merge with coincident existing nodes, number the rest after the maximum
-    nodes = db.nodes
-    nodes.flush()
-    numbers = np.zeros(all_xy.shape[0], np.int64)
-    fresh = np.ones(all_xy.shape[0], bool)
-    if len(nodes.ids):
-        dist, near = cKDTree(nodes.xy).query(all_xy)
-        hit = dist <= 1e-9 * max(extent, 1e-300)
-        numbers[hit] = nodes.ids[near[hit]]
-        fresh = ~hit
-    start = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
-    numbers[fresh] = np.arange(start, start + int(fresh.sum()))
-    for num, (x, y) in zip(numbers[fresh], all_xy[fresh], strict=True):
-        nodes.add(int(num), float(x), float(y))
-    nodes.flush()
+    db.nodes.flush()
+    before = len(db.nodes.ids)
+    numbers = place_nodes(s, all_xy, extent)
+    fresh = len(db.nodes.ids) - before
     el = db.elements
     el.flush()
     first = int(el.ids.max()) + 1 if len(el.ids) else 1
@@ -138,7 +128,7 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
                 (i, j, kk, kk, m_ij, m_jk, kk, m_ki)
         el.add(first + k, db.active_type, db.active_mat, db.active_real, conn)
     el.flush()
-    s.say(f"AMESH: {len(tri)} elements, {int(fresh.sum())} new nodes (size {size:g})")
+    s.say(f"AMESH: {len(tri)} elements, {fresh} new nodes (size {size:g})")
 
 
 def side_fractions(n: int, space: float) -> np.ndarray:

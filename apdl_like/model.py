@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from apdl_like.errors import ApdlError
+
 # Element types this subset knows: name -> (physics, corner nodes, quadratic?)
 ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
     "PLANE55": ("thermal", 4, False),
@@ -422,3 +424,23 @@ class Database:
     def next_record(self) -> int:
         self.load_records += 1
         return self.load_records
+
+    def mesh_key(self) -> tuple[int, int]:
+        """(node, element) table versions once pending rows are in: the key of mesh caches."""
+        self.nodes.flush()
+        self.elements.flush()
+        return (self.nodes.version, self.elements.version)
+
+
+def element_corners(db: Database, idx: np.ndarray, tri6: np.ndarray) -> np.ndarray:
+    """Corners (n, 4) of the elements as node-table indices, from the node-table indices of
+    their nodes idx (n, ≥ 4; −1 where blank): a 6-node triangle (tri6) and a blank fourth
+    node repeat the third corner, as MAPDL's degenerate K = L triangle does."""
+    corners = idx[:, :4].copy()
+    corners[tri6, 3] = corners[tri6, 2]
+    blank = corners[:, 3] < 0
+    corners[blank, 3] = corners[blank, 2]
+    if np.any(corners[:, :3] < 0):
+        bad = db.elements.ids[np.nonzero(np.any(corners[:, :3] < 0, axis=1))[0][0]]
+        raise ApdlError(f"element {bad} refers to a node that does not exist")
+    return corners

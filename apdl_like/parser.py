@@ -86,9 +86,10 @@ def _strip_comment(line: str) -> str:
     return line
 
 
-def split_fields(body: str) -> list[str]:
+def split_fields(body: str, separators: str = ",", kept: str = "") -> list[str]:
     """Split at commas outside parentheses and quotes: `*GET,T,NODE,NODE(0.1,0),TEMP` has 5
-    fields, `L(1) = 'T,F(AT X','q'` has 2 values."""
+    fields, `L(1) = 'T,F(AT X','q'` has 2 values.  Other `separators` may split too; those
+    also in `kept` stay as items of their own (a Fortran format's `/`)."""
     parts, depth, start, quoted = [], 0, 0, False
     for i, ch in enumerate(body):
         if ch == "'":
@@ -99,8 +100,10 @@ def split_fields(body: str) -> list[str]:
             depth += 1
         elif ch == ")":
             depth = max(depth - 1, 0)
-        elif ch == "," and depth == 0:
+        elif ch in separators and depth == 0:
             parts.append(body[start:i])
+            if ch in kept:
+                parts.append(ch)
             start = i + 1
     parts.append(body[start:])
     return parts

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.errors import ApdlError
-from apdl_like.model import Database, record_groups
+from apdl_like.model import Database, element_corners, record_groups
 from apdl_like.plane_elastic import solve_elastic
 from apdl_like.plane_thermal import (
     PlaneMesh,
@@ -74,12 +74,7 @@ def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None, np
     idx[~solid] = np.where(idx[~solid, :1] >= 0, idx[~solid, :1], 0)  # not meshed
     tri6 = np.array([db.element_types[int(t)].triangle6 for t in el.type], bool)
     quadratic = np.array([db.element_types[int(t)].quadratic for t in el.type], bool)
-    corners = idx[:, :4].copy()
-    corners[tri6, 3] = corners[tri6, 2]
-    corners[corners[:, 3] < 0, 3] = corners[corners[:, 3] < 0, 2]
-    if np.any(corners[:, :3] < 0):
-        bad = el.ids[np.nonzero(np.any(corners[:, :3] < 0, axis=1))[0][0]]
-        raise ApdlError(f"element {bad} refers to a node that does not exist")
+    corners = element_corners(db, idx, tri6)
     if not quadratic[solid].any():
         return corners, None, solid
     if not quadratic[solid].all():
@@ -112,9 +107,7 @@ def exterior_faces(db: Database) -> FaceTable:
 def plane_mesh(s: SessionState) -> PlaneMesh:
     """The scikit-fem mesh of the deck's thermal elements (cached)."""
     db = s.db
-    db.nodes.flush()
-    db.elements.flush()
-    key = (db.nodes.version, db.elements.version, analysis_mode(db))
+    key = (*db.mesh_key(), analysis_mode(db))
     cache = s.fem
     if cache.plane is None or cache.plane_key != key:
         corners, mid, solid = corners_and_midside(db)
@@ -128,9 +121,7 @@ def plane_mesh(s: SessionState) -> PlaneMesh:
 def deck_faces(s: SessionState) -> FaceTable:
     """The exterior faces of a deck's own mesh (cached); the face loads follow them."""
     db = s.db
-    db.nodes.flush()
-    db.elements.flush()
-    key = (db.nodes.version, db.elements.version)
+    key = db.mesh_key()
     cache = s.fem
     if cache.faces is None or cache.faces_key != key:
         cache.faces, cache.faces_key = exterior_faces(db), key
@@ -327,11 +318,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
         T = model.steady(inputs, T0, nonlinear)
         times, temps = [end], [T]
     else:
-        if settings.time is None:
-            raise ApdlError("a transient load step needs its end time (TIME)")
-        span = settings.time - sol.time
-        if not span > 0.0:
-            raise ApdlError(f"TIME {settings.time!r} is not after the current time {sol.time!r}")
+        span = sol.span_to(settings.time)
         ramped = settings.kbc == 0
         before = sol.previous_loads if ramped else None
         if ramped and before is None:

@@ -195,26 +195,14 @@ def conduction(u, v, w):  # noqa: ANN001, ANN201 - a scikit-fem form
 
 
 @BilinearForm
-def capacity(u, v, w):  # noqa: ANN001, ANN201
-    """∫ ρc u v dV."""
-    return w.rho_c * u * v * _radius(w)
+def mass(u, v, w):  # noqa: ANN001, ANN201
+    """∫ c u v dV: the capacity on cells (c = ρc, J/(m³·K)), a film on faces (c = h)."""
+    return w.c * u * v * _radius(w)
 
 
 @LinearForm
-def source(v, w):  # noqa: ANN001, ANN201
-    """∫ q v dV (q: HGEN, W/m³)."""
-    return w.q * v * _radius(w)
-
-
-@BilinearForm
-def film(u, v, w):  # noqa: ANN001, ANN201
-    """∫ h u v dA on a face."""
-    return w.h * u * v * _radius(w)
-
-
-@LinearForm
-def face_load(v, w):  # noqa: ANN001, ANN201
-    """∫ g v dA on a face (g = h·T_bulk or a heat flux)."""
+def load(v, w):  # noqa: ANN001, ANN201
+    """∫ g v dV: a source on cells (g = HGEN, W/m³), on faces h·T_bulk or a heat flux."""
     return w.g * v * _radius(w)
 
 
@@ -280,26 +268,26 @@ class PlaneThermal:
             Kp = conduction.assemble(b, kxx=self._cell_field(k, inputs.kxx, T_local),
                                      kyy=self._cell_field(k, inputs.kyy, T_local),
                                      axisymmetric=ax)
-            Cp = capacity.assemble(b, rho_c=self._cell_field(k, inputs.rho_c, T_local),
+            Cp = mass.assemble(b, c=self._cell_field(k, inputs.rho_c, T_local),
                                    axisymmetric=ax)
             K = K + S @ Kp @ S.T
             C = C + S @ Cp @ S.T
             q = inputs.hgen[part.elements]
             if np.any(q):
                 qq = np.repeat(q[:, None], b.X.shape[-1], axis=1)
-                f = f + S @ source.assemble(b, q=qq, axisymmetric=ax)
+                f = f + S @ load.assemble(b, g=qq, axisymmetric=ax)
             for keys, h, tb in inputs.films:
                 fb = self._facet_basis(k, keys)
                 if fb is not None:
-                    Hf = film.assemble(fb, h=h, axisymmetric=ax)
+                    Hf = mass.assemble(fb, c=h, axisymmetric=ax)
                     if self.mesh.lumped:
                         Hf = sp.diags(np.asarray(Hf.sum(axis=1)).ravel())
                     K = K + S @ Hf @ S.T
-                    f = f + S @ face_load.assemble(fb, g=h * tb, axisymmetric=ax)
+                    f = f + S @ load.assemble(fb, g=h * tb, axisymmetric=ax)
             for keys, flux in inputs.fluxes:
                 fb = self._facet_basis(k, keys)
                 if fb is not None:
-                    f = f + S @ face_load.assemble(fb, g=flux, axisymmetric=ax)
+                    f = f + S @ load.assemble(fb, g=flux, axisymmetric=ax)
         if self.mesh.lumped:
             C = sp.diags(np.asarray(C.sum(axis=1)).ravel()).tocsr()
         out = (K.tocsr(), C.tocsr(), f)
@@ -384,20 +372,20 @@ class PlaneThermal:
                                 axisymmetric=ax) @ T_local
         q = inputs.hgen[part.elements[cells]]
         if np.any(q):
-            r = r - source.assemble(b, q=np.repeat(q[:, None], b.X.shape[-1], axis=1),
+            r = r - load.assemble(b, g=np.repeat(q[:, None], b.X.shape[-1], axis=1),
                                     axisymmetric=ax)
         own = part.basis.mesh.t2f[:, cells].ravel()
         for keys, h, tb in inputs.films:
             facets = own[np.isin(part.facet_keys[own], keys)]
             if facets.size:
                 fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
-                r = r + film.assemble(fb, h=h, axisymmetric=ax) @ T_local \
-                    - face_load.assemble(fb, g=h * tb, axisymmetric=ax)
+                r = r + mass.assemble(fb, c=h, axisymmetric=ax) @ T_local \
+                    - load.assemble(fb, g=h * tb, axisymmetric=ax)
         for keys, flux in inputs.fluxes:
             facets = own[np.isin(part.facet_keys[own], keys)]
             if facets.size:
                 fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
-                r = r - face_load.assemble(fb, g=flux, axisymmetric=ax)
+                r = r - load.assemble(fb, g=flux, axisymmetric=ax)
         return part.to_global @ r
 
     def reaction(self, inputs: ThermalInputs, T: np.ndarray) -> np.ndarray:

@@ -33,9 +33,7 @@ _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants pos
 def fem_model(session: SessionState) -> FemModel:
     """The FEM view of the current mesh, rebuilt only when nodes or elements changed."""
     db = session.db
-    db.nodes.flush()
-    db.elements.flush()
-    key = (db.nodes.version, db.elements.version)
+    key = db.mesh_key()
     cache = session.fem
     if cache.model is not None and cache.model_key == key:
         return cache.model
@@ -270,11 +268,7 @@ def solve_thermal(session: SessionState) -> StepResult:
             raise ApdlError(str(exc)) from None
         steps_T, steps_t = [T], [end]
     else:
-        if s.time is None:
-            raise ApdlError("a transient load step needs its end time (TIME)")
-        span = s.time - sol.time
-        if not span > 0.0:
-            raise ApdlError(f"TIME {s.time!r} is not after the current time {sol.time!r}")
+        span = sol.span_to(s.time)
         if s.deltim is not None:
             n = max(1, int(np.ceil(span / s.deltim - 1e-9)))
         else:

@@ -92,6 +92,15 @@ class Solution:
     post_index: int = -1  # result set shown in /POST1 (SET)
     new_analysis: bool = True  # the next SOLVE starts a new results file (its load step 1)
 
+    def span_to(self, end_time: float | None) -> float:
+        """The length (s) of a transient load step from now to its TIME `end_time`."""
+        if end_time is None:
+            raise ApdlError("a transient load step needs its end time (TIME)")
+        span = end_time - self.time
+        if not span > 0.0:
+            raise ApdlError(f"TIME {end_time!r} is not after the current time {self.time!r}")
+        return span
+
 
 @dataclass
 class RunBudget:

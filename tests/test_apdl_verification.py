@@ -17,6 +17,11 @@ RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
 K = 50.0  # W/mK
 
 
+def ring_model(mesh: str) -> str:
+    """/PREP7 of the hollow cylinder (RI, RO, H as parameters) with `mesh` and k = K."""
+    return f"/PREP7\nRI = {RI}\nRO = {RO}\nH = {H}\n{mesh}\nMP,KXX,1,{K}\n"
+
+
 def run(text: str) -> Session:
     s = Session()
     s.run_text(text, "verify.inp")
@@ -77,13 +82,7 @@ MESHES = {
 @pytest.mark.parametrize("name", list(MESHES))
 def test_steady_flux_and_fixed_temperature(name):
     mesh, tol = MESHES[name]
-    s = run(f"""
-/PREP7
-RI = {RI}
-RO = {RO}
-H = {H}
-{mesh}
-MP,KXX,1,{K}
+    s = run(ring_model(mesh) + """
 /SOLU
 ANTYPE,STATIC
 NSEL,S,LOC,X,RI
@@ -105,13 +104,7 @@ X_MID = NX(NODE((RI+RO)/2,H))
 def test_steady_convection(name):
     mesh, tol = MESHES[name]
     h, t_bulk, q = 800.0, 25.0, 1e5
-    s = run(f"""
-/PREP7
-RI = {RI}
-RO = {RO}
-H = {H}
-{mesh}
-MP,KXX,1,{K}
+    s = run(ring_model(mesh) + f"""
 FINISH
 /SOLU
 NSEL,S,LOC,X,RI
@@ -134,13 +127,7 @@ FINISH
 def test_convection_by_sfe_on_element_faces():
     """SFE (element face 2 = J-K, the outer face of the last element) = SF on those nodes."""
     h, t_bulk, q = 800.0, 25.0, 1e5
-    s = run(f"""
-/PREP7
-RI = {RI}
-RO = {RO}
-H = {H}
-{ring_nodes_elements(20, "PLANE55")}
-MP,KXX,1,{K}
+    s = run(ring_model(ring_nodes_elements(20, "PLANE55")) + f"""
 /SOLU
 SFE,1,4,HFLUX,,{q}
 SFE,20,2,CONV,1,{h}

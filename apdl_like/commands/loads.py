@@ -21,24 +21,34 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 
-def node_targets(s: SessionState, c: Call, i: int = 1, end_field: int | None = None) -> np.ndarray:
-    """Node indices named by field i: ALL (selected), a component, or a number [NEND, NINC]."""
-    nodes = s.db.nodes
+def _named_targets(s: SessionState, c: Call, i: int, entity: str) -> np.ndarray | None:
+    """Rows named by field i without a number: ALL (the selected ones) or a component of
+    `entity` (NODE or ELEM); None when the field is a number (or a parameter)."""
+    noun, other = ("node", "elements") if entity == "NODE" else ("element", "nodes")
+    table = s.db.nodes if entity == "NODE" else s.db.elements
     text = c.label(i)
     if not text:
-        raise ApdlError(f"field {i} (node) is required")
+        raise ApdlError(f"field {i} ({noun}) is required")
     if text == "ALL":
-        return np.nonzero(nodes.selected)[0]
+        return np.nonzero(table.selected)[0]
     if text == "P":
         raise ApdlError("graphical picking (P) is not available in a deck")
     if text[0].isalpha() and text.upper() in s.db.components:
         comp = component(s, text)
-        if comp.entity != "NODE":
-            raise ApdlError(f"component {text} holds elements, not nodes")
+        if comp.entity != entity:
+            raise ApdlError(f"component {text} holds {other}, not {noun}s")
         return np.nonzero(component_mask(s, comp))[0]
     if text[0].isalpha() and not any(ch in text for ch in "+-*/(") and \
             text.upper() not in s.params:
         raise ApdlError(f"field {i}: {text} is neither ALL, a component, nor a parameter")
+    return None
+
+
+def node_targets(s: SessionState, c: Call, i: int = 1, end_field: int | None = None) -> np.ndarray:
+    """Node indices named by field i: ALL (selected), a component, or a number [NEND, NINC]."""
+    named = _named_targets(s, c, i, "NODE")
+    if named is not None:
+        return named
     first = c.int(i, what="node")
     nums = np.array([first])
     if end_field is not None and c.given(end_field):
@@ -49,31 +59,18 @@ def node_targets(s: SessionState, c: Call, i: int = 1, end_field: int | None = N
         if (last - first) // step > 10_000_000:
             raise ApdlError("node range too long")
         nums = np.arange(first, last + 1, step)
-    idx = nodes.index(nums)
+    idx = s.db.nodes.index(nums)
     if np.any(idx < 0):
         raise ApdlError(f"node {int(nums[np.nonzero(idx < 0)[0][0]])} does not exist")
     return idx
 
 
 def element_targets(s: SessionState, c: Call, i: int = 1) -> np.ndarray:
-    el = s.db.elements
-    text = c.label(i)
-    if not text:
-        raise ApdlError(f"field {i} (element) is required")
-    if text == "ALL":
-        return np.nonzero(el.selected)[0]
-    if text == "P":
-        raise ApdlError("graphical picking (P) is not available in a deck")
-    if text[0].isalpha() and text.upper() in s.db.components:
-        comp = component(s, text)
-        if comp.entity != "ELEM":
-            raise ApdlError(f"component {text} holds nodes, not elements")
-        return np.nonzero(component_mask(s, comp))[0]
-    if text[0].isalpha() and not any(ch in text for ch in "+-*/(") and \
-            text.upper() not in s.params:
-        raise ApdlError(f"field {i}: {text} is neither ALL, a component, nor a parameter")
+    named = _named_targets(s, c, i, "ELEM")
+    if named is not None:
+        return named
     num = c.int(i, what="element")
-    idx = el.index(num)
+    idx = s.db.elements.index(num)
     if idx[0] < 0:
         raise ApdlError(f"element {num} does not exist")
     return idx

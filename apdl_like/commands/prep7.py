@@ -121,6 +121,20 @@ def mp(s: SessionState, c: Call) -> None:
         material.coefficients.pop(label, None)
 
 
+def _table_values(c: Call, values: list[float], start: int, first_field: int,
+                  name: str) -> list[float]:
+    """`values` with fields first_field.. (up to six: name1..name6) written from table
+    location `start` on; a blank field keeps its location, a gap before it is NaN."""
+    for k in range(6):
+        if c.given(first_field + k):
+            i = start - 1 + k
+            if not 0 <= i < MAX_TABLE_POINTS:
+                raise ApdlError(f"table location {i + 1} out of range 1..{MAX_TABLE_POINTS}")
+            values += [float("nan")] * (i + 1 - len(values))
+            values[i] = c.num(first_field + k, what=f"{name}{k + 1}")
+    return values
+
+
 @command("MPTEMP", PREP7, 7)
 def mptemp(s: SessionState, c: Call) -> None:
     """MPTEMP,STLOC,T1..T6: the temperatures of the next MPDATA tables (blank: erase)."""
@@ -128,15 +142,7 @@ def mptemp(s: SessionState, c: Call) -> None:
         s.db.mp_temperatures = []
         return
     start = c.int(1, 1, what="STLOC")
-    temps = list(s.db.mp_temperatures)
-    for k in range(6):
-        if c.given(2 + k):
-            i = start - 1 + k
-            if not 0 <= i < MAX_TABLE_POINTS:
-                raise ApdlError(f"table location {i + 1} out of range 1..{MAX_TABLE_POINTS}")
-            temps += [float("nan")] * (i + 1 - len(temps))
-            temps[i] = c.num(2 + k, what=f"T{k + 1}")
-    s.db.mp_temperatures = temps
+    s.db.mp_temperatures = _table_values(c, list(s.db.mp_temperatures), start, 2, "T")
 
 
 @command("MPDATA", PREP7, 9)
@@ -149,14 +155,7 @@ def mpdata(s: SessionState, c: Call) -> None:
     start = c.int(3, 1, what="STLOC")
     material = s.db.materials.setdefault(mat, Material())
     old = material.tables.get(label)
-    values = list(old[1]) if old is not None else []
-    for k in range(6):
-        if c.given(4 + k):
-            i = start - 1 + k
-            if not 0 <= i < MAX_TABLE_POINTS:
-                raise ApdlError(f"table location {i + 1} out of range 1..{MAX_TABLE_POINTS}")
-            values += [float("nan")] * (i + 1 - len(values))
-            values[i] = c.num(4 + k, what=f"C{k + 1}")
+    values = _table_values(c, list(old[1]) if old is not None else [], start, 4, "C")
     temps = s.db.mp_temperatures[: len(values)]
     if len(temps) < len(values) or any(np.isnan(temps)) or any(np.isnan(values)):
         raise ApdlError("MPDATA needs a temperature (MPTEMP) for each value, without gaps")

@@ -10,7 +10,7 @@ import numpy as np
 from apdl_like.call import MODEL, Call, command, specs_of
 from apdl_like.commands.generate import from_cartesian
 from apdl_like.errors import ApdlError
-from apdl_like.model import Component
+from apdl_like.model import Component, ElementTable, NodeTable
 from apdl_like.selection import combine, in_range, number_range
 
 if TYPE_CHECKING:
@@ -27,6 +27,16 @@ def _mode(c: Call) -> str:
     return mode
 
 
+def _picking_mode(c: Call, table: NodeTable | ElementTable) -> str | None:
+    """S, R, A or U: the mode of a selection by item; ALL, NONE and INVE need no item, they
+    are applied to `table` here (and None is returned)."""
+    mode = _mode(c)
+    if mode in ("ALL", "NONE", "INVE"):
+        table.selected = combine(mode, table.selected, table.selected)
+        return None
+    return mode
+
+
 def _range(c: Call) -> tuple[float, float, float]:
     vmin = c.num(4, what="VMIN")
     vmax = c.num(5, vmin, what="VMAX")
@@ -37,10 +47,8 @@ def _range(c: Call) -> tuple[float, float, float]:
 @command("NSEL", _ANY_OR_BEGIN, 7)
 def nsel(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
-    mode = _mode(c)
-    current = nodes.selected
-    if mode in ("ALL", "NONE", "INVE"):
-        nodes.selected = combine(mode, current, current)
+    mode = _picking_mode(c, nodes)
+    if mode is None:
         return
     item = c.label(2, "NODE")
     if item == "NODE" and c.label(4) == "ALL":
@@ -58,16 +66,14 @@ def nsel(s: SessionState, c: Call) -> None:
         picked = in_range(values, vmin, vmax)
     else:
         raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
-    nodes.selected = combine(mode, current, picked)
+    nodes.selected = combine(mode, nodes.selected, picked)
 
 
 @command("ESEL", _ANY_OR_BEGIN, 7)
 def esel(s: SessionState, c: Call) -> None:
     el = s.db.elements
-    mode = _mode(c)
-    current = el.selected
-    if mode in ("ALL", "NONE", "INVE"):
-        el.selected = combine(mode, current, current)
+    mode = _picking_mode(c, el)
+    if mode is None:
         return
     item = c.label(2, "ELEM")
     if item == "ELEM":
@@ -84,7 +90,7 @@ def esel(s: SessionState, c: Call) -> None:
         picked = in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
     else:
         raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
-    el.selected = combine(mode, current, picked)
+    el.selected = combine(mode, el.selected, picked)
 
 
 def _centroids(s: SessionState) -> np.ndarray:
