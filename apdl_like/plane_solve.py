@@ -441,9 +441,5 @@ def solve_plane_structural(s: SessionState) -> StepResult:
                                  enhanced)
     sol = s.solution
     sol.time = settings.time if settings.time is not None else sol.time + 1.0
-    nodal = {"UX": mesh.nodal(disp[0]), "UY": mesh.nodal(disp[1])}
-    for item, key in (("SX", "rr"), ("SY", "zz"), ("SZ", "tt"), ("SXY", "rz"),
-                      ("SEQV", "von_mises")):
-        nodal[item] = mesh.nodal(stress[key])
-    return StepResult(len(sol.results) + 1, sol.time, "structural", T, disp, stress,
-                      nodal_temperature=mesh.nodal(T), nodal_structural=nodal)
+    return StepResult.structural(len(sol.results) + 1, sol.time, T, disp, stress, mesh.nodal,
+                                 mesh.nodal(T))

@@ -356,9 +356,5 @@ def solve_structural(session: SessionState) -> StepResult:
     u = elastic.solve(T)
     stress = elastic.stresses(u, T)
     sol.time = s.time if s.time is not None else sol.time + 1.0
-    nodal = {"UX": fem.glued_nodal(u[0]), "UY": fem.glued_nodal(u[1])}
-    for item, key in (("SX", "rr"), ("SY", "zz"), ("SZ", "tt"), ("SXY", "rz"),
-                      ("SEQV", "von_mises")):
-        nodal[item] = fem.glued_nodal(stress[key])
-    return StepResult(len(sol.results) + 1, sol.time, "structural", T, u, stress,
-                      nodal_temperature=fem.thermal_nodal(T), nodal_structural=nodal)
+    return StepResult.structural(len(sol.results) + 1, sol.time, T, u, stress,
+                                 fem.glued_nodal, fem.thermal_nodal(T))

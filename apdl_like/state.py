@@ -22,6 +22,7 @@ Command handlers take a `SessionState`; nothing here imports the commands or the
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -51,6 +52,19 @@ class StepResult:
     nodal_temperature: np.ndarray | None = None  # per APDL node, °C (NaN: no element)
     # per APDL node: UX, UY (m), SX, SY, SZ, SXY, SEQV (Pa; averaged nodal stresses)
     nodal_structural: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @classmethod
+    def structural(cls, load_step: int, time: float, temperature: np.ndarray,
+                   displacement: np.ndarray, stress: dict[str, np.ndarray],
+                   to_nodes: Callable[[np.ndarray], np.ndarray],
+                   nodal_temperature: np.ndarray) -> StepResult:
+        """A structural step; `to_nodes` maps a scalar field on the dofs to the APDL nodes."""
+        nodal = {"UX": to_nodes(displacement[0]), "UY": to_nodes(displacement[1])}
+        for item, key in (("SX", "rr"), ("SY", "zz"), ("SZ", "tt"), ("SXY", "rz"),
+                          ("SEQV", "von_mises")):
+            nodal[item] = to_nodes(stress[key])
+        return cls(load_step, time, "structural", temperature, displacement, stress,
+                   nodal_temperature=nodal_temperature, nodal_structural=nodal)
 
 
 @dataclass
