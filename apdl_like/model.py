@@ -406,6 +406,9 @@ class Database:
     keypoints: dict[int, tuple[float, float]] = field(default_factory=dict)
     areas: dict[int, list[int]] = field(default_factory=dict)
     lines: dict[int, Line] = field(default_factory=dict)
+    # keypoints and lines left out by KSEL/LSEL (MAPDL selects a new one): the rest are selected
+    unselected_keypoints: set[int] = field(default_factory=set)
+    unselected_lines: set[int] = field(default_factory=set)
     esize_divisions: int | None = None  # ESIZE,,NDIV: divisions of lines without LESIZE
     mesh_triangles: bool = False  # MSHAPE,1
     meshed_areas: set[int] = field(default_factory=set)

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from apdl_like.errors import ApdlError
 from apdl_like.session import Session
 
 RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
@@ -461,3 +462,72 @@ def test_enhanced_quad_passes_the_patch_test_when_distorted(mode):
         [1e-3, 2e-3, hoop, 0.0])
     np.testing.assert_allclose(recover(u_e)[:, 0, :], np.repeat(exact[:, None], 4, axis=1),
                                atol=1e-9 * E)
+
+
+SOLID_MODEL_SLAB = """
+/PREP7
+ET,1,PLANE55
+MP,KXX,1,{k}
+K,1,0,0
+K,2,{length},0
+K,3,{length},{height}
+K,4,0,{height}
+L,1,2
+L,2,3
+L,3,4
+L,4,1
+AL,1,2,3,4
+ESIZE,{size}
+AMESH,1
+/SOLU
+{left}
+{right}
+ALLSEL
+SOLVE
+*GET,T_END,NODE,NODE({length},{height}/2),TEMP
+*GET,T_MID,NODE,NODE(0.4*{length},0),TEMP
+"""
+
+
+@pytest.mark.parametrize("left, right", [
+    ("DL,4,,TEMP,{t0}", "SFL,2,CONV,{h},,{tb}"),
+    ("LSEL,S,LOC,X,0\nDL,ALL,,TEMP,{t0}", "LSEL,S,LOC,X,{length}\nSFL,ALL,CONV,{h},,{tb}"),
+    ("LSEL,S,LINE,,4\nDL,ALL,,TEMP,{t0}",
+     "LSEL,S,LOC,Y,0,1\nLSEL,R,LOC,X,0.09,1\nSFL,ALL,CONV,{h},,{tb}"),
+])
+def test_solid_model_loads_dl_and_sfl_on_a_convecting_slab(left, right):
+    """Planar slab (k, length L), DL: T0 on the line x = 0, SFL: film h to T_b on the line
+    x = L, the other lines insulated: 1-D conduction in series with the film,
+    q = (T0 − T_b)/(L/k + 1/h), T(L) = T_b + q/h, T linear in x (bilinear quads are exact)."""
+    k, length, h, t0, tb = 20.0, 0.1, 400.0, 100.0, 20.0
+    values = dict(k=k, length=length, h=h, t0=t0, tb=tb)
+    s = run(SOLID_MODEL_SLAB.format(height=0.04, size=0.01, left=left.format(**values),
+                                    right=right.format(**values), **values))
+    q = (t0 - tb) / (length / k + 1.0 / h)
+    t_end = tb + q / h
+    assert s.params["T_END"] == pytest.approx(t_end, rel=1e-9)
+    assert s.params["T_MID"] == pytest.approx(t0 + 0.4 * (t_end - t0), rel=1e-9)
+
+
+@pytest.mark.parametrize("right", ["DK,2,TEMP,10\nDK,3,TEMP,10",
+                                   "KSEL,S,LOC,X,0.1\nDK,ALL,TEMP,10"])
+def test_solid_model_loads_dk_fixes_the_node_on_a_keypoint(right):
+    """One row of elements (ESIZE = height): the right edge has only the nodes on keypoints
+    2 and 3, so DK there is a fixed end and T falls linearly from T0 to T1."""
+    s = run(SOLID_MODEL_SLAB.format(k=20.0, length=0.1, height=0.02, size=0.02,
+                                    left="DL,4,,TEMP,100", right=right))
+    assert s.params["T_END"] == pytest.approx(10.0, rel=1e-12)
+    assert s.params["T_MID"] == pytest.approx(100.0 - 0.4 * 90.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("deck, message", [
+    ("/PREP7\nK,1,0,0\nK,2,1,0\nL,1,2\n/SOLU\nDL,1,,TEMP,5\n", "line 1 has no nodes"),
+    ("/PREP7\n/SOLU\nDL,ALL,,TEMP,5\n", "no line is selected"),
+    ("/PREP7\nK,1,0,0\nK,2,1,0\nL,1,2\nLSEL,S,LOC,X,2,3\nDL,ALL,,TEMP,5\n",
+     "no line is selected"),
+    ("/PREP7\nK,1,0,0\n/SOLU\nDK,1,TEMP,5\n", "keypoint 1 has no node"),
+    ("/PREP7\n/SOLU\nSFL,3,CONV,10,,20\n", "line 3 does not exist"),
+])
+def test_solid_model_loads_refuse_what_they_cannot_transfer(deck, message):
+    with pytest.raises(ApdlError, match=message):
+        run(deck)

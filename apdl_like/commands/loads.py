@@ -81,18 +81,88 @@ _D_LABELS = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",), "ALL": ("d_u
 
 @command("D", LOADS, 11)
 def d(s: SessionState, c: Call) -> None:
-    labels = [c.label(2)] + [c.label(i) for i in range(7, 12) if c.given(i)]
-    for lab in labels:
-        if lab not in _D_LABELS:
-            raise ApdlError(f"DOF label must be TEMP, UX, UY or ALL, got {lab or '(empty)'!r}")
+    labels = [_dof_label(c, i) for i in (2, 7, 8, 9, 10, 11) if i == 2 or c.given(i)]
     value = c.num(3, 0.0, what="VALUE")
     if c.given(4) and c.num(4) != 0.0:
         raise ApdlError("field 4 (VALUE2, imaginary part) is not supported")
-    idx = node_targets(s, c, 1, end_field=5)
+    _fix_dofs(s, node_targets(s, c, 1, end_field=5), labels, value)
+    s.note_load(c)
+
+
+def _fix_dofs(s: SessionState, idx: np.ndarray, labels: list[str], value: float) -> None:
     arrays = s.db.nodes.arrays
     for lab in labels:
         for key in _D_LABELS[lab]:
             arrays[key][idx] = value
+
+
+def _dof_label(c: Call, i: int) -> str:
+    if (lab := c.label(i)) in _D_LABELS:
+        return lab
+    raise ApdlError(f"field {i}: DOF label must be TEMP, UX, UY or ALL, got {lab or '(empty)'!r}")
+
+
+# ------------------------------------------------------------------ solid-model loads
+# MAPDL keeps DK/DL/SFL on the keypoints and lines and transfers them to the mesh at SOLVE
+# (SBCTRAN); here they are transferred when given, so the lines must be meshed by then.
+
+def _nodes_on_lines(s: SessionState, c: Call, i: int) -> np.ndarray:
+    """Indices of the nodes on the line named by field i, or on every selected line (ALL)."""
+    if c.label(i) != "ALL":
+        return _nodes_on_line(s, c.int(i, what="line"))
+    chosen = [n for n in sorted(s.db.lines) if n not in s.db.unselected_lines]
+    if not chosen:
+        raise ApdlError(f"field {i}: ALL, but no line is selected (LSEL)")
+    return np.unique(np.concatenate([_nodes_on_line(s, n) for n in chosen]))
+
+
+def _nodes_on_line(s: SessionState, num: int) -> np.ndarray:
+    """Indices of the nodes on straight line `num` (its ends included)."""
+    ln = s.db.lines.get(num)
+    if ln is None:
+        raise ApdlError(f"line {num} does not exist")
+    a = np.array(s.db.keypoints[ln.k1], float)
+    b = np.array(s.db.keypoints[ln.k2], float)
+    s.db.nodes.flush()
+    xy = s.db.nodes.xy
+    t = np.clip((xy - a) @ (b - a) / float((b - a) @ (b - a)), 0.0, 1.0)
+    off = np.linalg.norm(xy - (a + t[:, None] * (b - a)), axis=1)
+    idx = np.nonzero(off <= 1e-9 * float(np.linalg.norm(b - a)))[0]
+    if idx.size == 0:
+        raise ApdlError(f"line {num} has no nodes: mesh it (AMESH) before loading it")
+    return idx
+
+
+@command("DK", LOADS, 8)
+def dk(s: SessionState, c: Call) -> None:
+    """DK,KPOI,Lab,VALUE: a DOF constraint at the node on keypoint KPOI (ALL: selected)."""
+    if c.label(1) == "ALL":
+        chosen = [n for n in sorted(s.db.keypoints) if n not in s.db.unselected_keypoints]
+    else:
+        chosen = [c.int(1, what="KPOI")]
+    s.db.nodes.flush()
+    xy = s.db.nodes.xy
+    idx = []
+    for num in chosen:
+        if num not in s.db.keypoints:
+            raise ApdlError(f"keypoint {num} does not exist")
+        dist = np.linalg.norm(xy - np.array(s.db.keypoints[num], float), axis=1)
+        if dist.size == 0 or dist.min() > 1e-9 * max(1.0, float(np.abs(xy).max())):
+            raise ApdlError(f"keypoint {num} has no node: mesh it (AMESH) before loading it")
+        idx.append(int(np.argmin(dist)))
+    if not idx:
+        raise ApdlError("field 1: ALL, but no keypoint is selected (KSEL)")
+    _fix_dofs(s, np.array(idx), [_dof_label(c, 2)], c.num(3, 0.0, what="VALUE"))
+    s.note_load(c)
+
+
+@command("DL", LOADS, 6)
+def dl(s: SessionState, c: Call) -> None:
+    """DL,LINE,AREA,Lab,Value1: a DOF constraint on every node of a line."""
+    lab = _dof_label(c, 3)
+    if c.given(5):
+        raise ApdlError("field 5 (Value2) is not supported")
+    _fix_dofs(s, _nodes_on_lines(s, c, 1), [lab], c.num(4, 0.0, what="Value1"))
     s.note_load(c)
 
 
@@ -134,16 +204,33 @@ def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | Non
 
 @command("SF", LOADS, 4)
 def sf(s: SessionState, c: Call) -> None:
+    _load_faces_on(s, c, node_targets(s, c, 1), 4, "the node set")
+
+
+def _load_faces_on(s: SessionState, c: Call, nodes: np.ndarray, bulk_field: int,
+                   where: str) -> None:
+    """SF/SFL: Lab in field 2 (CONV: h in field 3, the bulk temperature in `bulk_field`;
+    HFLUX: the flux in field 3) on the exterior faces with all their nodes in `nodes`."""
     lab = c.label(2)
     if lab not in ("CONV", "HFLUX"):
         raise ApdlError(f"field 2: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
     v1 = c.num(3, what="VALUE")
-    v2 = c.num(4, what="VALUE2 (bulk temperature)") if lab == "CONV" else None
-    faces = _faces_on_nodes(s, node_targets(s, c, 1))
+    v2 = c.num(bulk_field, what="bulk temperature") if lab == "CONV" else None
+    faces = _faces_on_nodes(s, nodes)
     if faces.size == 0:
-        raise ApdlError("no exterior element face has all its nodes in the node set")
+        raise ApdlError(f"no exterior element face has all its nodes on {where}")
     _set_face_load(s, faces, lab, v1, v2)
     s.note_load(c)
+
+
+@command("SFL", LOADS, 7)
+def sfl(s: SessionState, c: Call) -> None:
+    """SFL,LINE,Lab,VALI,VALJ,VAL2I,VAL2J: CONV (h, bulk temperature) or HFLUX on the
+    element faces along a line; uniform only (VALJ and VAL2J blank or equal to the I end)."""
+    for j, i in ((4, 3), (6, 5)):
+        if c.given(j) and c.num(j) != c.num(i, 0.0):
+            raise ApdlError(f"field {j}: a load varying along the line is not supported")
+    _load_faces_on(s, c, _nodes_on_lines(s, c, 1), 5, "the line")
 
 
 @command("SFDELE", LOADS, 2)
@@ -289,5 +376,5 @@ def tref(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(d, ddele, sf, sfdele, sfe, bf, bfe, bfedele, ic, tunif, bfunif, tref),
+    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfedele, ic, tunif, bfunif, tref),
 )

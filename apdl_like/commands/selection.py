@@ -140,6 +140,53 @@ def esln(s: SessionState, c: Call) -> None:
 def allsel(s: SessionState, c: Call) -> None:
     s.db.nodes.selected = np.ones(len(s.db.nodes), bool)
     s.db.elements.selected = np.ones(len(s.db.elements), bool)
+    s.db.unselected_keypoints.clear()
+    s.db.unselected_lines.clear()
+
+
+def _select_numbered(s: SessionState, c: Call, numbers: list[int], xy: np.ndarray,
+                     unselected: set[int], item_name: str) -> None:
+    """KSEL/LSEL: Type (S, R, A, U, ALL, NONE, INVE), Item (the entity's number, or LOC of
+    its keypoint / its midpoint in the active coordinate system), Comp, VMIN, VMAX, VINC."""
+    ids = np.array(numbers, np.int64)
+    current = ~np.isin(ids, list(unselected))
+    mode = _mode(c)
+    if mode in ("ALL", "NONE", "INVE"):
+        picked = current
+    else:
+        item = c.label(2, item_name)
+        if item == item_name:
+            picked = number_range(ids, *_range(c))
+        elif item == "LOC":
+            comp = c.label(3)
+            if comp not in ("X", "Y"):
+                raise ApdlError(f"field 3: LOC takes X or Y, got {comp!r}")
+            vmin = c.num(4, 0.0, what="VMIN")
+            vmax = c.num(5, vmin, what="VMAX")
+            local = from_cartesian(s.db.csys, xy.reshape(-1, 2))
+            picked = in_range(local[:, "XY".index(comp)], vmin, vmax)
+        else:
+            raise ApdlError(f"field 2: item must be {item_name} or LOC, got {item!r}")
+    chosen = combine(mode, current, picked)
+    unselected.clear()
+    unselected.update(int(n) for n in ids[~chosen])
+
+
+@command("KSEL", _ANY_OR_BEGIN, 7)
+def ksel(s: SessionState, c: Call) -> None:
+    kps = s.db.keypoints
+    numbers = sorted(kps)
+    _select_numbered(s, c, numbers, np.array([kps[n] for n in numbers], float),
+                     s.db.unselected_keypoints, "KP")
+
+
+@command("LSEL", _ANY_OR_BEGIN, 7)
+def lsel(s: SessionState, c: Call) -> None:
+    kps, lines = s.db.keypoints, s.db.lines
+    numbers = sorted(lines)
+    mids = np.array([0.5 * (np.array(kps[lines[n].k1]) + np.array(kps[lines[n].k2]))
+                     for n in numbers], float)
+    _select_numbered(s, c, numbers, mids, s.db.unselected_lines, "LINE")
 
 
 _COMPONENT_NAME = re.compile(r"[A-Z][A-Z0-9_]{0,31}\Z")
@@ -202,5 +249,5 @@ def cmsel(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(nsel, esel, nsle, esln, allsel, cm, cmdele, cmsel),
+    *specs_of(nsel, esel, nsle, esln, allsel, ksel, lsel, cm, cmdele, cmsel),
 )
