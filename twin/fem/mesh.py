@@ -19,6 +19,9 @@ region stays attached to the unsplit side only, so interfaces should end on free
 
 from __future__ import annotations
 
+import contextlib
+import io
+import logging
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -318,7 +321,14 @@ class AxiMesh:
         """Read a gmsh .msh file (physical groups name regions, boundaries, interfaces)."""
         import meshio
 
-        return cls.from_meshio(meshio.read(str(path)), interfaces)
+        # meshio's gmsh reader prints to stdout (a bare newline for our files), which would
+        # end up in the output of `twin synth --quiet` and of pipes; keep it for the log
+        captured = io.StringIO()
+        with contextlib.redirect_stdout(captured):
+            mesh = meshio.read(str(path))
+        if captured.getvalue().strip():
+            logging.getLogger(__name__).info("meshio: %s", captured.getvalue().strip())
+        return cls.from_meshio(mesh, interfaces)
 
     @classmethod
     def structured(
