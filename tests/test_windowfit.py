@@ -67,3 +67,17 @@ def test_fit_needs_the_twin_state(run, spindle_model):
                        np.zeros((1, 5)), nominal, nominal)
     with pytest.raises(ValueError, match="twin's state"):
         WindowFit(run, spindle_model).correct(f)
+
+
+def test_fit_stays_within_four_times_nominal(tmp_path, spindle_model):
+    # a run whose bearings are far hotter than any plausible heat explains (heat ×8): the
+    # Gauss–Newton steps would run the log factors off (to inf on a suite run with
+    # dropouts); the fit keeps every value within ×/÷ 4 of nominal
+    path = tmp_path / "hot.csv"
+    hot = read_run(make_recorded_run(path, spindle_model, minutes=3, heat=8.0, resistance=1.0))
+    fit = WindowFit(hot, spindle_model)
+    result = replay_method(hot, spindle_model, fit, keep_fields=False)
+    factors = np.array(fit.fitted) / np.array([list(w.nominal) for w in result.windows])
+    assert np.all(np.isfinite(factors))
+    assert np.all(factors <= 4.0 * (1 + 1e-9)) and np.all(factors >= 0.25 * (1 - 1e-9))
+    assert factors[1:, :2].max() == pytest.approx(4.0)

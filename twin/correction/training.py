@@ -66,8 +66,10 @@ def train_model(
     nets, results = {}, {}
     for i, output in enumerate(OUTPUTS):
         x, y = samples.inputs[output], samples.targets[output]
-        # a stopped bearing (nominal heat 0) has no heat factor to learn
-        train, test = (rows[x[rows, 5] > 0] for rows in split)
+        # a stopped bearing (nominal heat 0) has no heat factor to learn, and a window whose
+        # sensor the quality check excluded (stuck, dropout) has no input: both left out
+        usable = (x[:, 5] > 0) & np.isfinite(x).all(axis=1) & np.isfinite(y)
+        train, test = (rows[usable[rows]] for rows in split)
         if len(train) < 2:
             raise ValueError(f"too few running samples for {output} ({len(train)})")
         net, history = train_network(

@@ -47,6 +47,8 @@ FIT_SENSORS = (0, 1, 2, 3)
 """T1..T4: the rings and sleeves of both bearings (T5, the housing, hardly sees them)."""
 DRIVE_SPREAD_WEIGHTS = np.array([1.0, 1.0, 2.0, 2.0])
 """Drive scatter per value (H_front, H_rear, R_front, R_rear) in units of `drive_spread`."""
+LOG_FACTOR_LIMIT = float(np.log(4.0))
+"""Bound of a fitted log factor: the fit keeps each value within ×/÷ 4 of nominal."""
 
 
 @dataclass
@@ -110,7 +112,10 @@ class WindowFit:
                 probe[j] += self.step
                 jacobian[:, j] = (self._window(f, nominal * np.exp(probe)) - base)[seen] / self.step
             normal = jacobian.T @ jacobian + weight * np.eye(4)
-            theta = theta + np.linalg.solve(normal, -jacobian.T @ residual - weight * theta)
+            step = np.linalg.solve(normal, -jacobian.T @ residual - weight * theta)
+            # a window of few valid samples (dropouts, spikes) can throw Gauss-Newton far off:
+            # keep the factors within ×/÷ 4 of nominal (LOG_FACTOR_LIMIT)
+            theta = np.clip(theta + step, -LOG_FACTOR_LIMIT, LOG_FACTOR_LIMIT)
         return theta
 
     def _window(self, f: WindowFeatures, values: np.ndarray) -> np.ndarray:
