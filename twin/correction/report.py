@@ -3,7 +3,6 @@ with loss curves, the R² table (both configurations) and predicted-vs-target pl
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
@@ -12,6 +11,7 @@ import numpy as np
 from twin.correction.features import OUTPUTS, TARGET_UNITS, kind_of
 from twin.correction.training import TrainingResult
 from twin.io.atomic import write_json, write_text
+from twin.io.figures import new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 
 
@@ -22,19 +22,13 @@ def report_paths(model_path: str | Path) -> tuple[Path, Path]:
 
 
 def _figure_png(fig: Any) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return buf.getvalue()
+    return png_bytes(fig, dpi=90)
 
 
 def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, bytes]]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     images = []
-    fig, axes = plt.subplots(1, 4, figsize=(16, 3.4))
+    fig = new_figure(figsize=(16, 3.4))
+    axes = fig.subplots(1, 4)
     for ax, output in zip(axes, OUTPUTS, strict=True):
         for name, res in results.items():
             h = res.outputs[output].history
@@ -46,10 +40,10 @@ def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, bytes]]:
     axes[0].legend(fontsize=7)
     fig.tight_layout()
     images.append(("Loss curves (training and held-out 20 %)", _figure_png(fig)))
-    plt.close(fig)
 
     for name, res in results.items():
-        fig, axes = plt.subplots(1, 4, figsize=(16, 3.6))
+        fig = new_figure(figsize=(16, 3.6))
+        axes = fig.subplots(1, 4)
         for ax, output in zip(axes, OUTPUTS, strict=True):
             r = res.outputs[output]
             ax.plot(r.test_target, r.test_predicted, ".", ms=3)
@@ -62,7 +56,6 @@ def _plots(results: dict[str, TrainingResult]) -> list[tuple[str, bytes]]:
             ax.set_ylabel(f"predicted [{unit}]")
         fig.tight_layout()
         images.append((f"Predicted vs target, held-out samples ({name})", _figure_png(fig)))
-        plt.close(fig)
     return images
 
 

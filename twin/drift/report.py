@@ -6,7 +6,6 @@ One self-contained HTML page (`report.html`, figures embedded as PNG data URIs) 
 
 from __future__ import annotations
 
-import io
 import os
 from pathlib import Path
 
@@ -16,28 +15,22 @@ from twin.drift.data import DriftData
 from twin.drift.model import DriftModel
 from twin.drift.output import drift_metrics, write_metrics
 from twin.io.atomic import write_text
+from twin.io.figures import new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 
 
 def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return buf.getvalue()
+    return png_bytes(fig, dpi=90)
 
 
 def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
              hi: np.ndarray) -> list[dict]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     hours = (data.time_s - data.time_s[0]) / 3600.0
     segments = data.segment_ids()
     images = []
     for j, target in enumerate(model.targets):
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True,
-                                          height_ratios=[2, 1])
+        fig = new_figure(figsize=(10, 5.5))
+        top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
         y = data.targets_um[:, j]
         for s in np.unique(segments):
             rows = segments == s
@@ -57,11 +50,11 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
         fig.tight_layout()
         images.append({"title": f"{target}: measured and predicted, residuals",
                        "src": png_data_uri(_png(fig))})
-        plt.close(fig)
-    images += _validation_figures(model, plt)
+    images += _validation_figures(model)
     ranking = model.metadata.get("ranking", {}).get("sensors", [])
     if ranking:
-        fig, ax = plt.subplots(figsize=(10, 3.2))
+        fig = new_figure(figsize=(10, 3.2))
+        ax = fig.subplots()
         names = [r["sensor"] for r in ranking]
         grades = [r["mean_grade"] for r in ranking]
         colours = ["tab:green" if r["sensor"] in model.spec.sensors else "tab:gray"
@@ -73,11 +66,10 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
         ax.tick_params(axis="x", rotation=60, labelsize=8)
         fig.tight_layout()
         images.append({"title": "Sensor ranking", "src": png_data_uri(_png(fig))})
-        plt.close(fig)
     return images
 
 
-def _validation_figures(model: DriftModel, plt) -> list[dict]:  # noqa: ANN001 - pyplot
+def _validation_figures(model: DriftModel) -> list[dict]:
     """Out-of-fold predictions of the time-blocked validation at fitting, per target."""
     v = model.validation
     if not v:
@@ -87,7 +79,8 @@ def _validation_figures(model: DriftModel, plt) -> list[dict]:  # noqa: ANN001 -
     hours = np.cumsum(np.where(step > 0, step, 0.0)) / 3600.0   # files back to back
     images = []
     for j, target in enumerate(model.targets):
-        fig, ax = plt.subplots(figsize=(10, 3.6))
+        fig = new_figure(figsize=(10, 3.6))
+        ax = fig.subplots()
         for b in np.unique(v["block"]):
             rows = v["block"] == b
             if int(b) % 2:
@@ -104,7 +97,6 @@ def _validation_figures(model: DriftModel, plt) -> list[dict]:  # noqa: ANN001 -
         fig.tight_layout()
         images.append({"title": f"{target}: time-blocked validation at fitting "
                        f"({model.method})", "src": png_data_uri(_png(fig))})
-        plt.close(fig)
     return images
 
 

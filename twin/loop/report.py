@@ -164,13 +164,9 @@ METRIC_LABELS = {"temperature_accuracy_pct": "T acc [%]",
 
 def distribution_plot(runs: list[dict], methods: list[str]) -> bytes:
     """One small box plot per metric, every run's value drawn over it as a point."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     values = metric_values(runs)
-    fig, axes = plt.subplots(1, len(DISTRIBUTION_METRICS), figsize=(12, 3.2))
+    fig = new_figure(figsize=(12, 3.2))
+    axes = fig.subplots(1, len(DISTRIBUTION_METRICS))
     jitter = np.random.default_rng(0)  # fixed: the same folder draws the same picture
     for ax, key in zip(axes, DISTRIBUTION_METRICS, strict=True):
         data = [values.get(m, {}).get(key, []) for m in methods]
