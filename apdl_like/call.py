@@ -26,6 +26,7 @@ LOADS = frozenset({"PREP7", "SOLU"})
 POST = frozenset({"POST1"})
 POST26 = frozenset({"POST26"})
 MODEL = frozenset({"PREP7", "SOLU", "POST1", "POST26"})
+MAX_ENTITY_NUMBER = 2**31 - 1  # MAPDL numbers entities with 32-bit signed integers
 
 Handler = Callable[["SessionState", "Call"], None]
 
@@ -104,6 +105,18 @@ class Call:
             label = f" ({what})" if what else ""
             raise ApdlError(f"field {i}{label} must be an integer, got {value!r}")
         return int(round(value))
+
+    def int_in(self, i: int, low: int, high: int, default: int | None = None,
+               what: str = "") -> int:
+        """Field `i` as an integer in `low`..`high` (both included)."""
+        value = self.int(i, default, what)
+        if not low <= value <= high:
+            raise ApdlError(f"field {i} ({what}) must lie in {low}..{high}, got {value}")
+        return value
+
+    def entity(self, i: int, what: str) -> int:
+        """Field `i` as an entity number (node, element, keypoint, line, set, type)."""
+        return self.int_in(i, 1, MAX_ENTITY_NUMBER, what=what)
 
     def count(self) -> int:
         return len(self.statement.fields)

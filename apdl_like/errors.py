@@ -10,34 +10,26 @@ from twin.errors import InputError
 
 
 class ApdlError(InputError):
-    """A deck problem: `file:line: COMMAND: what is wrong`."""
+    """A deck problem: `file:line: COMMAND: what is wrong` (the error's row is the deck line,
+    its column the command)."""
 
-    def __init__(
-        self,
-        message: str,
-        *,
-        file: str | None = None,
-        line: int | None = None,
-        command: str | None = None,
-    ) -> None:
+    def __init__(self, message: str, *, file: str | None = None, line: int | None = None,
+                 command: str | None = None) -> None:
         super().__init__(message, file=file, row=line, column=command)
-        self.line = line
-        self.command = command
 
-    def located(self, file: str | None, line: int | None, command: str | None) -> ApdlError:
-        """The same error with the location filled in where it was still unknown."""
-        return ApdlError(
-            self.reason,
-            file=self.file if self.file is not None else file,
-            line=self.line if self.line is not None else line,
-            command=self.command if self.command is not None else command,
-        )
+    @property
+    def line(self) -> int | None:
+        return self.row
 
-    def __str__(self) -> str:
-        where = ""
+    @property
+    def command(self) -> str | None:
+        return self.column
+
+    def where(self) -> str:
         if self.file is not None:
             where = f"{self.file}:{self.line}" if self.line is not None else str(self.file)
         elif self.line is not None:
             where = f"line {self.line}"
-        parts = [p for p in (where, self.command) if p]
-        return ": ".join([*parts, self.reason])
+        else:
+            where = ""
+        return ": ".join(p for p in (where, self.command) if p)

@@ -8,11 +8,12 @@ numerical library) so that any CLI can import it without loading the others.
 
 from __future__ import annotations
 
+import copy
 import functools
 import os
 import sys
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Self
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
@@ -31,18 +32,36 @@ class InputError(ValueError):
         row: int | None = None,
         column: str | None = None,
     ) -> None:
+        super().__init__(message)
+        self.reason = message
         self.file = file
         self.row = row
         self.column = column
-        self.reason = message
+
+    def where(self) -> str:
+        """The location as the message shows it (`data.csv, row 3, column 'T_C'`), or ''."""
         where = []
-        if file is not None:
-            where.append(str(file))
-        if row is not None:
-            where.append(f"row {row}")
-        if column is not None:
-            where.append(f"column {column!r}")
-        super().__init__(f"{', '.join(where)}: {message}" if where else message)
+        if self.file is not None:
+            where.append(str(self.file))
+        if self.row is not None:
+            where.append(f"row {self.row}")
+        if self.column is not None:
+            where.append(f"column {self.column!r}")
+        return ", ".join(where)
+
+    def located(self, file: str | None = None, row: int | None = None,
+                column: str | None = None) -> Self:
+        """The same error with its location filled in where it was still unknown (a
+        reader's error re-raised by the caller that knows the file)."""
+        err = copy.copy(self)
+        err.file = self.file if self.file is not None else file
+        err.row = self.row if self.row is not None else row
+        err.column = self.column if self.column is not None else column
+        return err
+
+    def __str__(self) -> str:
+        where = self.where()
+        return f"{where}: {self.reason}" if where else self.reason
 
 
 def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:

@@ -6,9 +6,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, command, specs_of
+from apdl_like.call import MAX_ENTITY_NUMBER, PREP7, Call, command, specs_of
 from apdl_like.cdb import parse_cmblock, parse_eblock, parse_nblock
-from apdl_like.commands.prep7 import MAX_ENTITY_NUMBER
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 

@@ -14,7 +14,6 @@ from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, M
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
-MAX_ENTITY_NUMBER = 2**31 - 1
 MP_LABELS = ("KXX", "KYY", "KZZ", "DENS", "C", "EX", "EY", "EZ", "PRXY", "NUXY", "ALPX", "ALPY",
              "ALPZ", "EMIS", "HF", "ENTH")
 MP_POSITIVE = ("KXX", "KYY", "KZZ", "DENS", "C", "EX")
@@ -22,13 +21,6 @@ MP_POSITIVE = ("KXX", "KYY", "KZZ", "DENS", "C", "EX")
 MP_UNUSED = ("KZZ", "EY", "EZ", "ALPY", "ALPZ", "EMIS", "HF", "ENTH")
 MAX_TABLE_POINTS = 100
 CONTACT_TYPES = ("CONTA172", "TARGE169")
-
-
-def _entity_number(c: Call, i: int, what: str) -> int:
-    n = c.int(i, what=what)
-    if not 1 <= n <= MAX_ENTITY_NUMBER:
-        raise ApdlError(f"field {i} ({what}) must lie in 1..{MAX_ENTITY_NUMBER}, got {n}")
-    return n
 
 
 # 3-D types that archives written by other tools carry (mapdl-archive writes triangles as
@@ -51,7 +43,7 @@ def _element_name(c: Call) -> str:
 
 @command("ET", PREP7, 8)
 def et(s: SessionState, c: Call) -> None:
-    itype = _entity_number(c, 1, "ITYPE")
+    itype = c.entity(1, "ITYPE")
     name = _element_name(c)
     if name in CONTACT_TYPES:
         # contact pairs come with an AxiMesh session (interfaces); accepted for archives
@@ -66,10 +58,8 @@ def et(s: SessionState, c: Call) -> None:
 
 @command("KEYOPT", PREP7, 3)
 def keyopt(s: SessionState, c: Call) -> None:
-    itype = _entity_number(c, 1, "ITYPE")
-    knum = c.int(2, what="KNUM")
-    if not 1 <= knum <= 18:
-        raise ApdlError(f"field 2 (KNUM) must lie in 1..18, got {knum}")
+    itype = c.entity(1, "ITYPE")
+    knum = c.int_in(2, 1, 18, what="KNUM")
     value = c.int(3, 0, what="VALUE")
     et_ = s.db.element_types.get(itype)
     if et_ is None:
@@ -91,7 +81,7 @@ def etchg(s: SessionState, c: Call) -> None:
 
 def _attribute(name: str):  # noqa: ANN202
     def set_attribute(s: SessionState, c: Call) -> None:
-        setattr(s.db, f"active_{name}", _entity_number(c, 1, name.upper()))
+        setattr(s.db, f"active_{name}", c.entity(1, name.upper()))
 
     return set_attribute
 
@@ -103,7 +93,7 @@ def mp(s: SessionState, c: Call) -> None:
     label = c.label(1)
     if label not in MP_LABELS:
         raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
-    mat = _entity_number(c, 2, "MAT") if c.given(2) else 1  # MAPDL: MAT defaults to 1
+    mat = c.entity(2, "MAT") if c.given(2) else 1  # MAPDL: MAT defaults to 1
     value = c.num(3, 0.0, what="C0")
     coeffs = [value] + [c.num(i, 0.0, what=f"C{i - 3}") for i in range(4, 8)]
     while len(coeffs) > 1 and coeffs[-1] == 0.0:
@@ -151,7 +141,7 @@ def mpdata(s: SessionState, c: Call) -> None:
     label = c.label(1)
     if label not in MP_LABELS:
         raise ApdlError(f"field 1: property must be one of {', '.join(MP_LABELS)}, got {label!r}")
-    mat = _entity_number(c, 2, "MAT") if c.given(2) else 1
+    mat = c.entity(2, "MAT") if c.given(2) else 1
     start = c.int(3, 1, what="STLOC")
     material = s.db.materials.setdefault(mat, Material())
     old = material.tables.get(label)
@@ -176,7 +166,7 @@ def _real_values(s: SessionState, nset: int, start: int, c: Call, first_field: i
 
 @command("R", PREP7, 7)
 def r(s: SessionState, c: Call) -> None:
-    nset = _entity_number(c, 1, "NSET")
+    nset = c.entity(1, "NSET")
     s.db.real_sets[nset] = {}
     _real_values(s, nset, 1, c, 2, 6)
     s.db.last_real = (nset, 7)
@@ -193,10 +183,8 @@ def rmore(s: SessionState, c: Call) -> None:
 
 @command("RMODIF", PREP7, 8)
 def rmodif(s: SessionState, c: Call) -> None:
-    nset = _entity_number(c, 1, "NSET")
-    stloc = c.int(2, what="STLOC")
-    if not 1 <= stloc <= 100:
-        raise ApdlError(f"field 2 (STLOC) must lie in 1..100, got {stloc}")
+    nset = c.entity(1, "NSET")
+    stloc = c.int_in(2, 1, 100, what="STLOC")
     if nset not in s.db.real_sets:
         raise ApdlError(f"real constant set {nset} does not exist")
     _real_values(s, nset, stloc, c, 3, 6)
@@ -207,7 +195,7 @@ def rmodif(s: SessionState, c: Call) -> None:
 def n(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     if c.given(1):
-        num = _entity_number(c, 1, "NODE")
+        num = c.entity(1, "NODE")
     else:
         nodes.flush()
         num = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
@@ -233,7 +221,7 @@ def e(s: SessionState, c: Call) -> None:
     given = [i for i in range(1, 9) if c.given(i)]
     if given != list(range(1, len(given) + 1)):
         raise ApdlError("node fields must be given without gaps")
-    nums = [_entity_number(c, i, "node") for i in given]
+    nums = [c.entity(i, "node") for i in given]
     if et_.name not in _NODE_COUNTS:
         raise ApdlError(f"element type {db.active_type} ({et_.name}) is not supported: "
                         "PLANE35, PLANE55, PLANE77, PLANE182 or PLANE183")
@@ -265,7 +253,7 @@ def emodif(s: SessionState, c: Call) -> None:
     what = c.label(2)
     if what not in ("MAT", "TYPE", "REAL"):
         raise ApdlError(f"field 2 must be MAT, TYPE or REAL, got {what or '(empty)'!r}")
-    value = _entity_number(c, 3, what)
+    value = c.entity(3, what)
     if what == "TYPE" and value not in s.db.element_types:
         raise ApdlError(f"element type {value} is not defined (ET first)")
     idx = element_targets(s, c, 1)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -10,7 +11,7 @@ import numpy as np
 from apdl_like.call import MODEL, Call, command, specs_of
 from apdl_like.commands.generate import from_cartesian
 from apdl_like.errors import ApdlError
-from apdl_like.model import Component, ElementTable, NodeTable
+from apdl_like.model import Component
 from apdl_like.selection import combine, in_range, number_range
 
 if TYPE_CHECKING:
@@ -27,14 +28,15 @@ def _mode(c: Call) -> str:
     return mode
 
 
-def _picking_mode(c: Call, table: NodeTable | ElementTable) -> str | None:
-    """S, R, A or U: the mode of a selection by item; ALL, NONE and INVE need no item, they
-    are applied to `table` here (and None is returned)."""
+def _select(c: Call, current: np.ndarray, default_item: str,
+            pick: Callable[[str], np.ndarray]) -> np.ndarray:
+    """The selection after an xSEL command: Type (field 1) combines `current` with the items
+    `pick(Item)` marks (Item is field 2, `default_item` when blank); ALL, NONE and INVE need
+    no item."""
     mode = _mode(c)
     if mode in ("ALL", "NONE", "INVE"):
-        table.selected = combine(mode, table.selected, table.selected)
-        return None
-    return mode
+        return combine(mode, current, current)
+    return combine(mode, current, pick(c.label(2, default_item)))
 
 
 def _range(c: Call) -> tuple[float, float, float]:
@@ -47,15 +49,16 @@ def _range(c: Call) -> tuple[float, float, float]:
 @command("NSEL", _ANY_OR_BEGIN, 7)
 def nsel(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
-    mode = _picking_mode(c, nodes)
-    if mode is None:
-        return
-    item = c.label(2, "NODE")
+    nodes.selected = _select(c, nodes.selected, "NODE", lambda item: _nodes_picked(s, c, item))
+
+
+def _nodes_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
+    nodes = s.db.nodes
     if item == "NODE" and c.label(4) == "ALL":
-        picked = np.ones(len(nodes.ids), bool)  # NSEL,S,NODE,,ALL: every node
-    elif item == "NODE":
-        picked = number_range(nodes.ids, *_range(c))
-    elif item == "LOC":
+        return np.ones(len(nodes.ids), bool)  # NSEL,S,NODE,,ALL: every node
+    if item == "NODE":
+        return number_range(nodes.ids, *_range(c))
+    if item == "LOC":
         comp = c.label(3)
         if comp not in ("X", "Y", "Z"):
             raise ApdlError(f"field 3: LOC takes X or Y (Z is 0 in a 2-D model), got {comp!r}")
@@ -63,34 +66,31 @@ def nsel(s: SessionState, c: Call) -> None:
         vmax = c.num(5, vmin, what="VMAX")
         local = from_cartesian(s.db.csys, nodes.xy)
         values = np.zeros(len(nodes.ids)) if comp == "Z" else local[:, "XY".index(comp)]
-        picked = in_range(values, vmin, vmax)
-    else:
-        raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
-    nodes.selected = combine(mode, nodes.selected, picked)
+        return in_range(values, vmin, vmax)
+    raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
 
 
 @command("ESEL", _ANY_OR_BEGIN, 7)
 def esel(s: SessionState, c: Call) -> None:
     el = s.db.elements
-    mode = _picking_mode(c, el)
-    if mode is None:
-        return
-    item = c.label(2, "ELEM")
+    el.selected = _select(c, el.selected, "ELEM", lambda item: _elements_picked(s, c, item))
+
+
+def _elements_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
+    el = s.db.elements
     if item == "ELEM":
-        picked = number_range(el.ids, *_range(c))
-    elif item in ("TYPE", "MAT", "REAL"):
+        return number_range(el.ids, *_range(c))
+    if item in ("TYPE", "MAT", "REAL"):
         values = {"TYPE": el.type, "MAT": el.mat, "REAL": el.real}[item]
-        picked = number_range(values, *_range(c))
-    elif item == "CENT" or item == "LOC":
+        return number_range(values, *_range(c))
+    if item == "CENT" or item == "LOC":
         comp = c.label(3)
         if comp not in ("X", "Y"):
             raise ApdlError(f"field 3: {item} takes X or Y, got {comp!r}")
         vmin = c.num(4, what="VMIN")
         vmax = c.num(5, vmin, what="VMAX")
-        picked = in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
-    else:
-        raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
-    el.selected = combine(mode, el.selected, picked)
+        return in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
+    raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
 
 
 def _centroids(s: SessionState) -> np.ndarray:
@@ -149,25 +149,21 @@ def _select_numbered(s: SessionState, c: Call, numbers: list[int], xy: np.ndarra
     """KSEL/LSEL: Type (S, R, A, U, ALL, NONE, INVE), Item (the entity's number, or LOC of
     its keypoint / its midpoint in the active coordinate system), Comp, VMIN, VMAX, VINC."""
     ids = np.array(numbers, np.int64)
-    current = ~np.isin(ids, list(unselected))
-    mode = _mode(c)
-    if mode in ("ALL", "NONE", "INVE"):
-        picked = current
-    else:
-        item = c.label(2, item_name)
+
+    def pick(item: str) -> np.ndarray:
         if item == item_name:
-            picked = number_range(ids, *_range(c))
-        elif item == "LOC":
+            return number_range(ids, *_range(c))
+        if item == "LOC":
             comp = c.label(3)
             if comp not in ("X", "Y"):
                 raise ApdlError(f"field 3: LOC takes X or Y, got {comp!r}")
             vmin = c.num(4, 0.0, what="VMIN")
             vmax = c.num(5, vmin, what="VMAX")
             local = from_cartesian(s.db.csys, xy.reshape(-1, 2))
-            picked = in_range(local[:, "XY".index(comp)], vmin, vmax)
-        else:
-            raise ApdlError(f"field 2: item must be {item_name} or LOC, got {item!r}")
-    chosen = combine(mode, current, picked)
+            return in_range(local[:, "XY".index(comp)], vmin, vmax)
+        raise ApdlError(f"field 2: item must be {item_name} or LOC, got {item!r}")
+
+    chosen = _select(c, ~np.isin(ids, list(unselected)), item_name, pick)
     unselected.clear()
     unselected.update(int(n) for n in ids[~chosen])
 

@@ -21,15 +21,7 @@ from apdl_like.model import Line
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
-MAX_ENTITY_NUMBER = 2**31 - 1
 MAX_DIVISIONS = 10_000
-
-
-def _number(c: Call, i: int, what: str) -> int:
-    n = c.int(i, what=what)
-    if not 1 <= n <= MAX_ENTITY_NUMBER:
-        raise ApdlError(f"field {i} ({what}) must lie in 1..{MAX_ENTITY_NUMBER}, got {n}")
-    return n
 
 
 @command("K", PREP7, 4)
@@ -52,7 +44,7 @@ def kgen(s: SessionState, c: Call) -> None:
     if c.label(2) == "ALL":
         pattern = sorted(kps)
     else:
-        first = _number(c, 2, "NP1")
+        first = c.entity(2, "NP1")
         last = c.int(3, first, what="NP2")
         pattern = [n for n in range(first, last + 1, max(c.int(4, 1, what="NINC"), 1))
                    if n in kps]
@@ -69,7 +61,7 @@ def kgen(s: SessionState, c: Call) -> None:
 @command("L", PREP7, 4)
 def line(s: SessionState, c: Call) -> None:
     """L,P1,P2[,NDIV,SPACE]: a straight line between two keypoints."""
-    p1, p2 = _number(c, 1, "P1"), _number(c, 2, "P2")
+    p1, p2 = c.entity(1, "P1"), c.entity(2, "P2")
     for p in (p1, p2):
         if p not in s.db.keypoints:
             raise ApdlError(f"keypoint {p} does not exist")
@@ -83,7 +75,7 @@ def line(s: SessionState, c: Call) -> None:
 def lesize(s: SessionState, c: Call) -> None:
     """LESIZE,NL1,SIZE,ANGSIZ,NDIV,SPACE: divisions (or size) and spacing ratio of lines."""
     lines = s.db.lines
-    chosen = sorted(lines) if c.label(1) == "ALL" else [_number(c, 1, "NL1")]
+    chosen = sorted(lines) if c.label(1) == "ALL" else [c.entity(1, "NL1")]
     for n in chosen:
         if n not in lines:
             raise ApdlError(f"line {n} does not exist")
@@ -110,7 +102,7 @@ def lesize(s: SessionState, c: Call) -> None:
 @command("A", PREP7, 18)
 def area(s: SessionState, c: Call) -> None:
     """A,P1,P2,...: an area through keypoints (in order around it)."""
-    pts = [_number(c, i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
+    pts = [c.entity(i, "keypoint") for i in range(1, c.count() + 1) if c.given(i)]
     if len(pts) < 3:
         raise ApdlError("an area needs at least 3 keypoints")
     for p in pts:
@@ -122,7 +114,7 @@ def area(s: SessionState, c: Call) -> None:
 @command("AL", PREP7, 10)
 def area_lines(s: SessionState, c: Call) -> None:
     """AL,L1,L2,...: an area bounded by lines (in order around it)."""
-    nums = [_number(c, i, "line") for i in range(1, c.count() + 1) if c.given(i)]
+    nums = [c.entity(i, "line") for i in range(1, c.count() + 1) if c.given(i)]
     if len(nums) < 3:
         raise ApdlError("an area needs at least 3 lines")
     lines = s.db.lines
@@ -166,9 +158,7 @@ def esize(s: SessionState, c: Call) -> None:
             raise ApdlError(f"field 1 (SIZE) must be positive, got {size!r}")
         s.db.esize, s.db.esize_divisions = size, None
     elif c.given(2):
-        ndiv = c.int(2, what="NDIV")
-        if not 1 <= ndiv <= MAX_DIVISIONS:
-            raise ApdlError(f"field 2 (NDIV) must lie in 1..{MAX_DIVISIONS}, got {ndiv}")
+        ndiv = c.int_in(2, 1, MAX_DIVISIONS, what="NDIV")
         s.db.esize_divisions = ndiv
     else:
         raise ApdlError("ESIZE needs SIZE (field 1) or NDIV (field 2)")
@@ -189,8 +179,8 @@ def amesh(s: SessionState, c: Call) -> None:
     if c.label(1, "ALL") == "ALL":
         chosen = sorted(areas)
     else:
-        first = _number(c, 1, "NA1")
-        last = _number(c, 2, "NA2") if c.given(2) else first
+        first = c.entity(1, "NA1")
+        last = c.entity(2, "NA2") if c.given(2) else first
         step = c.int(3, 1, what="NINC")
         if step < 1:
             raise ApdlError("field 3 (NINC) must be ≥ 1")

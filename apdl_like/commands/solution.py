@@ -195,9 +195,7 @@ def _load_state(s: SessionState) -> dict:
 def lswrite(s: SessionState, c: Call) -> None:
     """LSWRITE,LSNUM: the current loads and options as load step LSNUM (in memory)."""
     steps = s.load_steps
-    num = c.int(1, max(steps, default=0) + 1, what="LSNUM")
-    if not 1 <= num <= 9999:
-        raise ApdlError(f"field 1 (LSNUM) must lie in 1..9999, got {num}")
+    num = c.int_in(1, 1, 9999, max(steps, default=0) + 1, what="LSNUM")
     steps[num] = _load_state(s)
     s.budget.unsolved = None  # written loads are solved by LSSOLVE
 
