@@ -379,21 +379,31 @@ def test_long_cylinder_thermal_stress_on_quads(keyopt1, rel):
     assert abs(uniform.params["HOOP_IN"]) < 1e-6 * E * alpha * 5  # free expansion: no stress
 
 
+def wall_end_C(t0: float, tb: float, h: float, length: float = 0.1, k: float = 20.0) -> float:
+    """Planar wall, T0 at x = 0, film h to T_b at x = L, conduction k in series with the
+    film: T(L) = T_b + (T0 − T_b)/(1 + hL/k)."""
+    return tb + (t0 - tb) / (1.0 + h * length / k)
+
+
+def convecting_slab(size: float, types: str, surface: str) -> str:
+    """/PREP7 of the slab 0..0.1 × 0..0.05 (k = 20, element size `size`) meshed by AMESH;
+    `surface` runs with the nodes at x = 0.1 selected, the element `types` come first."""
+    return f"""
+/PREP7
+{types}
+MP,KXX,1,20
+RECTNG,0,0.1,0,0.05
+ESIZE,{size}
+AMESH,1
+NSEL,S,LOC,X,0.1
+{surface}
+"""
+
+
 def test_surf151_convection_matches_the_one_dimensional_wall():
     """A slab 0.1 m long, T = 100 at x = 0, SURF151 elements (ESURF) at x = 0.1 carrying
     SFE convection h = 50, T_bulk = 20; k = 20: T(L) = T_b + (T_0 − T_b)/(1 + hL/k) = 84."""
-    s = run("""
-/PREP7
-ET,1,PLANE55
-ET,2,SURF151
-MP,KXX,1,20
-RECTNG,0,0.1,0,0.05
-ESIZE,0.01
-AMESH,1
-NSEL,S,LOC,X,0.1
-ESLN,S,0
-TYPE,2
-ESURF
+    s = run(convecting_slab(0.01, "ET,1,PLANE55\nET,2,SURF151", "ESLN,S,0\nTYPE,2\nESURF") + """
 ALLSEL
 /SOLU
 NSEL,S,LOC,X,0
@@ -406,21 +416,13 @@ ALLSEL
 SOLVE
 *GET,T_END,NODE,NODE(0.1,0,0),TEMP
 """)
-    assert s.params["T_END"] == pytest.approx(20.0 + 80.0 / (1.0 + 50.0 * 0.1 / 20.0), rel=1e-9)
+    assert s.params["T_END"] == pytest.approx(wall_end_C(100.0, 20.0, 50.0), rel=1e-9)
 
 
 def test_lswrite_lssolve_solves_each_written_load_step():
     """Two load steps written with LSWRITE and solved by LSSOLVE: a slab with T_0 at x = 0
     and convection h = 50, T_b = 20 at x = L: T(L) = T_b + (T_0 − T_b)/(1 + hL/k)."""
-    s = run("""
-/PREP7
-ET,1,PLANE55
-MP,KXX,1,20
-RECTNG,0,0.1,0,0.05
-ESIZE,0.025
-AMESH,1
-NSEL,S,LOC,X,0.1
-SF,ALL,CONV,50,20
+    s = run(convecting_slab(0.025, "ET,1,PLANE55", "SF,ALL,CONV,50,20") + """
 NSEL,S,LOC,X,0
 D,ALL,TEMP,100
 ALLSEL
@@ -440,7 +442,7 @@ SET,2
 *GET,T_TWO,NODE,NODE(0.1,0,0),TEMP
 """)
     for t0, name in ((100.0, "T_ONE"), (200.0, "T_TWO")):
-        assert s.params[name] == pytest.approx(20.0 + (t0 - 20.0) / 1.25, rel=1e-9)
+        assert s.params[name] == pytest.approx(wall_end_C(t0, 20.0, 50.0), rel=1e-9)
 
 
 @pytest.mark.parametrize("mode", ["axisymmetric", "plane_strain"])
@@ -503,8 +505,7 @@ def test_solid_model_loads_dl_and_sfl_on_a_convecting_slab(left, right):
     values = dict(k=k, length=length, h=h, t0=t0, tb=tb)
     s = run(SOLID_MODEL_SLAB.format(height=0.04, size=0.01, left=left.format(**values),
                                     right=right.format(**values), **values))
-    q = (t0 - tb) / (length / k + 1.0 / h)
-    t_end = tb + q / h
+    t_end = wall_end_C(t0, tb, h, length, k)
     assert s.params["T_END"] == pytest.approx(t_end, rel=1e-9)
     assert s.params["T_MID"] == pytest.approx(t0 + 0.4 * (t_end - t0), rel=1e-9)
 

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import MODEL, Call, command, specs_of
+from apdl_like.call import MODEL, Call, Handler, command, specs_of
 from apdl_like.commands.generate import from_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
@@ -46,12 +46,6 @@ def _range(c: Call) -> tuple[float, float, float]:
     return vmin, vmax, vinc
 
 
-@command("NSEL", _ANY_OR_BEGIN, 7)
-def nsel(s: SessionState, c: Call) -> None:
-    nodes = s.db.nodes
-    nodes.selected = _select(c, nodes.selected, "NODE", lambda item: _nodes_picked(s, c, item))
-
-
 def _nodes_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
     nodes = s.db.nodes
     if item == "NODE" and c.label(4) == "ALL":
@@ -70,12 +64,6 @@ def _nodes_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
     raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
 
 
-@command("ESEL", _ANY_OR_BEGIN, 7)
-def esel(s: SessionState, c: Call) -> None:
-    el = s.db.elements
-    el.selected = _select(c, el.selected, "ELEM", lambda item: _elements_picked(s, c, item))
-
-
 def _elements_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
     el = s.db.elements
     if item == "ELEM":
@@ -91,6 +79,22 @@ def _elements_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
         vmax = c.num(5, vmin, what="VMAX")
         return in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
     raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
+
+
+def _table_selection(table: str, default_item: str,
+                     pick: Callable[[SessionState, Call, str], np.ndarray]) -> Handler:
+    """The handler of NSEL / ESEL: selects among `s.db.<table>` the items `pick` marks."""
+
+    def select(s: SessionState, c: Call) -> None:
+        entities = getattr(s.db, table)
+        entities.selected = _select(c, entities.selected, default_item,
+                                    lambda item: pick(s, c, item))
+
+    return select
+
+
+nsel = command("NSEL", _ANY_OR_BEGIN, 7)(_table_selection("nodes", "NODE", _nodes_picked))
+esel = command("ESEL", _ANY_OR_BEGIN, 7)(_table_selection("elements", "ELEM", _elements_picked))
 
 
 def _centroids(s: SessionState) -> np.ndarray:
