@@ -289,8 +289,11 @@ def _dispatch(session: SessionState, st: Statement) -> None:
                  "POST1": "/POST1", "POST26": "/POST26"}
         allowed = " or ".join(where[p] for p in sorted(spec.processors))
         raise st.error(f"not valid in {where[session.processor]} (use it in {allowed})")
-    if len(st.fields) > spec.max_fields:
-        raise st.error(f"takes at most {spec.max_fields} fields, got {len(st.fields)}")
+    given = len(st.fields)
+    while given > spec.max_fields and not str(st.fields[given - 1]).strip():
+        given -= 1  # trailing blank fields are no input (FSUM,,,)
+    if given > spec.max_fields:
+        raise st.error(f"takes at most {spec.max_fields} fields, got {given}")
     try:
         spec.handler(session, Call(st, session))
     except ApdlError as exc:

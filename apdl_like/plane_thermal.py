@@ -346,16 +346,28 @@ class PlaneThermal:
         raise ApdlError(f"the nonlinear thermal step did not converge in {PICARD_ITERATIONS} "
                         "Picard iterations")
 
-    def element_heat(self, inputs: ThermalInputs, T: np.ndarray, element: int) -> np.ndarray:
-        """Heat flow (W) at the global dofs of one element, steady: its conduction and film
-        matrices times T less its loads; the sum over the elements at a node with a fixed
-        temperature is that node's reaction heat."""
-        owner = [k for k, part in enumerate(self.mesh.parts) if np.any(part.elements == element)]
-        if not owner:
+    def element_heat(self, inputs: ThermalInputs, T: np.ndarray,
+                     elements: int | np.ndarray) -> np.ndarray:
+        """Heat flow (W) at the global dofs of some elements (indices of the deck's element
+        table), summed over them, steady: their conduction and film matrices times T less
+        their loads; the sum over the elements at a node with a fixed temperature is that
+        node's reaction heat."""
+        wanted = np.atleast_1d(np.asarray(elements, np.int64))
+        out = np.zeros(self.mesh.n_dofs)
+        found = np.zeros(wanted.size, bool)
+        for k, part in enumerate(self.mesh.parts):
+            cells = np.nonzero(np.isin(part.elements, wanted))[0]
+            found |= np.isin(wanted, part.elements)
+            if cells.size:
+                out += part.to_global @ self._cells_heat(k, inputs, T, cells)
+        if not found.all():
             raise ApdlError("the element is not part of the thermal mesh")
-        k = owner[0]
+        return out
+
+    def _cells_heat(self, k: int, inputs: ThermalInputs, T: np.ndarray,
+                    cells: np.ndarray) -> np.ndarray:
+        """Local-dof heat flow of some cells of part k (see `element_heat`)."""
         part = self.mesh.parts[k]
-        cells = np.nonzero(part.elements == element)[0]
         ax = self.mesh.axisymmetric
         b = Basis(part.basis.mesh, part.basis.elem, elements=cells)
         T_local = T[part.local_dofs]
@@ -379,14 +391,16 @@ class PlaneThermal:
             facets = own[np.isin(part.facet_keys[own], keys)]
             if facets.size:
                 fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
-                r = r + mass.assemble(fb, c=h, axisymmetric=ax) @ T_local \
-                    - load.assemble(fb, g=h * tb, axisymmetric=ax)
+                H = mass.assemble(fb, c=h, axisymmetric=ax)
+                if self.mesh.lumped:
+                    H = sp.diags(np.asarray(H.sum(axis=1)).ravel())
+                r = r + H @ T_local - load.assemble(fb, g=h * tb, axisymmetric=ax)
         for keys, flux in inputs.fluxes:
             facets = own[np.isin(part.facet_keys[own], keys)]
             if facets.size:
                 fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
                 r = r - load.assemble(fb, g=flux, axisymmetric=ax)
-        return part.to_global @ r
+        return r
 
     def reaction(self, inputs: ThermalInputs, T: np.ndarray) -> np.ndarray:
         """Heat flow into the model at each dof (W; nonzero at fixed temperatures), steady."""

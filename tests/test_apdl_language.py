@@ -302,3 +302,11 @@ def test_a_command_spelled_error_is_an_unknown_command_not_a_crash():
     assert s.params["B"] == 2.0
     assert s.state.listing.warnings == [
         "warning: deck.inp:1: ERROR: unknown or unsupported command ERROR; ignored"]
+
+
+def test_trailing_blank_fields_are_no_input():
+    """MAPDL reads `FSUM,,,` as FSUM (VM99 writes it): blank fields past a command's last
+    field are accepted, a value there is still an error naming the command."""
+    run("/PREP7\nTUNIF,20,,,\nFINISH\n")
+    with pytest.raises(ApdlError, match="TUNIF.*takes at most"):
+        run("/PREP7\nTUNIF,20,,,5\nFINISH\n")

@@ -532,3 +532,42 @@ def test_solid_model_loads_dk_fixes_the_node_on_a_keypoint(right):
 def test_solid_model_loads_refuse_what_they_cannot_transfer(deck, message):
     with pytest.raises(ApdlError, match=message):
         run(deck)
+
+
+def test_fsum_heat_of_selected_elements_and_nodes():
+    """FSUM sums the element nodal heat flows of the selected elements at the selected nodes,
+    positive into the model (MAPDL's sign: VM99's fin reports -HEAT at its wall, VM100's
+    chimney +HEAT through its heated film).  A ring heated by a film at RI and held at RO:
+    the film element, the held element at the held nodes and the whole model all carry the
+    ring's heat flow Q = ΔT / (R_film + R_wall)."""
+    n, h, t_bulk, t_outer = 20, 400.0, 200.0, 20.0
+    s = run(ring_model(ring_nodes_elements(n, "PLANE55")) + f"""
+FINISH
+/SOLU
+NSEL,S,LOC,X,RI
+SF,ALL,CONV,{h},{t_bulk}
+NSEL,S,LOC,X,RO
+D,ALL,TEMP,{t_outer}
+ALLSEL
+SOLVE
+FINISH
+/POST1
+FSUM
+*GET,Q_ALL,FSUM,,ITEM,HEAT
+ESEL,S,ELEM,,1
+FSUM
+*GET,Q_FILM,FSUM,,ITEM,HEAT
+ESEL,S,ELEM,,{n}
+NSEL,S,LOC,X,RO
+FSUM
+*GET,Q_HELD,FSUM,,ITEM,HEAT
+NSEL,S,LOC,X,RI
+FSUM
+*GET,Q_NONE,FSUM,,ITEM,HEAT
+""")
+    area_in = 2 * math.pi * RI * H
+    q = (t_bulk - t_outer) / (1 / (h * area_in) + math.log(RO / RI) / (2 * math.pi * K * H))
+    p = s.params
+    for name in ("Q_ALL", "Q_FILM", "Q_HELD"):
+        assert p[name] == pytest.approx(q, rel=2e-3), name
+    assert p["Q_NONE"] == 0.0  # the selected element has no selected node

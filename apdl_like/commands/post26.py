@@ -150,9 +150,19 @@ def prnld(s: SessionState, c: Call) -> None:
 
 @command("FSUM", POST, 2)
 def fsum(s: SessionState, c: Call) -> None:
-    """FSUM: the total reaction heat of the selected nodes (*GET,Par,FSUM,,ITEM,HEAT)."""
-    nodes, heat = reactions(s)
-    total = float(heat[s.db.nodes.selected[nodes]].sum())
+    """FSUM: the heat flow of the selected elements summed at the selected nodes
+    (*GET,Par,FSUM,,ITEM,HEAT).  MAPDL sums the element nodal heat flows, counted positive
+    into the model: a film that heats the model adds, a fixed temperature that takes heat
+    out adds; over all elements and nodes it is minus the total reaction heat."""
+    model, inputs = _plane(s)
+    res = s.result()
+    if res.analysis != "thermal":
+        raise ApdlError("FSUM sums heat flows of a thermal result")
+    elements = np.nonzero(s.db.elements.selected)[0]
+    heat = -model.element_heat(inputs, res.temperature, elements) if elements.size else \
+        np.zeros(model.mesh.n_dofs)
+    dofs = model.mesh.node_dof[s.db.nodes.selected]
+    total = float(heat[np.unique(dofs[dofs >= 0])].sum())
     s.fsum_heat = total
     s.say(f"FSUM: HEAT = {total:.6E}")
 
