@@ -186,7 +186,7 @@ def _properties(db: Database, transient: bool) -> tuple[dict[str, list[Property]
     mats = sorted({int(m) for m in np.unique(db.elements.mat)})
     size = max(mats) + 1
     out: dict[str, list[Property]] = {"kxx": [None] * size, "kyy": [None] * size,  # type: ignore[list-item]
-                                      "rho_c": [None] * size}
+                                      "rho_c": [None] * size, "enthalpy": [None] * size}
     for mat in mats:
         if mat not in db.materials:
             raise ApdlError(f"material {mat} is used by elements but has no MP properties")
@@ -194,7 +194,9 @@ def _properties(db: Database, transient: bool) -> tuple[dict[str, list[Property]
         m = db.materials[mat]
         kyy = material_property(db, mat, "KYY", "") if "KYY" in m.props or "KYY" in m.tables \
             else kxx
-        if transient:
+        if transient and "ENTH" in m.tables:
+            out["enthalpy"][mat], rho_c = enthalpy_table(*m.tables["ENTH"])
+        elif transient:
             dens = material_property(db, mat, "DENS", "for a transient")
             c = material_property(db, mat, "C", "for a transient")
             rho_c = _product(dens, c)
@@ -202,6 +204,28 @@ def _properties(db: Database, transient: bool) -> tuple[dict[str, list[Property]
             rho_c = material_property(db, mat, "C", "", default=1.0)
         out["kxx"][mat], out["kyy"][mat], out["rho_c"][mat] = kxx, kyy, rho_c
     return out, mats
+
+
+def enthalpy_table(temps: np.ndarray, enthalpy: np.ndarray) -> tuple[Property, Property]:
+    """H(T) and ρc(T) = dH/dT of an MPTEMP/MPDATA enthalpy table (ENTH, J/m³): MAPDL
+    uses the enthalpy instead of DENS·C when both are given (phase change: the latent heat
+    is the steep part of H).  H is linear between the points and goes on with the end
+    slopes beyond them; each interval's slope holds up to its upper temperature."""
+    if temps.size < 2:
+        raise ApdlError("an enthalpy table (MPDATA,ENTH) needs at least two temperatures")
+    slopes = np.diff(enthalpy) / np.diff(temps)
+    if np.any(slopes <= 0.0):
+        raise ApdlError("the enthalpy (MPDATA,ENTH) must increase with temperature")
+    inner = temps[1:-1]
+
+    def interval(T: np.ndarray) -> np.ndarray:
+        return np.searchsorted(inner, T, side="right")
+
+    def H(T: np.ndarray) -> np.ndarray:
+        i = interval(T)
+        return enthalpy[i] + slopes[i] * (T - temps[i])
+
+    return H, lambda T: slopes[interval(T)]
 
 
 def _product(a: Property, b: Property) -> Property:
@@ -258,7 +282,9 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
     d = ramp(now.d_temp, None if before is None else before.d_temp, tunif)
     nodes_fixed = np.nonzero(~np.isnan(now.d_temp) & (mesh.node_dof >= 0))[0]
     fixed = (mesh.node_dof[nodes_fixed], d[nodes_fixed])
-    return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed)
+    enthalpy = props["enthalpy"] if any(h is not None for h in props["enthalpy"]) else None
+    return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed,
+                         enthalpy)
 
 
 def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:

@@ -215,6 +215,9 @@ class ThermalInputs:
     films            (face keys, h W/m²K, T_bulk °C) groups; keys: packed corner node numbers
     fluxes           (face keys, q W/m²) groups
     fixed            (dofs, values °C)
+    enthalpy         per material H(T) J/m³ (MPDATA,ENTH) or None: a transient step's
+                     capacity is then the secant (H(T1) − H(T0)) / (T1 − T0), so a step
+                     across a phase change takes in exactly its latent heat
     """
 
     kxx: list[Property]
@@ -224,6 +227,7 @@ class ThermalInputs:
     films: list[tuple[np.ndarray, float, float]]
     fluxes: list[tuple[np.ndarray, float]]
     fixed: tuple[np.ndarray, np.ndarray]
+    enthalpy: list[Property | None] | None = None
 
 
 class PlaneThermal:
@@ -248,6 +252,33 @@ class PlaneThermal:
         for m, cells in self.groups[k].items():
             out[cells] = props[m](Tq[cells])
         return out
+
+    def secant_capacity(self, inputs: ThermalInputs, T0: np.ndarray,
+                        T1: np.ndarray) -> sp.csr_matrix:
+        """The capacity matrix of a step T0 -> T1 with (H(T1) − H(T0)) / (T1 − T0) at each
+        quadrature point where the material has an enthalpy table, ρc(T1) elsewhere and
+        where the point's temperature does not change."""
+        n = self.mesh.n_dofs
+        C = sp.csr_matrix((n, n))
+        ax = self.mesh.axisymmetric
+        for k, part in enumerate(self.mesh.parts):
+            b = part.basis
+            T0q = b.interpolate(T0[part.local_dofs]).value
+            T1q = b.interpolate(T1[part.local_dofs]).value
+            c = np.empty_like(T1q)
+            for m, cells in self.groups[k].items():
+                a, z = T0q[cells], T1q[cells]
+                c[cells] = inputs.rho_c[m](z)
+                H = inputs.enthalpy[m] if inputs.enthalpy is not None else None
+                if H is not None:
+                    dT = z - a
+                    moved = np.abs(dT) > 1e-12 * (1.0 + np.abs(z))
+                    sec = (H(z) - H(a)) / np.where(moved, dT, 1.0)
+                    c[cells] = np.where(moved, sec, c[cells])
+            C = C + part.to_global @ mass.assemble(b, c=c, axisymmetric=ax) @ part.to_global.T
+        if self.mesh.lumped:
+            C = sp.diags(np.asarray(C.sum(axis=1)).ravel())
+        return C.tocsr()
 
     def operators(self, inputs: ThermalInputs, T: np.ndarray,
                   nonlinear: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix, np.ndarray]:
@@ -336,6 +367,8 @@ class PlaneThermal:
             K1, C1, f1 = self.operators(inputs_new, T1, nonlinear) if nonlinear or \
                 inputs_new is not inputs_old else (K0, C0, f0)
             C = 0.5 * (C0 + C1) if nonlinear else C0
+            if inputs_new.enthalpy is not None:
+                C = self.secant_capacity(inputs_new, T, T1)
             A = C / dt + theta * K1
             rhs = C @ T / dt - (1.0 - theta) * (K0 @ T) + theta * f1 + (1.0 - theta) * f0
             T_new = self._solve(A.tocsr(), rhs, inputs_new.fixed)

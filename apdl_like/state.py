@@ -104,6 +104,7 @@ class Solution:
     substep_temperatures: list[np.ndarray] = field(default_factory=list)
     results: list[StepResult] = field(default_factory=list)
     post_index: int = -1  # result set shown in /POST1 (SET)
+    post_result: StepResult | None = None  # SET,,,,,TIME: a set between stored times
     new_analysis: bool = True  # the next SOLVE starts a new results file (its load step 1)
 
     def span_to(self, end_time: float | None) -> float:
@@ -229,6 +230,8 @@ class SessionState:
         results = self.solution.results
         if not results:
             raise ApdlError("no results yet (SOLVE first)")
+        if self.solution.post_result is not None:
+            return self.solution.post_result
         return results[self.solution.post_index]
 
     def nodal_result(self, item: str, n: float) -> float:

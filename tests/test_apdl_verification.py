@@ -571,3 +571,46 @@ FSUM
     for name in ("Q_ALL", "Q_FILM", "Q_HELD"):
         assert p[name] == pytest.approx(q, rel=2e-3), name
     assert p["Q_NONE"] == 0.0  # the selected element has no selected node
+
+
+def test_enthalpy_table_melts_an_insulated_block_and_set_reads_between_times():
+    """MPDATA,ENTH replaces DENS·C: with uniform HGEN q the insulated block's enthalpy
+    rises as H(T) = H(T0) + q t.  H: 4.2 MJ/m³K below -1 °C and above 0 °C, a 42 MJ/m³
+    latent step between; from -5 °C at q = 4.2 MW/m³: -1 °C at 4 s, 0 °C at 14 s, 6 °C at
+    20 s (1 s steps land on the breakpoints, so backward Euler is exact).  SET,,,,,TIME
+    between stored times interpolates linearly (MAPDL's rule): -0.45 °C at 9.5 s."""
+    s = run("""
+/PREP7
+ET,1,PLANE55
+MP,KXX,1,0.6
+MPTEMP,1,-10,-1,0,10
+MPDATA,ENTH,1,1,0,37.8E6,79.8E6,121.8E6
+RECTNG,0,0.01,0,0.002
+ESIZE,0.001
+AMESH,ALL
+/SOLU
+ANTYPE,TRANS
+TUNIF,-5
+BFE,ALL,HGEN,,4.2E6
+KBC,1
+TIME,20
+DELTIM,1
+SOLVE
+FINISH
+/POST1
+*GET,T_END,NODE,1,TEMP
+SET,,,,,4
+*GET,T_4,NODE,1,TEMP
+SET,,,,,9.5
+*GET,T_9H,NODE,NODE(0.01,0.002),TEMP
+SET,,,,,14
+*GET,T_14,NODE,1,TEMP
+SET,LAST
+*GET,T_LAST,NODE,1,TEMP
+""")
+    p = s.params
+    assert p["T_4"] == pytest.approx(-1.0, abs=1e-9)
+    assert p["T_9H"] == pytest.approx(-0.45, abs=1e-9)
+    assert p["T_14"] == pytest.approx(0.0, abs=1e-9)
+    assert p["T_END"] == pytest.approx(6.0, abs=1e-9)
+    assert p["T_LAST"] == p["T_END"]

@@ -7,7 +7,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import POST, Call, command, specs_of
+from apdl_like.commands.post26 import thermal_history
 from apdl_like.errors import ApdlError
+from apdl_like.state import StepResult
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -20,6 +22,10 @@ def set_(s: SessionState, c: Call) -> None:
     results = s.solution.results
     kind = results[-1].analysis  # the results file of the last analysis
     steps = [i for i, r in enumerate(results) if r.analysis == kind]
+    s.solution.post_result = None
+    if c.given(5) and not c.given(1):
+        s.solution.post_result = _at_time(s, c.num(5, what="TIME"))
+        return
     what = c.label(1, "LAST")
     if what in ("LAST", ""):
         s.solution.post_index = steps[-1]
@@ -31,6 +37,24 @@ def set_(s: SessionState, c: Call) -> None:
         if not match:
             raise ApdlError(f"load step {step} does not exist (1..{len(steps)})")
         s.solution.post_index = match[0]
+
+
+def _at_time(s: SessionState, time_s: float) -> StepResult:
+    """SET,,,,,TIME: the thermal result at a time, linearly interpolated between the two
+    stored times around it (MAPDL's rule), the first or last beyond them."""
+    mesh = s.fem.plane
+    if mesh is None:
+        raise ApdlError("SET by TIME reads the thermal results of a deck's own mesh")
+    times, temps = thermal_history(s)
+    k = int(np.searchsorted(times, time_s))
+    if k == 0 or k == times.size:
+        T = temps[min(k, times.size - 1)]
+    else:
+        w = (time_s - times[k - 1]) / (times[k] - times[k - 1])
+        T = (1.0 - w) * temps[k - 1] + w * temps[k]
+    step = next(r.load_step for r in s.solution.results
+                if r.analysis == "thermal" and r.time >= min(time_s, times[-1]))
+    return StepResult(step, time_s, "thermal", T, nodal_temperature=mesh.nodal(T))
 
 
 _ITEMS = {

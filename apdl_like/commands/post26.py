@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 MAX_VARIABLE = 200
 
 
-def _history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
+def thermal_history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
     """(times, thermal dof vectors) of the stored results of the last thermal analysis."""
     sol = s.solution
     thermal = [r for r in sol.results if r.analysis == "thermal"]
@@ -64,7 +64,7 @@ def nsol(s: SessionState, c: Call) -> None:
     i = s.node_index(c.int(2, what="NODE"))
     if c.label(3, "TEMP") != "TEMP":
         raise ApdlError(f"field 3: NSOL supports TEMP, got {c.label(3)!r}")
-    times, temps = _history(s)
+    times, temps = thermal_history(s)
     model, _ = _plane(s)
     dof = model.mesh.node_dof[i]
     if dof < 0:
@@ -87,7 +87,7 @@ def esol(s: SessionState, c: Call) -> None:
         raise ApdlError(f"field 4: ESOL supports HEAT, got {c.label(4) or '(empty)'!r}")
     model, inputs = _plane(s)
     dof = model.mesh.node_dof[s.node_index(node)]
-    times, temps = _history(s)
+    times, temps = thermal_history(s)
     values = np.array([model.element_heat(inputs, T, e)[dof] for T in temps])
     s.variables[nvar] = (c.label(6, "HEAT"), times, values)
 

@@ -177,6 +177,7 @@ def solve(s: SessionState, c: Call) -> None:
     result.load_step = 1 + sum(r.analysis == kind for r in sol.results)
     sol.results.append(result)
     sol.post_index = -1
+    sol.post_result = None
     s.say(f"load step {result.load_step}: {result.analysis} solution at time {result.time:g}")
 
 
