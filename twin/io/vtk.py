@@ -58,11 +58,16 @@ def section_mesh(points_m: np.ndarray, triangles: np.ndarray,
 
 
 def write_vtu(path: str | os.PathLike[str], mesh: Any) -> Path:
-    """meshio.Mesh → .vtu (binary, zlib-compressed), atomically."""
+    """meshio.Mesh → .vtu (binary, uncompressed), atomically.
+
+    Uncompressed: zlib took seven eighths of the write (7.7 of 8.7 ms per frame of the
+    default spindle, a tenth of a 3-method replay's run time) for files 2.7 times smaller
+    (150 against 410 kB).
+    """
     import meshio
 
     with atomic_target(path) as tmp:
-        meshio.write(tmp, mesh, file_format="vtu")
+        meshio.write(tmp, mesh, file_format="vtu", compression=None)
     return Path(path)
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,7 @@ from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.folders import replaced_folder
 from twin.loop.metrics import accuracy_metrics
+from twin.loop.overlap import ForkedTask
 from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
 
 DONE_FILE = ".done.json"
@@ -96,8 +98,25 @@ def replay_run_to_dir(
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
                  on_window) -> dict:  # noqa: ANN001
-    from twin.correction.methods import make_corrector
+    from twin.io.figures import load_matplotlib
     from twin.loop.report import render_run_plots
+
+    # the report's figures are drawn by a forked child on the second core, overlapping the
+    # solve (it imports matplotlib meanwhile) and the field files (it draws meanwhile)
+    with ForkedTask(partial(render_run_plots, out_dir), prepare=load_matplotlib) as plots:
+        accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
+                                          spindle, on_window, plots)
+        plots.join()
+    write_json(out_dir / "accuracy.json", accuracy)
+    write_json(out_dir / DONE_FILE, token)
+    return accuracy
+
+
+def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
+                    on_window, plots: ForkedTask) -> tuple[dict, dict]:  # noqa: ANN001
+    """Replay and write every file but accuracy.json and the .done token; `plots` is
+    started once keypoints.csv and corrections.csv (what the figures show) are written."""
+    from twin.correction.methods import make_corrector
     from twin.runs import read_run, write_quality
     from twin.spindle.model import SpindleModel
 
@@ -138,6 +157,7 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
 
     _write_keypoints(out_dir / "keypoints.csv", results, meas_T, meas_drift)
     _write_corrections(out_dir / "corrections.csv", results)
+    plots.start()
     write_quality(run, out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
@@ -159,10 +179,7 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
                 title=f"{run.name} · {primary} · t = {t:.0f} s",
                 T_initial_C=r.T_initial_C,
             )
-    render_run_plots(out_dir)
-    write_json(out_dir / "accuracy.json", accuracy)
-    write_json(out_dir / DONE_FILE, token)
-    return accuracy
+    return accuracy, token
 
 
 def measured_reference(

@@ -1,0 +1,147 @@
+"""A task run in a forked child process, overlapping the parent's own work (a second core).
+
+    with ForkedTask(task, prepare) as side:   # forks now; the child runs prepare()
+        ...                                   # the parent works meanwhile
+        side.start()                          # task's inputs are ready: the child runs task()
+        ...                                   # the parent goes on with other work
+        side.join()                           # waits; raises if prepare or task failed
+
+The child is forked early so that it can `prepare` (import matplotlib, say) while the
+parent works, and it holds a copy of the parent's memory, so the task needs no pickling:
+it is any callable, and it reads what it needs from that copy or from files the parent
+wrote before `start`.  Its failure comes back as a `ForkedTaskError` from `join` (the
+message of the child's exception; the child writes nothing to stdout or stderr).  Leaving
+the `with` block without `start` (the parent failed) kills the child, which has written
+nothing by then; a started child is always waited for.
+
+Where fork is unavailable (Windows) or unsafe (other threads are running: a lock one of
+them holds at the fork would stay locked in the child for ever), nothing is forked:
+`start` runs prepare and task in the parent, as plain sequential code would, and `join`
+has nothing left to do.  Either way the task runs exactly once and its outputs are the same.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+from collections.abc import Callable
+from types import TracebackType
+
+_GO = b"g"
+_MAX_MESSAGE = 4000
+
+
+class ForkedTaskError(RuntimeError):
+    """The forked task (or its preparation) raised; the message is the child's."""
+
+
+def fork_is_safe() -> bool:
+    """True where `os.fork` exists and this process runs no other thread."""
+    return hasattr(os, "fork") and threading.active_count() == 1
+
+
+class ForkedTask:
+    """`task()` in a forked child once `start` is called; see the module doc."""
+
+    def __init__(self, task: Callable[[], object],
+                 prepare: Callable[[], object] | None = None, fork: bool = True) -> None:
+        self._task, self._prepare = task, prepare
+        self._pid: int | None = None
+        self._go = self._result = -1
+        self._started = self._joined = False
+        if fork and fork_is_safe():
+            self._fork()
+
+    @property
+    def forked(self) -> bool:
+        return self._pid is not None
+
+    def _fork(self) -> None:
+        go_r, go_w = os.pipe()
+        result_r, result_w = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: never returns into the parent's frames
+            os.close(go_w)
+            os.close(result_r)
+            _child(self._prepare, self._task, go_r, result_w)
+        os.close(go_r)
+        os.close(result_w)
+        self._pid, self._go, self._result = pid, go_w, result_r
+
+    def start(self) -> None:
+        """The task's inputs are ready: run it (in the child, or here without a child)."""
+        if self._started:
+            raise RuntimeError("the task was started already")
+        self._started = True
+        if self._pid is None:
+            if self._prepare is not None:
+                self._prepare()
+            self._task()
+            return
+        os.write(self._go, _GO)
+        os.close(self._go)
+        self._go = -1
+
+    def join(self) -> None:
+        """Wait for the child; raise `ForkedTaskError` if its preparation or task failed."""
+        if self._joined:
+            return
+        self._joined = True
+        if self._pid is None:
+            return
+        if not self._started:  # not wanted: the child is preparing or waiting, writing nothing
+            os.kill(self._pid, signal.SIGKILL)
+            os.close(self._go)
+            self._go = -1
+        chunks = []
+        while chunk := os.read(self._result, 1 << 16):
+            chunks.append(chunk)
+        os.close(self._result)
+        _, status = os.waitpid(self._pid, 0)
+        code = os.waitstatus_to_exitcode(status)
+        if self._started and code != 0:
+            message = b"".join(chunks).decode(errors="replace")
+            raise ForkedTaskError(message or f"the forked task ended with exit code {code}")
+
+    def __enter__(self) -> ForkedTask:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        if exc_type is None:
+            self.join()
+            return
+        try:  # the parent failed: end the child, report the parent's error
+            self.join()
+        except ForkedTaskError:
+            pass
+
+
+def _child(prepare: Callable[[], object] | None, task: Callable[[], object],
+           go: int, result: int) -> None:
+    """The forked child's whole life; ends the process with os._exit (no cleanup of the
+    parent's state: its buffers, atexit handlers and `finally` blocks are the parent's)."""
+    code = 1
+    try:
+        failure = None
+        if prepare is not None:
+            try:
+                prepare()
+            except BaseException as exc:  # noqa: BLE001 - reported if the task is wanted
+                failure = exc
+        if os.read(go, 1) != _GO:  # the parent ended without start: not wanted
+            code = 0
+            return
+        if failure is not None:
+            raise failure
+        task()
+        code = 0
+    except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
+        message = f"{type(exc).__name__}: {exc}".encode(errors="replace")[:_MAX_MESSAGE]
+        try:
+            os.write(result, message)
+        except OSError:
+            pass
+    finally:
+        os._exit(code)
