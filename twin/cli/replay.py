@@ -58,6 +58,8 @@ def replay(
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    # redrawn when a run finishes, not by rich's refresh thread: a process running no other
+    # thread may fork (twin.loop.overlap draws the figures in a forked child)
     with Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -65,11 +67,12 @@ def replay(
         TimeElapsedColumn(),
         console=console,
         disable=quiet,
+        auto_refresh=False,
     ) as progress:
         tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="") for p in paths}
 
         def tell(name: str, status: str) -> None:
-            progress.update(tasks[name], completed=1, status=status[:80])
+            progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
 
         result = replay_batch(
             paths,
