@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from twin.loop.overlap import ForkedTask, ForkedTaskError, fork_is_safe
@@ -21,13 +22,17 @@ def _write_pid(path: Path) -> None:
 def test_task_runs_in_a_child_after_start_and_sees_files_written_before(tmp_path):
     prepared = tmp_path / "prepared"
     source, done = tmp_path / "source.txt", tmp_path / "done.txt"
-    with ForkedTask(lambda: done.write_text(source.read_text().upper()),
-                    prepare=lambda: _write_pid(prepared)) as side:
+    def task() -> str:
+        done.write_text(source.read_text().upper())
+        return f"pid {os.getpid()}: ünïcode"
+
+    with ForkedTask(task, prepare=lambda: _write_pid(prepared)) as side:
         assert side.forked
         source.write_text("written after the fork")  # the task reads it only after start
         side.start()
-        side.join()
+        reply = side.join()
     assert done.read_text() == "WRITTEN AFTER THE FORK"
+    assert reply == f"pid {prepared.read_text()}: ünïcode"
     assert int(prepared.read_text()) != os.getpid()
 
 
@@ -49,9 +54,18 @@ def test_a_failing_preparation_fails_the_task(tmp_path):
 
     done = tmp_path / "done"
     with pytest.raises(ForkedTaskError, match="ImportError: matplotlib is missing"):
-        with ForkedTask(lambda: done.write_text("x"), prepare=prepare) as side:
+        with ForkedTask(lambda: done.write_text("x") and None, prepare=prepare) as side:
             side.start()
     assert not done.exists()
+
+
+@needs_fork
+def test_a_task_returning_no_text_is_an_error_forked_or_not():
+    for fork in (True, False):
+        side = ForkedTask(lambda: 42, fork=fork)
+        with pytest.raises((ForkedTaskError, TypeError), match="text or None, not int"):
+            side.start()
+            side.join()
 
 
 @needs_fork
@@ -68,12 +82,87 @@ def test_a_task_never_started_never_runs_and_the_parents_error_passes(tmp_path):
 
 def test_without_fork_start_runs_prepare_and_task_here_in_order(tmp_path):
     calls = []
-    side = ForkedTask(lambda: calls.append(("task", os.getpid())),
+    side = ForkedTask(lambda: calls.append(("task", os.getpid())) or "done",
                       prepare=lambda: calls.append(("prepare", os.getpid())), fork=False)
     assert not side.forked
     assert calls == []
     side.start()
     assert calls == [("prepare", os.getpid()), ("task", os.getpid())]
-    side.join()
+    assert side.join() == "done"
     with pytest.raises(RuntimeError, match="started already"):
         side.start()
+
+
+def test_method_replay_survives_its_json_exactly():
+    from twin.correction.features import BoundaryValues
+    from twin.correction.result import Correction
+    from twin.loop.replay import (
+        MethodReplay,
+        WindowRecord,
+        method_replay_from_json,
+        method_replay_to_json,
+    )
+
+    rng = np.random.default_rng(3)
+    T = rng.normal(30.0, 5.0, (30, 5))
+    T[4, 2] = np.nan  # an invalid sensor sample stays NaN
+    band = rng.random((30, 6)) / 3.0
+    correction = Correction(1.1e6 / 3, 2.2e6, 1.2e-4, 1e-4 / 7, C_H=(1.01, 0.99),
+                            C_C=(1.0, 1.0 / 3), factors={"motor": 1.07, "film_coolant": 0.93},
+                            state_C=rng.normal(25.0, 1.0, 40), band_sd=band[:15])
+    r = MethodReplay(
+        method="estimator", time_s=4.0 * np.arange(1, 31), T_twin_C=T,
+        drift_z_um=rng.normal(size=30), drift_r_um=rng.normal(size=30),
+        windows=[WindowRecord(0, 0.0, 9000.0, 25.3, correction,
+                              BoundaryValues(1e6, 2e6, 1e-4, 1e-4), "/SOLU\nSOLVE\n")],
+        fields={60.0: rng.normal(size=40)}, T_initial_C=24.9, wall_s=0.123, band_sd=band)
+    back = method_replay_from_json(method_replay_to_json(r))
+    for name in ("time_s", "T_twin_C", "drift_z_um", "drift_r_um", "band_sd"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(r, name))
+    assert (back.method, back.T_initial_C, back.wall_s) == (r.method, r.T_initial_C, r.wall_s)
+    assert list(back.fields) == [60.0]
+    np.testing.assert_array_equal(back.fields[60.0], r.fields[60.0])
+    w, c = back.windows[0], back.windows[0].correction
+    assert (w.window, w.start_s, w.speed_rpm, w.ambient_C, w.deck) == (0, 0.0, 9000.0, 25.3,
+                                                                         "/SOLU\nSOLVE\n")
+    assert w.nominal == r.windows[0].nominal and c == correction  # values, C_H, C_C, factors
+    np.testing.assert_array_equal(c.state_C, correction.state_C)
+    np.testing.assert_array_equal(c.band_sd, correction.band_sd)
+
+
+_SAME_WITH_AND_WITHOUT_FORK = """
+import sys
+from twin.loop.overlap import fork_is_safe
+from twin.loop.runfiles import replay_run_to_dir
+from twin.spindle.model import SpindleModel
+
+assert fork_is_safe()
+run, out, methods = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
+model = SpindleModel.load()
+for overlap in (True, False):
+    replay_run_to_dir(run, f"{out}/{overlap}", methods, "examples/correction_model.safetensors",
+                      snapshots="none", spindle=model, overlap=overlap)
+"""
+
+
+def test_replay_with_forked_helpers_writes_the_same_files_as_without(tmp_path):
+    """The estimator (state, band and factors) and ratio replayed by a forked child and the
+    figures drawn by another give byte-identical files."""
+    import subprocess
+    import sys
+
+    from tests.test_replay import make_recorded_run
+    from twin.spindle.model import SpindleModel
+
+    run = make_recorded_run(tmp_path / "hot.csv", SpindleModel.load(), minutes=4)
+    root = Path(__file__).resolve().parent.parent
+    subprocess.run([sys.executable, "-c", _SAME_WITH_AND_WITHOUT_FORK, str(run), str(tmp_path),
+                    "estimator,ratio,open_loop,bpnn"], check=True, cwd=root,
+                   env={**os.environ, "PYTHONPATH": str(root)})
+    forked, plain = tmp_path / "True" / "hot", tmp_path / "False" / "hot"
+    names = sorted(p.relative_to(plain) for p in plain.rglob("*") if p.is_file())
+    assert names == sorted(p.relative_to(forked) for p in forked.rglob("*") if p.is_file())
+    assert {"keypoints.csv", "corrections.csv", "accuracy.json"} <= {str(n) for n in names}
+    assert any(n.suffix == ".png" for n in names) and any(n.suffix == ".vtu" for n in names)
+    for name in names:
+        assert (forked / name).read_bytes() == (plain / name).read_bytes(), name

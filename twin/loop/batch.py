@@ -42,13 +42,14 @@ class BatchResult:
         return 2 if self.failed else 0
 
 
-def run_job(job: ReplayJob, spindle=None) -> dict:  # noqa: ANN001
+def run_job(job: ReplayJob, spindle=None, overlap: bool = False) -> dict:  # noqa: ANN001
     """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
-    spindle for this run); never raises: returns {"ok": accuracy} or {"error": ...}."""
+    spindle for this run), with forked helpers on the spare core if `overlap`; never
+    raises: returns {"ok": accuracy} or {"error": ...}."""
     try:
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
-            spindle=spindle,
+            spindle=spindle, overlap=overlap,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -147,13 +148,14 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
                 yield outcome
         return
     # a worker process or a dask task builds its own spindle per run (about 0.5 s of a
-    # run's replay); in this process one model serves every run
+    # run's replay); in this process one model serves every run, and the run's forked
+    # helpers use the other core (workers fill the cores themselves: none there)
     if jobs <= 1 or len(todo) <= 1:
         from twin.spindle.model import SpindleModel
 
         spindle = SpindleModel.load() if todo else None
         for job in todo:
-            outcome = run_job(job, spindle)
+            outcome = run_job(job, spindle, overlap=True)
             _tell(progress, outcome)
             yield outcome
         return

@@ -4,31 +4,37 @@
         ...                                   # the parent works meanwhile
         side.start()                          # task's inputs are ready: the child runs task()
         ...                                   # the parent goes on with other work
-        side.join()                           # waits; raises if prepare or task failed
+        text = side.join()                    # waits; task's result, or raises if it failed
 
 The child is forked early so that it can `prepare` (import matplotlib, say) while the
 parent works, and it holds a copy of the parent's memory, so the task needs no pickling:
 it is any callable, and it reads what it needs from that copy or from files the parent
-wrote before `start`.  Its failure comes back as a `ForkedTaskError` from `join` (the
-message of the child's exception; the child writes nothing to stdout or stderr).  Leaving
+wrote before `start`.  What it returns (text or None) comes back from `join`, as text
+through a pipe (UTF-8: again no pickling).  Its failure comes back as a `ForkedTaskError`
+from `join` (the message of the child's exception; the child writes nothing to stdout or
+stderr).  Leaving
 the `with` block without `start` (the parent failed) kills the child, which has written
 nothing by then; a started child is always waited for.
 
 Where fork is unavailable (Windows) or unsafe (other threads are running: a lock one of
 them holds at the fork would stay locked in the child for ever), nothing is forked:
 `start` runs prepare and task in the parent, as plain sequential code would, and `join`
-has nothing left to do.  Either way the task runs exactly once and its outputs are the same.
+returns the task's result.  Either way the task runs exactly once and its outputs are the
+same.
 """
 
 from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
 from types import TracebackType
 
 _GO = b"g"
+_DONE, _FAILED = b"0", b"1"  # the first byte the child sends back: its result or its error
+_NONE, _TEXT = b"N", b"T"  # then: the task returned None, or text (which follows)
 _MAX_MESSAGE = 4000
 
 
@@ -37,16 +43,18 @@ class ForkedTaskError(RuntimeError):
 
 
 def fork_is_safe() -> bool:
-    """True where `os.fork` exists and this process runs no other thread."""
-    return hasattr(os, "fork") and threading.active_count() == 1
+    """True where `os.fork` exists and this process runs no other thread, nor torch (whose
+    thread pools are not Python threads)."""
+    return hasattr(os, "fork") and threading.active_count() == 1 and "torch" not in sys.modules
 
 
 class ForkedTask:
     """`task()` in a forked child once `start` is called; see the module doc."""
 
-    def __init__(self, task: Callable[[], object],
+    def __init__(self, task: Callable[[], str | None],
                  prepare: Callable[[], object] | None = None, fork: bool = True) -> None:
         self._task, self._prepare = task, prepare
+        self._value: str | None = None
         self._pid: int | None = None
         self._go = self._result = -1
         self._started = self._joined = False
@@ -77,19 +85,20 @@ class ForkedTask:
         if self._pid is None:
             if self._prepare is not None:
                 self._prepare()
-            self._task()
+            self._value = _checked(self._task())
             return
         os.write(self._go, _GO)
         os.close(self._go)
         self._go = -1
 
-    def join(self) -> None:
-        """Wait for the child; raise `ForkedTaskError` if its preparation or task failed."""
+    def join(self) -> str | None:
+        """Wait for the child and return the task's result; raise `ForkedTaskError` if its
+        preparation or the task failed."""
         if self._joined:
-            return
+            return self._value
         self._joined = True
         if self._pid is None:
-            return
+            return self._value
         if not self._started:  # not wanted: the child is preparing or waiting, writing nothing
             os.kill(self._pid, signal.SIGKILL)
             os.close(self._go)
@@ -100,9 +109,14 @@ class ForkedTask:
         os.close(self._result)
         _, status = os.waitpid(self._pid, 0)
         code = os.waitstatus_to_exitcode(status)
-        if self._started and code != 0:
-            message = b"".join(chunks).decode(errors="replace")
+        if not self._started:
+            return None
+        reply = b"".join(chunks)
+        if code != 0 or reply[:1] != _DONE:
+            message = reply[1:].decode(errors="replace") if reply[:1] == _FAILED else ""
             raise ForkedTaskError(message or f"the forked task ended with exit code {code}")
+        self._value = None if reply[1:2] == _NONE else reply[2:].decode()
+        return self._value
 
     def __enter__(self) -> ForkedTask:
         return self
@@ -118,7 +132,7 @@ class ForkedTask:
             pass
 
 
-def _child(prepare: Callable[[], object] | None, task: Callable[[], object],
+def _child(prepare: Callable[[], object] | None, task: Callable[[], str | None],
            go: int, result: int) -> None:
     """The forked child's whole life; ends the process with os._exit (no cleanup of the
     parent's state: its buffers, atexit handlers and `finally` blocks are the parent's)."""
@@ -135,13 +149,26 @@ def _child(prepare: Callable[[], object] | None, task: Callable[[], object],
             return
         if failure is not None:
             raise failure
-        task()
+        value = _checked(task())
+        _write_all(result, _DONE + (_NONE if value is None else _TEXT + value.encode()))
         code = 0
     except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
         message = f"{type(exc).__name__}: {exc}".encode(errors="replace")[:_MAX_MESSAGE]
         try:
-            os.write(result, message)
+            _write_all(result, _FAILED + message)
         except OSError:
             pass
     finally:
         os._exit(code)
+
+
+def _checked(value: object) -> str | None:
+    if value is not None and not isinstance(value, str):
+        raise TypeError(f"a forked task returns text or None, not {type(value).__name__}")
+    return value
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]

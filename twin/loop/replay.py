@@ -20,6 +20,7 @@ as measured from the start.
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -276,4 +277,61 @@ def replay_method(
         T_initial_C=T0,
         wall_s=time.perf_counter() - t_wall,
         band_sd=band,
+    )
+
+
+def _array(a: np.ndarray | None) -> dict | None:
+    """An array as JSON: float64 values as their exact repr (JSON's floats round-trip)."""
+    if a is None:
+        return None
+    a = np.asarray(a, dtype=float)
+    return {"shape": list(a.shape), "values": a.ravel().tolist()}
+
+
+def _from_array(d: dict | None) -> np.ndarray | None:
+    return None if d is None else np.array(d["values"], dtype=float).reshape(d["shape"])
+
+
+def method_replay_to_json(r: MethodReplay) -> str:
+    """`r` as JSON text, every value exact (NaN as JSON's NaN token): what a replay done in
+    another process sends back (twin.loop.runfiles), without pickling."""
+    def window(w: WindowRecord) -> dict:
+        c = w.correction
+        return {
+            "window": w.window, "start_s": w.start_s, "speed_rpm": w.speed_rpm,
+            "ambient_C": w.ambient_C, "nominal": list(w.nominal), "deck": w.deck,
+            "correction": {
+                "values": list(c.values), "C_H": list(c.C_H), "C_C": list(c.C_C),
+                "factors": dict(c.factors), "state_C": _array(c.state_C),
+                "band_sd": _array(c.band_sd),
+            },
+        }
+
+    return json.dumps({
+        "method": r.method, "time_s": _array(r.time_s), "T_twin_C": _array(r.T_twin_C),
+        "drift_z_um": _array(r.drift_z_um), "drift_r_um": _array(r.drift_r_um),
+        "windows": [window(w) for w in r.windows],
+        "fields": [[t, _array(T)] for t, T in r.fields.items()],
+        "T_initial_C": r.T_initial_C, "wall_s": r.wall_s, "band_sd": _array(r.band_sd),
+    })
+
+
+def method_replay_from_json(text: str) -> MethodReplay:
+    """The inverse of `method_replay_to_json`."""
+    d = json.loads(text)
+
+    def window(w: dict) -> WindowRecord:
+        c = w["correction"]
+        correction = Correction(
+            *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
+            state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]))
+        return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
+                            correction, BoundaryValues(*w["nominal"]), w["deck"])
+
+    return MethodReplay(
+        method=d["method"], time_s=_from_array(d["time_s"]), T_twin_C=_from_array(d["T_twin_C"]),
+        drift_z_um=_from_array(d["drift_z_um"]), drift_r_um=_from_array(d["drift_r_um"]),
+        windows=[window(w) for w in d["windows"]],
+        fields={t: _from_array(T) for t, T in d["fields"]},
+        T_initial_C=d["T_initial_C"], wall_s=d["wall_s"], band_sd=_from_array(d["band_sd"]),
     )

@@ -20,7 +20,6 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Callable, Sequence
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -30,8 +29,14 @@ from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.folders import replaced_folder
 from twin.loop.metrics import accuracy_metrics
-from twin.loop.overlap import ForkedTask
-from twin.loop.replay import MethodReplay, deck_window_solver, replay_method
+from twin.loop.overlap import ForkedTask, ForkedTaskError
+from twin.loop.replay import (
+    MethodReplay,
+    deck_window_solver,
+    method_replay_from_json,
+    method_replay_to_json,
+    replay_method,
+)
 
 DONE_FILE = ".done.json"
 SNAPSHOT_CHOICES = ("none", "end", "every")
@@ -83,27 +88,34 @@ def replay_run_to_dir(
     snapshots: str = "none",
     spindle=None,  # noqa: ANN001 - a loaded SpindleModel to reuse, or None
     on_window: Callable[[str, int, int], None] | None = None,
+    overlap: bool = True,
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
 
     The folder DIR/<run-name>/ is replaced as a whole (`replaced_folder`): a shorter rerun
     leaves none of the longer run's files, and a failed one leaves no earlier result.
+    overlap: use a second core through forked children (`twin.loop.overlap`) for part of
+    the methods and for the figures; the outputs are the same either way.  A batch whose
+    workers already fill the cores turns it off.
     """
     if snapshots not in SNAPSHOT_CHOICES:
         raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
     with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
         return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
-                            on_window)
+                            on_window, overlap)
 
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                 on_window) -> dict:  # noqa: ANN001
+                 on_window, overlap: bool) -> dict:  # noqa: ANN001
     from twin.io.figures import load_matplotlib
     from twin.loop.report import render_run_plots
 
+    def draw_plots() -> None:
+        render_run_plots(out_dir)
+
     # the report's figures are drawn by a forked child on the second core, overlapping the
     # solve (it imports matplotlib meanwhile) and the field files (it draws meanwhile)
-    with ForkedTask(partial(render_run_plots, out_dir), prepare=load_matplotlib) as plots:
+    with ForkedTask(draw_plots, prepare=load_matplotlib, fork=overlap) as plots:
         accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
                                           spindle, on_window, plots)
         plots.join()
@@ -129,19 +141,8 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     ]
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
-    results: dict[str, MethodReplay] = {}
-    for corrector in correctors:
-        callback = None
-        if on_window is not None:
-            callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
-        results[corrector.name] = replay_method(
-            run,
-            model,
-            corrector,
-            keep_fields=corrector.name == primary,
-            on_window=callback,
-            solver=solver,
-        )
+    results = _replay_methods(run, model, correctors, primary, solver, on_window,
+                              fork=plots.forked)
 
     first = next(iter(results.values()))
     meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
@@ -180,6 +181,41 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
                 T_initial_C=r.T_initial_C,
             )
     return accuracy, token
+
+
+def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
+                    fork: bool) -> dict[str, MethodReplay]:
+    """Every method's replay, by name in the order given.
+
+    With `fork` (and no per-window callback, which could not cross processes) the first
+    half of the methods other than the primary is replayed by a forked child on the second
+    core and sent back as JSON; the parent replays the rest.  Each window's solve depends on
+    its own inputs only (the session's cached factorizations are keyed by the matrix), so
+    the split changes no number.  Should the child fail, the parent replays its methods
+    itself: the error, if it is one, is then raised here with its own type.
+    """
+    def replay(corrector) -> MethodReplay:  # noqa: ANN001
+        callback = None
+        if on_window is not None:
+            callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
+        return replay_method(run, model, corrector, keep_fields=corrector.name == primary,
+                             on_window=callback, solver=solver)
+
+    others = [c for c in correctors if c.name != primary]
+    away = others[: (len(others) + 1) // 2] if fork and on_window is None else []
+    side = ForkedTask(lambda: json.dumps([method_replay_to_json(replay(c)) for c in away]),
+                      fork=bool(away))
+    with side:
+        if away:
+            side.start()
+        results = {c.name: replay(c) for c in correctors if c not in away}
+        try:
+            sent = json.loads(side.join() or "[]")
+        except ForkedTaskError:
+            sent = [method_replay_to_json(replay(c)) for c in away]
+    results.update((c.name, method_replay_from_json(text)) for c, text in zip(away, sent,
+                                                                              strict=True))
+    return {c.name: results[c.name] for c in correctors}
 
 
 def measured_reference(
