@@ -12,9 +12,8 @@ it is any callable, and it reads what it needs from that copy or from files the 
 wrote before `start`.  What it returns (text or None) comes back from `join`, as text
 through a pipe (UTF-8: again no pickling).  Its failure comes back as a `ForkedTaskError`
 from `join` (the message of the child's exception; the child writes nothing to stdout or
-stderr).  Leaving
-the `with` block without `start` (the parent failed) kills the child, which has written
-nothing by then; a started child is always waited for.
+stderr).  Leaving the `with` block without `start` (the parent failed) kills the child,
+which has written nothing by then; a started child is always waited for.
 
 Where fork is unavailable (Windows) or unsafe (other threads are running: a lock one of
 them holds at the fork would stay locked in the child for ever), nothing is forked:
