@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import os
 import signal
-import sys
 import threading
 from collections.abc import Callable
 from types import TracebackType
@@ -42,9 +41,12 @@ class ForkedTaskError(RuntimeError):
 
 
 def fork_is_safe() -> bool:
-    """True where `os.fork` exists and this process runs no other thread, nor torch (whose
-    thread pools are not Python threads)."""
-    return hasattr(os, "fork") and threading.active_count() == 1 and "torch" not in sys.modules
+    """True where `os.fork` exists and this process runs no other Python thread.
+
+    Native thread pools are no obstacle as long as the child does not use them: OpenBLAS
+    (numpy, scipy) quiesces its pool around a fork, and the children here never run torch
+    (used for training only), whose OpenMP pool would not survive one."""
+    return hasattr(os, "fork") and threading.active_count() == 1
 
 
 class ForkedTask:
