@@ -19,13 +19,14 @@ from apdl_like.parser import Statement
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
-ANY = frozenset({"BEGIN", "PREP7", "SOLU", "POST1", "POST26"})
+ANY = frozenset({"BEGIN", "PREP7", "SOLU", "POST1", "POST26", "AUX12"})
 PREP7 = frozenset({"PREP7"})
 SOLU = frozenset({"SOLU"})
 LOADS = frozenset({"PREP7", "SOLU"})
 POST = frozenset({"POST1"})
 POST26 = frozenset({"POST26"})
-MODEL = frozenset({"PREP7", "SOLU", "POST1", "POST26"})
+MODEL = frozenset({"PREP7", "SOLU", "POST1", "POST26", "AUX12"})
+AUX12 = frozenset({"AUX12"})
 MAX_ENTITY_NUMBER = 2**31 - 1  # MAPDL numbers entities with 32-bit signed integers
 
 Handler = Callable[["SessionState", "Call"], None]

@@ -286,7 +286,7 @@ def _dispatch(session: SessionState, st: Statement) -> None:
         return
     if session.processor not in spec.processors:
         where = {"BEGIN": "the begin level", "PREP7": "/PREP7", "SOLU": "/SOLU",
-                 "POST1": "/POST1", "POST26": "/POST26"}
+                 "POST1": "/POST1", "POST26": "/POST26", "AUX12": "/AUX12"}
         allowed = " or ".join(where[p] for p in sorted(spec.processors))
         raise st.error(f"not valid in {where[session.processor]} (use it in {allowed})")
     given = len(st.fields)

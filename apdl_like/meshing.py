@@ -128,7 +128,22 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
                 (i, j, kk, kk, m_ij, m_jk, kk, m_ki)
         el.add(first + k, db.active_type, db.active_mat, db.active_real, conn)
     el.flush()
+    centroids = xy_used[tri].mean(axis=1)
+    for num, poly in zip(area_numbers, polygons, strict=True):
+        inside = _inside(poly, centroids)
+        db.area_elements[num] = first + np.nonzero(inside)[0]
     s.say(f"AMESH: {len(tri)} elements, {fresh} new nodes (size {size:g})")
+
+
+def _inside(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Which points lie inside the polygon (even-odd rule on a ray along +x)."""
+    x, y = points[:, 0:1], points[:, 1:2]
+    x0, y0 = polygon[:, 0], polygon[:, 1]
+    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
+    spans = (y0 > y) != (y1 > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
+    return (spans & (x < cross)).sum(axis=1) % 2 == 1
 
 
 def side_fractions(n: int, space: float) -> np.ndarray:
@@ -244,4 +259,5 @@ def mesh_mapped(s: SessionState, area: int, grid: np.ndarray) -> int:
             el.add(first + count, db.active_type, db.active_mat, db.active_real, conn)
             count += 1
     el.flush()
+    db.area_elements[area] = np.arange(first, first + count)
     return count

@@ -311,6 +311,9 @@ class FaceLoads:
     conv_record: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     hflux: np.ndarray = field(default_factory=lambda: np.zeros(0))
     hflux_record: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    # RDSF: a radiating surface, its emissivity and enclosure number (NaN: none)
+    rdsf_emis: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    rdsf_encl: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     FILLS = {
         "conv_h": np.nan,
@@ -318,6 +321,8 @@ class FaceLoads:
         "conv_record": -1,
         "hflux": np.nan,
         "hflux_record": -1,
+        "rdsf_emis": np.nan,
+        "rdsf_encl": np.nan,
     }
 
     def rekey(self, new_keys: np.ndarray) -> None:
@@ -409,9 +414,11 @@ class Database:
     # keypoints and lines left out by KSEL/LSEL (MAPDL selects a new one): the rest are selected
     unselected_keypoints: set[int] = field(default_factory=set)
     unselected_lines: set[int] = field(default_factory=set)
+    unselected_areas: set[int] = field(default_factory=set)
     esize_divisions: int | None = None  # ESIZE,,NDIV: divisions of lines without LESIZE
     mesh_triangles: bool = False  # MSHAPE,1
     meshed_areas: set[int] = field(default_factory=set)
+    area_elements: dict[int, np.ndarray] = field(default_factory=dict)  # AMESH: area -> elements
     esize: float | None = None
     title: str = ""
     mp_temperatures: list[float] = field(default_factory=list)  # MPTEMP, for MPDATA

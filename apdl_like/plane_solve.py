@@ -43,6 +43,7 @@ class FaceTable:
 
     face_nodes: np.ndarray  # (2, n_faces) node indices
     face_keys: np.ndarray  # (n_faces,) pair_keys of the corner node numbers
+    owner: np.ndarray  # (n_faces,) the element (index in the element table) it bounds
 
     def face_index(self, keys: np.ndarray) -> np.ndarray:
         """Positions of node-pair keys among the exterior faces; -1 where not one."""
@@ -91,17 +92,18 @@ def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None, np
 def exterior_faces(db: Database) -> FaceTable:
     """The element edges used by exactly one element."""
     corners, _, solid = corners_and_midside(db)
+    owner = np.repeat(np.nonzero(solid)[0], 4)
     corners = corners[solid]
     a = corners.ravel()
     b = np.roll(corners, -1, axis=1).ravel()
     keep = a != b
-    a, b = a[keep], b[keep]
+    a, b, owner = a[keep], b[keep], owner[keep]
     ids = db.nodes.ids
     keys = pair_keys(ids[a], ids[b])
     unique, first, counts = np.unique(keys, return_index=True, return_counts=True)
     once = first[counts == 1]
     once.sort()
-    return FaceTable(np.vstack([a[once], b[once]]), keys[once])
+    return FaceTable(np.vstack([a[once], b[once]]), keys[once], owner[once])
 
 
 def plane_mesh(s: SessionState) -> PlaneMesh:

@@ -12,6 +12,7 @@ from types import MappingProxyType
 
 from apdl_like.call import CommandSpec
 from apdl_like.commands import (
+    aux12,
     begin,
     blocks,
     generate,
@@ -25,7 +26,7 @@ from apdl_like.commands import (
     tables,
 )
 
-FAMILIES = (begin, blocks, generate, loads, post1, post26, prep7, selection, solid,
+FAMILIES = (aux12, begin, blocks, generate, loads, post1, post26, prep7, selection, solid,
             solution, tables)
 
 

@@ -244,6 +244,9 @@ def face_table(session: SessionState):  # noqa: ANN201 - FemModel | plane_solve.
 
 def solve_thermal(session: SessionState) -> StepResult:
     """A thermal load step: on twin.fem for a twin session, else on the deck's own mesh."""
+    if np.any(~np.isnan(session.db.faces.rdsf_emis)):
+        raise ApdlError("radiation between RDSF surfaces is not solved (apdl_like computes "
+                        "their view factors only: /AUX12, VFQUERY)")
     if not session.fem.external_mesh:
         return solve_plane_thermal(session)
     fem = fem_model(session)

@@ -144,6 +144,16 @@ class Listing:
 
 
 @dataclass
+class Radiation:
+    """/AUX12: the view-factor geometry (V2DOPT; None: the elements' own), the factors of
+    the RDSF faces (key, (F, areas, owners)) and the last VFQUERY average."""
+
+    axisymmetric: bool | None = None
+    factors: tuple | None = None
+    average: float | None = None
+
+
+@dataclass
 class SessionState:
     """Everything a deck reads and writes (see the module docstring for the owners)."""
 
@@ -160,6 +170,7 @@ class SessionState:
     # /POST26 variables: number -> (name, times s, values); FSUM's last total heat, W
     variables: dict[int, tuple[str, np.ndarray, np.ndarray]] = field(default_factory=dict)
     fsum_heat: float | None = None
+    radiation: Radiation = field(default_factory=Radiation)
     load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving
     recorded_solves: list[dict] = field(default_factory=list)

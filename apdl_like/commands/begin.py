@@ -47,7 +47,7 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
                    "ALIST", "DLIST", "SFLIST", "SFELIST", "BFLIST", "BFELIST", "CPLIST",
                    "MPLIST", "ETLIST", "RLIST", "CMLIST", "PRETAB", "PRESOL", "PRRSOL",
                    "PRERR", "ANTIME", "ANIM", "SMRTSIZE", "/PMACRO", "/MSTART", "PATH",
-                   "PPATH", "PDEF", "PRPATH")
+                   "PPATH", "PDEF", "PRPATH", "/CLABEL", "CMPL", "PRTIME")
 
 
 _STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
@@ -71,6 +71,13 @@ def star_get(s: SessionState, c: Call) -> None:
         if item not in ("ITEM", "") or sub not in ("HEAT", ""):
             raise ApdlError("FSUM supports *GET,Par,FSUM,,ITEM,HEAT")
         s.params[name] = s.fsum_heat
+        return
+    if entity == "RAD":
+        if item != "VFAVG":
+            raise ApdlError(f"field 4: RAD supports VFAVG, got {item or '(empty)'!r}")
+        if s.radiation.average is None:
+            raise ApdlError("VFQUERY has not been run")
+        s.params[name] = s.radiation.average
         return
     if entity not in ("NODE", "ELEM"):
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
@@ -114,7 +121,7 @@ COMMANDS = (
     *specs_of(com, title, star_get),
     *(CommandSpec(name, ANY, 0, _enter(processor)) for name, processor in (
         ("/PREP7", "PREP7"), ("/SOLU", "SOLU"), ("/POST1", "POST1"), ("/POST26", "POST26"),
-        ("FINISH", "BEGIN"))),
+        ("/AUX12", "AUX12"), ("FINISH", "BEGIN"))),
     CommandSpec("/STITLE", ANY, 1, ignored),
     *(CommandSpec(name, ANY, 10, ignored) for name in OUTPUT_CONTROLS),
 )

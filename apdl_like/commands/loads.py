@@ -197,6 +197,11 @@ def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | Non
         if v2 is not None:
             f.conv_bulk[faces] = v2
         f.conv_record[faces] = rec
+    elif lab == "RDSF":
+        if v1 is None or not 0.0 < v1 <= 1.0:
+            raise ApdlError(f"RDSF emissivity must lie in (0, 1], got {v1!r}")
+        f.rdsf_emis[faces] = v1
+        f.rdsf_encl[faces] = 1.0 if v2 is None else v2
     else:
         f.hflux[faces] = v1
         f.hflux_record[faces] = rec
@@ -212,15 +217,18 @@ def _load_faces_on(s: SessionState, c: Call, nodes: np.ndarray, bulk_field: int,
     """SF/SFL: Lab in field 2 (CONV: h in field 3, the bulk temperature in `bulk_field`;
     HFLUX: the flux in field 3) on the exterior faces with all their nodes in `nodes`."""
     lab = c.label(2)
-    if lab not in ("CONV", "HFLUX"):
-        raise ApdlError(f"field 2: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
+    if lab not in ("CONV", "HFLUX", "RDSF"):
+        raise ApdlError(f"field 2: surface load must be CONV, HFLUX or RDSF, got "
+                        f"{lab or '(empty)'!r}")
     v1 = c.num(3, what="VALUE")
-    v2 = c.num(bulk_field, what="bulk temperature") if lab == "CONV" else None
+    v2 = c.num(bulk_field, what="bulk temperature") if lab == "CONV" else \
+        c.num(bulk_field, 1.0, what="enclosure number") if lab == "RDSF" else None
     faces = _faces_on_nodes(s, nodes)
     if faces.size == 0:
         raise ApdlError(f"no exterior element face has all its nodes on {where}")
     _set_face_load(s, faces, lab, v1, v2)
-    s.note_load(c)
+    if lab != "RDSF":  # radiation surfaces also serve /AUX12 view factors without a SOLVE
+        s.note_load(c)
 
 
 @command("SFL", LOADS, 7)
@@ -236,14 +244,16 @@ def sfl(s: SessionState, c: Call) -> None:
 @command("SFDELE", LOADS, 2)
 def sfdele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
-    if lab not in ("CONV", "HFLUX", "ALL"):
-        raise ApdlError(f"field 2 must be CONV, HFLUX or ALL, got {lab!r}")
+    if lab not in ("CONV", "HFLUX", "RDSF", "ALL"):
+        raise ApdlError(f"field 2 must be CONV, HFLUX, RDSF or ALL, got {lab!r}")
     faces = _faces_on_nodes(s, node_targets(s, c, 1))
     f = s.db.faces
     if lab in ("CONV", "ALL"):
         f.conv_h[faces], f.conv_bulk[faces], f.conv_record[faces] = np.nan, np.nan, -1
     if lab in ("HFLUX", "ALL"):
         f.hflux[faces], f.hflux_record[faces] = np.nan, -1
+    if lab in ("RDSF", "ALL"):
+        f.rdsf_emis[faces], f.rdsf_encl[faces] = np.nan, np.nan
 
 
 def _element_faces(s: SessionState, elems: np.ndarray, lkey: int) -> np.ndarray:

@@ -146,6 +146,7 @@ def allsel(s: SessionState, c: Call) -> None:
     s.db.elements.selected = np.ones(len(s.db.elements), bool)
     s.db.unselected_keypoints.clear()
     s.db.unselected_lines.clear()
+    s.db.unselected_areas.clear()
 
 
 def _select_numbered(s: SessionState, c: Call, numbers: list[int], xy: np.ndarray,
@@ -187,6 +188,28 @@ def lsel(s: SessionState, c: Call) -> None:
     mids = np.array([0.5 * (np.array(kps[lines[n].k1]) + np.array(kps[lines[n].k2]))
                      for n in numbers], float)
     _select_numbered(s, c, numbers, mids, s.db.unselected_lines, "LINE")
+
+
+@command("ASEL", _ANY_OR_BEGIN, 7)
+def asel(s: SessionState, c: Call) -> None:
+    kps, areas = s.db.keypoints, s.db.areas
+    numbers = sorted(areas)
+    centroids = np.array([np.mean([kps[k] for k in areas[n]], axis=0) for n in numbers],
+                         float)
+    _select_numbered(s, c, numbers, centroids, s.db.unselected_areas, "AREA")
+
+
+@command("ESLA", _ANY_OR_BEGIN, 1)
+def esla(s: SessionState, c: Call) -> None:
+    """ESLA,Type: the elements AMESH made in the selected areas."""
+    mode = _mode(c)
+    if mode not in ("S", "R", "A", "U"):
+        raise ApdlError(f"field 1: ESLA takes S, R, A or U, got {mode!r}")
+    chosen = [n for n in sorted(s.db.area_elements) if n not in s.db.unselected_areas]
+    numbers = np.concatenate([s.db.area_elements[n] for n in chosen]) if chosen else \
+        np.zeros(0, np.int64)
+    el = s.db.elements
+    el.selected = combine(mode, el.selected, np.isin(el.ids, numbers))
 
 
 _COMPONENT_NAME = re.compile(r"[A-Z][A-Z0-9_]{0,31}\Z")
@@ -249,5 +272,5 @@ def cmsel(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(nsel, esel, nsle, esln, allsel, ksel, lsel, cm, cmdele, cmsel),
+    *specs_of(nsel, esel, nsle, esln, allsel, ksel, lsel, asel, esla, cm, cmdele, cmsel),
 )

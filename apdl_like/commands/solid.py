@@ -108,6 +108,17 @@ def area(s: SessionState, c: Call) -> None:
     for p in pts:
         if p not in s.db.keypoints:
             raise ApdlError(f"keypoint {p} does not exist")
+    add_area(s, pts)
+
+
+def add_area(s: SessionState, pts: list[int]) -> None:
+    """A new area through keypoints; like MAPDL, the lines between consecutive keypoints
+    that do not exist yet are created first, numbered in order around the area (SFL, LESIZE
+    and LSEL then find them by number)."""
+    lines = s.db.lines
+    for p1, p2 in zip(pts, pts[1:] + pts[:1], strict=True):
+        if not any({ln.k1, ln.k2} == {p1, p2} for ln in lines.values()):
+            lines[max(lines, default=0) + 1] = Line(p1, p2)
     s.db.areas[max(s.db.areas, default=0) + 1] = pts
 
 
@@ -137,8 +148,22 @@ def area_lines(s: SessionState, c: Call) -> None:
 
 @command("RECTNG", PREP7, 4)
 def rectng(s: SessionState, c: Call) -> None:
-    x1, x2 = c.num(1, what="X1"), c.num(2, what="X2")
-    y1, y2 = c.num(3, what="Y1"), c.num(4, what="Y2")
+    """RECTNG,X1,X2,Y1,Y2: a rectangular area (4 keypoints, 4 lines, 1 area)."""
+    _rectangle(s, c.num(1, what="X1"), c.num(2, what="X2"), c.num(3, what="Y1"),
+               c.num(4, what="Y2"))
+
+
+@command("BLC4", PREP7, 5)
+def blc4(s: SessionState, c: Call) -> None:
+    """BLC4,XCORNER,YCORNER,WIDTH,HEIGHT: a rectangle by a corner and its sides (a 2-D
+    model: DEPTH must be blank or 0)."""
+    if c.given(5) and c.num(5) != 0.0:
+        raise ApdlError("field 5 (DEPTH) makes a block volume: only 2-D areas are supported")
+    x, y = c.num(1, 0.0, what="XCORNER"), c.num(2, 0.0, what="YCORNER")
+    _rectangle(s, x, x + c.num(3, what="WIDTH"), y, y + c.num(4, what="HEIGHT"))
+
+
+def _rectangle(s: SessionState, x1: float, x2: float, y1: float, y2: float) -> None:
     if x1 == x2 or y1 == y2:
         raise ApdlError("the rectangle has zero width or height")
     kps = s.db.keypoints
@@ -146,7 +171,7 @@ def rectng(s: SessionState, c: Call) -> None:
     corners = [(x1, y1), (x2, y1), (x2, y2), (x1, y2)]
     for i, xy in enumerate(corners):
         kps[first + i] = xy
-    s.db.areas[max(s.db.areas, default=0) + 1] = list(range(first, first + 4))
+    add_area(s, list(range(first, first + 4)))
 
 
 @command("ESIZE", PREP7, 2)
@@ -211,6 +236,6 @@ def amesh(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, esize, mshape, amesh),
+    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, blc4, esize, mshape, amesh),
     CommandSpec("MSHKEY", PREP7, 1, ignored),  # mapped wherever the area allows
 )
