@@ -15,16 +15,17 @@ reports them).  Conductivity may be orthotropic (KXX, KYY in the global axes) an
 and c, depend on temperature (MP with C1..C4, or MPTEMP/MPDATA tables).
 
 Nonlinear problems (k, ρc depending on T) are solved by Picard iteration: the operators are
-assembled at the last iterate until the largest temperature change is at most
-`PICARD_TOLERANCE` × (1 + the largest |T|); at most `PICARD_ITERATIONS` iterations.
+assembled at the last iterate until it converges (`twin.fem.stepper.picard`).
 
-Transient load steps use the θ-method (TINTP; θ = 1 backward Euler by default).  With
-AUTOTS the step size follows a step-doubling estimate of the local error (at most
-`STEP_TOLERANCE` × the temperature scale of the problem), between DTMIN and DTMAX.
+Transient load steps use twin.fem's θ-method (`twin.fem.stepper.theta_step`, `march_to`;
+TINTP sets θ, 1 backward Euler by default).  With AUTOTS the step size follows a
+step-doubling estimate of the local error (at most `STEP_TOLERANCE` × the temperature scale
+of the problem), between DTMIN and DTMAX.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -45,11 +46,16 @@ from skfem import (
 )
 
 from apdl_like.errors import ApdlError
+from twin.fem.stepper import (
+    StepControl,
+    SteppingError,
+    ThetaSystem,
+    march_to,
+    picard,
+    theta_step,
+)
 
-PICARD_TOLERANCE = 1e-8
-PICARD_ITERATIONS = 200
 STEP_TOLERANCE = 1e-5
-MAX_SUBSTEPS = 200_000
 PAIR_BASE = np.int64(1) << 31
 
 # k(T) [W/mK] etc. from temperature at quadrature points
@@ -281,7 +287,7 @@ class PlaneThermal:
         return C.tocsr()
 
     def operators(self, inputs: ThermalInputs, T: np.ndarray,
-                  nonlinear: bool = True) -> tuple[sp.csr_matrix, sp.csr_matrix, np.ndarray]:
+                  nonlinear: bool = True) -> ThetaSystem:
         """(K conduction + films, C capacity, f loads) at temperature T.
 
         Without temperature dependence they are assembled once per `inputs` object."""
@@ -321,7 +327,7 @@ class PlaneThermal:
                     f = f + S @ load.assemble(fb, g=flux, axisymmetric=ax)
         if self.mesh.lumped:
             C = sp.diags(np.asarray(C.sum(axis=1)).ravel()).tocsr()
-        out = (K.tocsr(), C.tocsr(), f)
+        out = ThetaSystem(K.tocsr(), C.tocsr(), f)
         if not nonlinear:
             self._linear_cache = (inputs, out)
         return out
@@ -347,37 +353,35 @@ class PlaneThermal:
     # ---------------------------------------------------------------- solves
     def steady(self, inputs: ThermalInputs, T0: np.ndarray, nonlinear: bool) -> np.ndarray:
         """K(T) T = f(T), Picard iteration from T0 when properties depend on T."""
-        T = T0
-        for _ in range(PICARD_ITERATIONS if nonlinear else 1):
+
+        def update(T: np.ndarray) -> np.ndarray:
             K, _, f = self.operators(inputs, T, nonlinear)
-            T_new = self._solve(K, f, inputs.fixed)
-            change = float(np.max(np.abs(T_new - T))) if T.size else 0.0
-            T = T_new
-            if not nonlinear or change <= PICARD_TOLERANCE * (1.0 + float(np.max(np.abs(T)))):
-                return T
-        raise ApdlError(f"the nonlinear thermal solve did not converge in {PICARD_ITERATIONS} "
-                        "Picard iterations")
+            return self._solve(K, f, inputs.fixed)
+
+        try:
+            return picard(update, T0, nonlinear)
+        except SteppingError as exc:
+            raise ApdlError(f"the nonlinear thermal solve {exc}") from None
 
     def step(self, inputs_old: ThermalInputs, inputs_new: ThermalInputs, T: np.ndarray,
              dt: float, theta: float, nonlinear: bool) -> np.ndarray:
-        """One θ-step: (C/dt + θK) T1 = (C/dt − (1−θ)K) T0 + θ f1 + (1−θ) f0."""
-        K0, C0, f0 = self.operators(inputs_old, T, nonlinear)
-        T1 = T
-        for _ in range(PICARD_ITERATIONS if nonlinear else 1):
-            K1, C1, f1 = self.operators(inputs_new, T1, nonlinear) if nonlinear or \
-                inputs_new is not inputs_old else (K0, C0, f0)
-            C = 0.5 * (C0 + C1) if nonlinear else C0
-            if inputs_new.enthalpy is not None:
-                C = self.secant_capacity(inputs_new, T, T1)
-            A = C / dt + theta * K1
-            rhs = C @ T / dt - (1.0 - theta) * (K0 @ T) + theta * f1 + (1.0 - theta) * f0
-            T_new = self._solve(A.tocsr(), rhs, inputs_new.fixed)
-            change = float(np.max(np.abs(T_new - T1)))
-            T1 = T_new
-            if not nonlinear or change <= PICARD_TOLERANCE * (1.0 + float(np.max(np.abs(T1)))):
-                return T1
-        raise ApdlError(f"the nonlinear thermal step did not converge in {PICARD_ITERATIONS} "
-                        "Picard iterations")
+        """One θ-step: (C/dt + θK1) T1 = (C/dt − (1−θ)K0) T0 + θ f1 + (1−θ) f0."""
+        start = self.operators(inputs_old, T, nonlinear)
+
+        def end_at(T1: np.ndarray) -> ThetaSystem:
+            if nonlinear or inputs_new is not inputs_old:
+                return self.operators(inputs_new, T1, nonlinear)
+            return start
+
+        def solve(A: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+            return self._solve(A, rhs, inputs_new.fixed)
+
+        capacity = None if inputs_new.enthalpy is None else \
+            (lambda T1: self.secant_capacity(inputs_new, T, T1))
+        try:
+            return theta_step(T, dt, theta, start, end_at, solve, nonlinear, capacity)
+        except SteppingError as exc:
+            raise ApdlError(f"the nonlinear thermal step {exc}") from None
 
     def element_heat(self, inputs: ThermalInputs, T: np.ndarray,
                      elements: int | np.ndarray) -> np.ndarray:
@@ -486,36 +490,13 @@ def march(model: PlaneThermal, inputs_at: Callable[[float], ThermalInputs], T0: 
           scale: float) -> tuple[list[float], list[np.ndarray]]:
     """Substeps from t0 to t1: fixed `dt` (the last one shortened to land on t1) or, with
     `adaptive`, sizes from a step-doubling error estimate within [dt_min, dt_max]."""
-    times, temps = [], []
-    t, T = t0, T0
-    tol = STEP_TOLERANCE * max(scale, 1.0)
-    h = dt
-    while t < t1 - 1e-12 * max(1.0, abs(t1)):
-        if len(times) >= MAX_SUBSTEPS:
-            raise ApdlError(f"more than {MAX_SUBSTEPS} substeps in one load step")
-        h = min(h, t1 - t)
-        old = inputs_at(t)
-        if not adaptive:
-            T = model.step(old, inputs_at(t + h), T, h, theta, nonlinear)
-            t += h
-            times.append(t)
-            temps.append(T)
-            continue
-        mid = inputs_at(t + 0.5 * h)
-        new = inputs_at(t + h)
-        full = model.step(old, new, T, h, theta, nonlinear)
-        half = model.step(old, mid, T, 0.5 * h, theta, nonlinear)
-        half = model.step(mid, new, half, 0.5 * h, theta, nonlinear)
-        error = float(np.max(np.abs(full - half)))
-        if error > tol and h > dt_min * (1 + 1e-9):
-            h = max(dt_min, h * max(0.2, 0.9 * np.sqrt(tol / error)))
-            continue
-        t += h
-        T = half  # the more accurate of the two
-        times.append(t)
-        temps.append(T)
-        grow = 2.0 if error == 0.0 else min(2.0, 0.9 * np.sqrt(tol / error))
-        h = min(dt_max, max(dt_min, h * max(grow, 0.5)))
-    if times:
-        times[-1] = t1
-    return times, temps
+    inputs_at = functools.lru_cache(maxsize=4)(inputs_at)  # a half step's end starts the next
+
+    def step(T: np.ndarray, t: float, t_next: float, h: float) -> np.ndarray:
+        return model.step(inputs_at(t), inputs_at(t_next), T, h, theta, nonlinear)
+
+    control = StepControl(dt_min, dt_max, STEP_TOLERANCE * max(scale, 1.0)) if adaptive else None
+    try:
+        return march_to(step, T0, t0, t1, dt, control)
+    except SteppingError as exc:
+        raise ApdlError(str(exc)) from None

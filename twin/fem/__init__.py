@@ -10,7 +10,8 @@ probes      point-evaluation matrices
 loads       ThermalLoads: one validated load set
 balance     HeatBalance: the discrete heat balance of a step
 thermal     ThermalProblem: operators by region/boundary/interface, steady and transient
-stepper     ThermalStepper: θ-method steps, `march(T, n)` yields each step's temperature
+stepper     the θ-method: ThermalStepper (fixed loads, `march(T, n)` yields each step), and
+            theta_step / picard / march_to for re-assembled systems (k(T), AUTOTS)
 structural  ElasticProblem: factorized once, thermal load operator, stresses, probes
 """
 

@@ -1,6 +1,10 @@
-"""θ-method time stepping of the heat equation with a fixed Δt and fixed loads.
+"""θ-method time stepping of the heat equation C dT/dt + K T = f.
 
-    (C/Δt + θK) T⁺ = (C/Δt − (1 − θ)K) T + f        θ = 1 backward Euler, ½ Crank–Nicolson
+    (C/Δt + θK₁) T₁ = (C/Δt − (1 − θ)K₀) T₀ + θ f₁ + (1 − θ) f₀
+    θ = 1 backward Euler, ½ Crank–Nicolson; index 0 the start of the step, 1 its end
+
+`ThermalStepper` is the form for fixed operators and loads (K₀ = K₁, f₀ = f₁): the left
+side is factorized once and a step is one back-substitution::
 
     stepper = problem.transient(loads, dt=4.0)
     for T in stepper.march(T, 15):       # like scikit-fem's ex19 `evolve`
@@ -8,12 +12,18 @@
 
 The problem (`ThermalProblem.transient`) assembles and factorizes; the stepper holds only
 what a step needs and never touches the problem's operators.
+
+`theta_step` is the general form, for a system assembled by the caller at each end of the
+step: loads that change in time, and k(T), ρc(T) by Picard iteration (`picard`).
+`march_to` strings such steps from t0 to t1, at a fixed Δt or with the step size chosen
+from a step-doubling estimate of the local error (`StepControl`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import Protocol
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -74,3 +84,124 @@ class ThermalStepper:
         if self._balance is None:
             self._balance = self._make_balance()
         return self._balance(T_old, T_new)
+
+
+PICARD_TOLERANCE = 1e-8
+"""Picard iteration stops when no temperature changed by more than this × (1 + max |T|)."""
+PICARD_ITERATIONS = 200
+MAX_SUBSTEPS = 200_000
+
+
+class SteppingError(RuntimeError):
+    """A time integration that cannot finish: Picard iteration not converging, or more
+    substeps than `MAX_SUBSTEPS` (the caller names the problem it was solving)."""
+
+
+class ThetaSystem(NamedTuple):
+    """C dT/dt + K T = f at one state: K conductance (W/K), C capacity (J/K), f load (W)."""
+
+    K: sp.csr_matrix
+    C: sp.csr_matrix
+    f: np.ndarray
+
+
+def picard(update: Callable[[np.ndarray], np.ndarray], T0: np.ndarray,
+           iterate: bool = True) -> np.ndarray:
+    """The fixed point T = update(T) from T0 (°C), or one update when not `iterate` (a
+    linear problem); converged when the largest change is at most `PICARD_TOLERANCE` ×
+    (1 + max |T|)."""
+    T = T0
+    for _ in range(PICARD_ITERATIONS if iterate else 1):
+        T_new = update(T)
+        change = float(np.max(np.abs(T_new - T))) if T.size else 0.0
+        T = T_new
+        if not iterate or change <= PICARD_TOLERANCE * (1.0 + float(np.max(np.abs(T)))):
+            return T
+    raise SteppingError(f"did not converge in {PICARD_ITERATIONS} Picard iterations")
+
+
+def theta_step(
+    T: np.ndarray,
+    dt: float,
+    theta: float,
+    start: ThetaSystem,
+    end_at: Callable[[np.ndarray], ThetaSystem],
+    solve: Callable[[sp.csr_matrix, np.ndarray], np.ndarray],
+    iterate: bool,
+    capacity: Callable[[np.ndarray], sp.csr_matrix] | None = None,
+) -> np.ndarray:
+    """One θ-step of Δt (s) from T (°C): `start` is the system at the start of the step,
+    `end_at(T₁)` the system at its end assembled at temperature T₁, `solve(A, rhs)` solves
+    with the prescribed temperatures of the end.  With `iterate` (properties depending on
+    T) the end is re-assembled at each Picard iterate and C is the mean of both ends'.
+    `capacity(T₁)`, when given, is the step's C (J/K) instead: e.g. an enthalpy secant
+    (H(T₁) − H(T)) / (T₁ − T), so a step across a phase change takes in its latent heat."""
+    K0, C0, f0 = start
+
+    def update(T1: np.ndarray) -> np.ndarray:
+        K1, C1, f1 = end_at(T1)
+        if capacity is not None:
+            C = capacity(T1)
+        else:
+            C = 0.5 * (C0 + C1) if iterate else C0
+        A = C / dt + theta * K1
+        rhs = C @ T / dt - (1.0 - theta) * (K0 @ T) + theta * f1 + (1.0 - theta) * f0
+        return solve(A.tocsr(), rhs)
+
+    return picard(update, T, iterate)
+
+
+@dataclass(frozen=True)
+class StepControl:
+    """Adaptive step size: a step is accepted when one step of h and two of h/2 differ by
+    at most `tolerance` (°C); h stays within [dt_min, dt_max] (s)."""
+
+    dt_min: float
+    dt_max: float
+    tolerance: float
+
+
+def march_to(
+    step: Callable[[np.ndarray, float, float, float], np.ndarray],
+    T0: np.ndarray,
+    t0: float,
+    t1: float,
+    dt: float,
+    control: StepControl | None = None,
+) -> tuple[list[float], list[np.ndarray]]:
+    """Steps from time t0 to t1 (s): `step(T, t, t_next, h)` advances T by h = t_next − t.
+    Without `control` every step is `dt` (the last one shortened to land on t1); with it the
+    first step tries `dt` and the next sizes follow the step-doubling error estimate (the
+    two half steps are kept).  Returns the end time and temperature of every step; the last
+    time is t1 exactly."""
+    times: list[float] = []
+    temps: list[np.ndarray] = []
+    t, T = t0, T0
+    h = dt
+    while t < t1 - 1e-12 * max(1.0, abs(t1)):
+        if len(times) >= MAX_SUBSTEPS:
+            raise SteppingError(f"more than {MAX_SUBSTEPS} substeps in one load step")
+        h = min(h, t1 - t)
+        if control is None:
+            T = step(T, t, t + h, h)
+            t += h
+            times.append(t)
+            temps.append(T)
+            continue
+        full = step(T, t, t + h, h)
+        half = step(T, t, t + 0.5 * h, 0.5 * h)
+        half = step(half, t + 0.5 * h, t + h, 0.5 * h)
+        error = float(np.max(np.abs(full - half)))
+        tol = control.tolerance
+        if error > tol and h > control.dt_min * (1 + 1e-9):
+            h = max(control.dt_min, h * max(0.2, 0.9 * np.sqrt(tol / error)))
+            continue
+        t += h
+        T = half  # the more accurate of the two
+        times.append(t)
+        temps.append(T)
+        grow = 2.0 if error == 0.0 else min(2.0, 0.9 * np.sqrt(tol / error))
+        h = min(control.dt_max, max(control.dt_min, h * max(grow, 0.5)))
+    if times:
+        times[-1] = t1
+    return times, temps

@@ -1,0 +1,87 @@
+"""twin.fem.stepper's general θ-method (theta_step, picard, march_to) on systems whose exact
+solution is known: a lumped body cooling or heating, C dT/dt + K T = f."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from twin.fem.stepper import (
+    MAX_SUBSTEPS,
+    StepControl,
+    SteppingError,
+    ThetaSystem,
+    march_to,
+    picard,
+    theta_step,
+)
+
+C_J_K, K_W_K, T_INF_C = 400.0, 2.0, 20.0  # one lumped body: time constant C/K = 200 s
+
+
+def body(load_W: float = K_W_K * T_INF_C) -> ThetaSystem:
+    return ThetaSystem(sp.csr_matrix([[K_W_K]]), sp.csr_matrix([[C_J_K]]), np.array([load_W]))
+
+
+def solve(A: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+    return rhs / A.toarray().ravel()
+
+
+@pytest.mark.parametrize("theta", [0.5, 2 / 3, 1.0])
+def test_theta_step_is_the_theta_recurrence(theta):
+    """One step of C dT/dt + K T = f with f changing over the step:
+    T1 = ((C/Δt − (1−θ)K) T0 + θ f1 + (1−θ) f0) / (C/Δt + θK)."""
+    dt, T0, f0, f1 = 10.0, 80.0, 40.0, 100.0
+    T1 = theta_step(np.array([T0]), dt, theta, body(f0), lambda T: body(f1), solve, False)
+    exact = ((C_J_K / dt - (1 - theta) * K_W_K) * T0 + theta * f1 + (1 - theta) * f0) / (
+        C_J_K / dt + theta * K_W_K)
+    assert T1[0] == pytest.approx(exact, rel=1e-14)
+
+
+def test_picard_finds_the_fixed_point_and_refuses_a_divergent_one():
+    # k(T) = 1 + T/100 W/K, f = 3 W: k(T) T = f is T²/100 + T − 3 = 0
+    root = (-1.0 + math.sqrt(1.0 + 4 * 3.0 / 100.0)) / (2 / 100.0)
+    T = picard(lambda T: 3.0 / (1.0 + T / 100.0), np.array([0.0]))
+    assert T[0] == pytest.approx(root, rel=1e-7)
+    with pytest.raises(SteppingError, match="Picard"):
+        picard(lambda T: -2.0 * T + 1.0, np.array([0.0]))  # |slope| > 1: no convergence
+
+
+@pytest.mark.parametrize("theta, order", [(1.0, 1), (0.5, 2)])
+def test_march_to_fixed_steps_converge_at_the_method_order(theta, order):
+    """Cooling from 80 °C towards 20 °C: T(t) = 20 + 60 e^(−t/200); the error at t = 100 s
+    falls by 2^order when Δt halves; the last step lands on t1 exactly."""
+
+    def step(T, t, t_next, h):
+        return theta_step(T, h, theta, body(), lambda T1: body(), solve, False)
+
+    exact = T_INF_C + 60.0 * math.exp(-100.0 / (C_J_K / K_W_K))
+    errors = []
+    for dt in (30.0, 15.0):  # 30 does not divide 100: the last step is shortened
+        times, temps = march_to(step, np.array([80.0]), 0.0, 100.0, dt)
+        assert times[-1] == 100.0
+        errors.append(abs(temps[-1][0] - exact))
+    assert 2**order * 0.8 < errors[0] / errors[1] < 2**order * 1.25
+
+
+def test_march_to_adaptive_meets_its_tolerance():
+    """Step doubling keeps the local error of each step at most the tolerance, so the end
+    value is within (number of steps) × tolerance of the exact exponential."""
+
+    def step(T, t, t_next, h):
+        return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
+
+    control = StepControl(dt_min=0.01, dt_max=50.0, tolerance=1e-3)
+    times, temps = march_to(step, np.array([80.0]), 0.0, 400.0, 1.0, control)
+    exact = T_INF_C + 60.0 * math.exp(-2.0)
+    assert times[-1] == 400.0 and np.all(np.diff(times) > 0)
+    assert abs(temps[-1][0] - exact) < 1e-3 * len(times)
+    assert max(np.diff([0.0, *times])) > 1.0  # the step grew where the error allowed
+
+
+def test_march_to_refuses_too_many_substeps():
+    with pytest.raises(SteppingError, match=f"more than {MAX_SUBSTEPS} substeps"):
+        march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 1.0, 1.0 / (MAX_SUBSTEPS + 10))
