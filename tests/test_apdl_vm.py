@@ -8,30 +8,23 @@ lie within 2 % of its target.
 from __future__ import annotations
 
 import math
-import re
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from apdl_like.vrt import results_table as read_results_table
+
 DECKS = Path(__file__).parent / "data" / "apdl_vm"
 TOLERANCE = 0.02
-_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[EeDd][-+]?\d+)?")
 
 # the decks that run as published, and the rows of their results tables
-ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4}
+ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4, "vm99": 5, "vm227": 3}
 
 
 def results_table(path: Path) -> list[tuple[str, float, float]]:
-    """(label, target, computed) of each *VWRITE row: label in columns 2..17, then three
-    numbers (target, computed, ratio)."""
-    rows = []
-    for line in path.read_text().splitlines():
-        numbers = _NUMBER.findall(line[17:])
-        if len(line) > 17 and line[0] == " " and len(numbers) == 3 and "|" not in line:
-            rows.append((line[1:17].strip(), float(numbers[0]), float(numbers[1])))
-    return rows
+    return read_results_table(path.read_text())
 
 
 @pytest.mark.parametrize("deck", sorted(ROWS))

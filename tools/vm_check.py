@@ -2,7 +2,9 @@
 
     python tools/vm_check.py DIR [DIR ...] [--tolerance 0.02] [--timeout 300] [--json FILE]
 
-Each deck runs as written (`apdl-like run DECK --out TMP`, a fresh process).  The deck
+Each deck runs as written (`python -m apdl_like run DECK --out TMP`, a fresh process in a
+scratch folder, so `apdl_like` comes from PYTHONPATH or the installed package, never from the
+current directory).  The deck
 writes its own results table (`/OUT,vmNN,vrt`): per row a label (A8,A8), the TARGET, the
 computed value and their ratio.  A deck passes when it runs (exit 0), writes the table and
 every computed value is within the tolerance of its target (relative; a zero target needs
@@ -26,27 +28,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?")
+from apdl_like.vrt import results_table
+
 _UNKNOWN = re.compile(r"^warning: [^:]+:(\d+): (\S+): unknown or unsupported command")
-
-
-def table_rows(text: str) -> list[tuple[str, float, float]]:
-    """(label, target, computed) of each row of a vrt table: a line whose text after the
-    16-character label holds at least three numbers (target, computed, ratio)."""
-    rows = []
-    for line in text.splitlines():
-        if len(line) < 18 or line.lstrip().startswith(("|", "-")):
-            continue
-        numbers = _NUMBER.findall(line[17:])
-        if len(numbers) < 3:
-            continue
-        try:
-            target, computed = (float(x.replace("D", "E").replace("d", "e"))
-                                for x in numbers[-3:-1])
-        except ValueError:
-            continue
-        rows.append((line[1:17].strip(), target, computed))
-    return rows
 
 
 def judge(rows: list[tuple[str, float, float]], tolerance: float) -> list[str]:
@@ -64,9 +48,9 @@ def check_deck(deck: Path, tolerance: float, timeout: float) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out"
         try:
-            proc = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck),
+            proc = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck.resolve()),
                                    "--out", str(out)], capture_output=True, text=True,
-                                  timeout=timeout, check=False)
+                                  timeout=timeout, check=False, cwd=tmp)
         except subprocess.TimeoutExpired:
             return {"deck": deck.name, "status": "error", "detail": f"timeout {timeout:g} s",
                     "unknown": []}
@@ -81,7 +65,7 @@ def check_deck(deck: Path, tolerance: float, timeout: float) -> dict:
         tables = sorted(out.glob("*.vrt")) if out.is_dir() else []
         if not tables:
             return result | {"status": "no table", "detail": ""}
-        rows = table_rows(tables[0].read_text(errors="replace"))
+        rows = results_table(tables[0].read_text(errors="replace"))
         if not rows:
             return result | {"status": "no table", "detail": "no rows with target/computed"}
         bad = judge(rows, tolerance)
