@@ -111,3 +111,39 @@ FINISH
 /SOLU
 SOLVE
 """, "radiating.inp")
+
+
+def test_esla_selects_the_elements_of_the_selected_area_free_or_mapped():
+    """ASEL + ESLA pick exactly the elements lying in the chosen area: two touching
+    rectangles meshed together with triangles (free), then a third one mapped."""
+    s = Session()
+    s.run_text("""
+/PREP7
+ET,1,PLANE55
+BLC4,0,0,1,1
+BLC4,1,0,2,1
+MSHAPE,1
+ESIZE,0.25
+AMESH,1,2
+MSHAPE,0
+BLC4,0,2,1,1
+AMESH,3
+ASEL,S,AREA,,2
+ESLA,S
+*GET,N2,ELEM,,NUM,COUNT
+ASEL,S,AREA,,3
+ESLA,S
+*GET,N3,ELEM,,NUM,COUNT
+ASEL,ALL
+ESLA,S
+*GET,NALL,ELEM,,NUM,COUNT
+""", "areas.inp")
+    db = s.db
+    el = db.elements
+    xy = db.nodes.xy[db.nodes.index(el.nodes[:, :3].ravel()).reshape(-1, 3)]
+    centroid = xy.mean(axis=1)
+    in_2 = (centroid[:, 0] > 1.0) & (centroid[:, 1] < 1.0)
+    in_3 = centroid[:, 1] > 2.0
+    assert s.params["N2"] == in_2.sum() > 0
+    assert s.params["N3"] == in_3.sum() == 16  # 4 × 4 mapped quads
+    assert s.params["NALL"] == len(el.ids)
