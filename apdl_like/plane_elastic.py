@@ -253,7 +253,13 @@ def enhanced_quads(xy: np.ndarray, mode: str, E: np.ndarray, nu: np.ndarray,
                    th: np.ndarray) -> tuple[np.ndarray, np.ndarray, object]:
     """Condensed element stiffness (ne, 8, 8) and thermal load (ne, 8) of bilinear quads with
     four incompatible modes (MAPDL's PLANE182 enhanced strain), and a recovery function
-    u_e (ne, 8) -> stresses (4, ne, 4 corners).  th: thermal strain α ΔT at the corners."""
+    u_e (ne, 8) -> stresses (4, ne, 4 corners).  th: thermal strain α ΔT at the corners.
+
+    MAPDL's theory reference gives KEYOPT(1) = 3 these four internal DOFs (against shear
+    locking) and KEYOPT(1) = 2 a fifth one against volumetric locking, without its form;
+    both KEYOPTs run as this four-mode element.  The nodal stresses follow MAPDL's default
+    (ERESX,DEFA for elastic elements): the 2 × 2 point values extrapolated to the corners,
+    then averaged over the elements at each node."""
     D = np.moveaxis(elasticity_matrix(E, nu, mode), -1, 0)  # (ne, 4, 4)
     normal = 2 if mode == "plane_stress" else 3
     ne = xy.shape[0]
