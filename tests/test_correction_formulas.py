@@ -7,6 +7,7 @@ import pytest
 
 from twin.correction.formulas import (
     ContactFit,
+    RatioGuard,
     RatioGuards,
     contact_drop_ratio,
     contact_pressure_factor,
@@ -42,7 +43,7 @@ def test_eq2_hand_worked_table1_row_60s():
 
 def test_eq3_hand_worked():
     # rises over a window of 0.60 K measured and 0.48 K simulated: C_H = 1.25
-    C_H = window_rise_ratio(0.60, 0.48, RatioGuards(window_ratio_limits=(0.5, 2.0)))
+    C_H = window_rise_ratio(0.60, 0.48, RatioGuards(window=RatioGuard(0.1, (0.5, 2.0))))
     assert C_H == pytest.approx(1.25)
     assert heat_second_correction(1.8e6, C_H) == pytest.approx(2.25e6)
 
@@ -73,9 +74,9 @@ def test_guards_neutral_for_tiny_negative_or_missing_denominators():
 
 def test_guards_clip_to_limits():
     g = RatioGuards()
-    assert total_rise_ratio(40.0, 26.0, 25.0, g) == g.total_ratio_limits[1]
-    assert window_rise_ratio(0.01, 1.0, g) == g.window_ratio_limits[0]
-    assert guarded_ratio(3.0, 1.0, min_denominator=0.1, limits=(0.5, 2.0)) == 2.0
+    assert total_rise_ratio(40.0, 26.0, 25.0, g) == g.total.limits[1]
+    assert window_rise_ratio(0.01, 1.0, g) == g.window.limits[0]
+    assert guarded_ratio(3.0, 1.0, RatioGuard(0.1, (0.5, 2.0))) == 2.0
 
 
 def test_corrections_never_non_positive():
@@ -119,6 +120,8 @@ def test_eq6_hand_worked():
 def test_bad_guards_rejected():
     with pytest.raises(ValueError, match="value_limits"):
         RatioGuards(value_limits=(1.5, 2.0))
-    with pytest.raises(ValueError, match="min_total_rise_C"):
-        RatioGuards(min_total_rise_C=0.0)
+    with pytest.raises(ValueError, match="min_denominator"):
+        RatioGuard(0.0, (0.5, 2.0))
+    with pytest.raises(ValueError, match="limits"):
+        RatioGuard(0.5, (1.2, 2.0))
     assert math.isclose(RatioGuards().value_limits[0], 0.2)

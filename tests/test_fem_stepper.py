@@ -9,15 +9,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from twin.fem.stepper import (
-    MAX_SUBSTEPS,
-    StepControl,
-    SteppingError,
-    ThetaSystem,
-    march_to,
-    picard,
-    theta_step,
-)
+from twin.fem import stepper
+from twin.fem.stepper import StepControl, SteppingError, ThetaSystem, theta_step
 
 C_J_K, K_W_K, T_INF_C = 400.0, 2.0, 20.0  # one lumped body: time constant C/K = 200 s
 
@@ -44,10 +37,10 @@ def test_theta_step_is_the_theta_recurrence(theta):
 def test_picard_finds_the_fixed_point_and_refuses_a_divergent_one():
     # k(T) = 1 + T/100 W/K, f = 3 W: k(T) T = f is T²/100 + T − 3 = 0
     root = (-1.0 + math.sqrt(1.0 + 4 * 3.0 / 100.0)) / (2 / 100.0)
-    T = picard(lambda T: 3.0 / (1.0 + T / 100.0), np.array([0.0]))
+    T = stepper.picard(lambda T: 3.0 / (1.0 + T / 100.0), np.array([0.0]))
     assert T[0] == pytest.approx(root, rel=1e-7)
     with pytest.raises(SteppingError, match="Picard"):
-        picard(lambda T: -2.0 * T + 1.0, np.array([0.0]))  # |slope| > 1: no convergence
+        stepper.picard(lambda T: -2.0 * T + 1.0, np.array([0.0]))  # |slope| > 1: no convergence
 
 
 @pytest.mark.parametrize("theta, order", [(1.0, 1), (0.5, 2)])
@@ -61,7 +54,7 @@ def test_march_to_fixed_steps_converge_at_the_method_order(theta, order):
     exact = T_INF_C + 60.0 * math.exp(-100.0 / (C_J_K / K_W_K))
     errors = []
     for dt in (30.0, 15.0):  # 30 does not divide 100: the last step is shortened
-        times, temps = march_to(step, np.array([80.0]), 0.0, 100.0, dt)
+        times, temps = stepper.march_to(step, np.array([80.0]), 0.0, 100.0, dt)
         assert times[-1] == 100.0
         errors.append(abs(temps[-1][0] - exact))
     assert 2**order * 0.8 < errors[0] / errors[1] < 2**order * 1.25
@@ -75,7 +68,7 @@ def test_march_to_adaptive_meets_its_tolerance():
         return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
 
     control = StepControl(dt_min=0.01, dt_max=50.0, tolerance=1e-3)
-    times, temps = march_to(step, np.array([80.0]), 0.0, 400.0, 1.0, control)
+    times, temps = stepper.march_to(step, np.array([80.0]), 0.0, 400.0, 1.0, control)
     exact = T_INF_C + 60.0 * math.exp(-2.0)
     assert times[-1] == 400.0 and np.all(np.diff(times) > 0)
     assert abs(temps[-1][0] - exact) < 1e-3 * len(times)
@@ -83,5 +76,6 @@ def test_march_to_adaptive_meets_its_tolerance():
 
 
 def test_march_to_refuses_too_many_substeps():
-    with pytest.raises(SteppingError, match=f"more than {MAX_SUBSTEPS} substeps"):
-        march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 1.0, 1.0 / (MAX_SUBSTEPS + 10))
+    n = stepper.MAX_SUBSTEPS
+    with pytest.raises(SteppingError, match=f"more than {n} substeps"):
+        stepper.march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 1.0, 1.0 / (n + 10))

@@ -16,7 +16,7 @@ from twin.correction.features import (
     BoundaryValues,
     WindowFeatures,
 )
-from twin.correction.formulas import ContactFit, RatioGuards
+from twin.correction.formulas import ContactFit, RatioGuard, RatioGuards
 from twin.correction.methods import (
     METHODS,
     BpnnCorrection,
@@ -40,6 +40,7 @@ __all__ = [
     "Corrector",
     "OpenLoop",
     "RatioCorrection",
+    "RatioGuard",
     "RatioGuards",
     "WindowFeatures",
     "load_model",

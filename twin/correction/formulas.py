@@ -45,6 +45,32 @@ CONTACT_PRESSURE_EXPONENT = 0.68
 """Exponent of (P/E) in the contact-resistance correlation (REFERENCE.md §1, Eq. 4)."""
 
 
+def _check_floor_and_band(guard: object, floor: str, band: str) -> None:
+    """The field `floor` of `guard` must be positive and its `band` (low, high) must
+    satisfy 0 < low <= 1 <= high (a neutral factor 1 must stay possible)."""
+    name = type(guard).__name__
+    if not getattr(guard, floor) > 0:
+        raise ValueError(f"{name}.{floor} must be positive")
+    low, high = getattr(guard, band)
+    if not 0 < low <= 1 <= high:
+        raise ValueError(f"{name}.{band} must satisfy 0 < low <= 1 <= high")
+
+
+@dataclass(frozen=True)
+class RatioGuard:
+    """The guard of one ratio of a measured to a simulated change (°C or K).
+
+    min_denominator  a simulated change below this gives the neutral factor 1
+    limits           the clip of the ratio, low ≤ 1 ≤ high
+    """
+
+    min_denominator: float
+    limits: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        _check_floor_and_band(self, "min_denominator", "limits")
+
+
 @dataclass(frozen=True)
 class RatioGuards:
     """Limits that keep the ratio corrections finite, positive and calm.
@@ -53,33 +79,20 @@ class RatioGuards:
     so that a ratio is only taken when both rises are signal, not noise.
     """
 
-    min_total_rise_C: float = 0.5
-    """Eq. 2: simulated rise over ambient below this (the first seconds of a run) → factor 1."""
-    min_window_rise_C: float = 0.1
-    """Eq. 3: simulated rise over one window below this (near balance) → factor 1."""
-    min_contact_drop_C: float = 0.1
-    """Eq. 6: simulated ring-to-sleeve drop below this → factor 1."""
-    total_ratio_limits: tuple[float, float] = (0.5, 2.0)
-    """Clip of the Eq. 2 ratio."""
-    window_ratio_limits: tuple[float, float] = (0.8, 1.25)
-    """Clip of C_H (Eq. 3): one window may change the heat by at most this factor."""
-    contact_ratio_limits: tuple[float, float] = (0.8, 1.25)
-    """Clip of C_C (Eq. 6)."""
+    total: RatioGuard = RatioGuard(0.5, (0.5, 2.0))
+    """Eq. 2: a simulated rise over ambient below 0.5 °C (the first seconds of a run) → 1."""
+    window: RatioGuard = RatioGuard(0.1, (0.8, 1.25))
+    """Eq. 3 (C_H): a simulated rise over one window below 0.1 °C (near balance) → 1; one
+    window may change the heat by at most the clip's factor."""
+    contact: RatioGuard = RatioGuard(0.1, (0.8, 1.25))
+    """Eq. 6 (C_C): a simulated ring-to-sleeve drop below 0.1 °C → 1."""
     value_limits: tuple[float, float] = (0.2, 5.0)
     """Corrected H and R stay within these multiples of their nominal (Eq. 1 / Eq. 4) value."""
     min_relative_pressure: float = 0.1
     """Eq. 5: floor of P'/P = 1 + Δδ/δ0 (a fit that opens would make R infinite)."""
 
     def __post_init__(self) -> None:
-        for name in ("min_total_rise_C", "min_window_rise_C", "min_contact_drop_C",
-                     "min_relative_pressure"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"RatioGuards.{name} must be positive")
-        for name in ("total_ratio_limits", "window_ratio_limits", "contact_ratio_limits",
-                     "value_limits"):
-            low, high = getattr(self, name)
-            if not 0 < low <= 1 <= high:
-                raise ValueError(f"RatioGuards.{name} must satisfy 0 < low <= 1 <= high")
+        _check_floor_and_band(self, "min_relative_pressure", "value_limits")
 
 
 DEFAULT_GUARDS = RatioGuards()
@@ -105,25 +118,20 @@ class ContactFit:
                 raise ValueError(f"ContactFit.{name} must be positive")
 
 
-def guarded_ratio(
-    numerator: ArrayLike,
-    denominator: ArrayLike,
-    *,
-    min_denominator: float,
-    limits: tuple[float, float],
-) -> np.ndarray:
+def guarded_ratio(numerator: ArrayLike, denominator: ArrayLike, guard: RatioGuard) -> np.ndarray:
     """numerator / denominator, or 1 where that ratio carries no information.
 
-    Neutral (1) where |denominator| < min_denominator, where the two have opposite signs or
-    the numerator is zero, or where either is not finite; otherwise clipped to `limits`.
+    Neutral (1) where |denominator| < guard.min_denominator, where the two have opposite
+    signs or the numerator is zero, or where either is not finite; otherwise clipped to
+    `guard.limits`.
     """
     num = np.asarray(numerator, dtype=float)
     den = np.asarray(denominator, dtype=float)
-    usable = np.isfinite(num) & np.isfinite(den) & (np.abs(den) >= min_denominator)
+    usable = np.isfinite(num) & np.isfinite(den) & (np.abs(den) >= guard.min_denominator)
     safe_den = np.where(usable, den, 1.0)
     ratio = np.where(usable, num / safe_den, 1.0)
     ratio = np.where(ratio > 0, ratio, 1.0)
-    return np.clip(ratio, limits[0], limits[1])
+    return np.clip(ratio, guard.limits[0], guard.limits[1])
 
 
 def total_rise_ratio(
@@ -134,40 +142,22 @@ def total_rise_ratio(
 ) -> np.ndarray:
     """Eq. 2 factor (t_m − t_amb) / (t_f − t_amb), guarded."""
     amb = np.asarray(ambient_C, dtype=float)
-    return guarded_ratio(
-        np.asarray(measured_C, dtype=float) - amb,
-        np.asarray(simulated_C, dtype=float) - amb,
-        min_denominator=guards.min_total_rise_C,
-        limits=guards.total_ratio_limits,
-    )
+    measured_rise = np.asarray(measured_C, dtype=float) - amb
+    return guarded_ratio(measured_rise, np.asarray(simulated_C, dtype=float) - amb, guards.total)
 
 
 def window_rise_ratio(
-    measured_rise_C: ArrayLike,
-    simulated_rise_C: ArrayLike,
-    guards: RatioGuards = DEFAULT_GUARDS,
+    measured_rise_C: ArrayLike, simulated_rise_C: ArrayLike, guards: RatioGuards = DEFAULT_GUARDS
 ) -> np.ndarray:
     """Eq. 3 coefficient C_H = Δt_m / Δt_f of the rises over one window, guarded."""
-    return guarded_ratio(
-        measured_rise_C,
-        simulated_rise_C,
-        min_denominator=guards.min_window_rise_C,
-        limits=guards.window_ratio_limits,
-    )
+    return guarded_ratio(measured_rise_C, simulated_rise_C, guards.window)
 
 
 def contact_drop_ratio(
-    measured_drop_C: ArrayLike,
-    simulated_drop_C: ArrayLike,
-    guards: RatioGuards = DEFAULT_GUARDS,
+    measured_drop_C: ArrayLike, simulated_drop_C: ArrayLike, guards: RatioGuards = DEFAULT_GUARDS
 ) -> np.ndarray:
     """Eq. 6 coefficient C_C = Δt_m / Δt_f of the ring-to-sleeve drops, guarded."""
-    return guarded_ratio(
-        measured_drop_C,
-        simulated_drop_C,
-        min_denominator=guards.min_contact_drop_C,
-        limits=guards.contact_ratio_limits,
-    )
+    return guarded_ratio(measured_drop_C, simulated_drop_C, guards.contact)
 
 
 def heat_first_correction(

@@ -45,6 +45,7 @@ from twin.correction.features import (
 )
 from twin.correction.formulas import (
     ContactFit,
+    RatioGuard,
     RatioGuards,
     contact_drop_ratio,
     contact_pressure_factor,
@@ -60,7 +61,7 @@ window-rise ratio both estimate the same heat ratio, and their product counts it
 (see `RatioCorrection`).  (1, 1, 1) is the paper's literal product."""
 
 
-TARGET_GUARDS = RatioGuards(window_ratio_limits=(0.5, 2.0), contact_ratio_limits=(0.5, 2.0))
+TARGET_GUARDS = RatioGuards(window=RatioGuard(0.1, (0.5, 2.0)), contact=RatioGuard(0.1, (0.5, 2.0)))
 """Targets come from smooth fitted curves of a whole run, not from one noisy window, so
 the per-window limits of the online method are widened (the floors and the value band
 stay)."""
