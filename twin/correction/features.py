@@ -123,6 +123,9 @@ class WindowFeatures:
     measured_drift_um: np.ndarray | None = None
     """(n,) the recorded axial nose drift at `measured_time_s` (NaN: invalid; None: not
     recorded).  Only an estimator told to assimilate it reads it."""
+    measured_speed_rpm: np.ndarray | None = None
+    """(n,) the recorded speed at `measured_time_s` (None: not passed).  An estimator
+    re-runs the window just ended with it when the speed changed inside that window."""
     previous_factors: tuple[float, float, float, float] | None = None
     """Per value, the factor value / nominal of the last window in which the value was not
     0 (a stopped bearing keeps the factor it had before the stop).  None: derived from

@@ -30,9 +30,11 @@ class Correction:
     C_C: tuple[float, float] = (1.0, 1.0)
     """(front, rear) resistance of this window / resistance of the previous window."""
     factors: Mapping[str, float] = field(default_factory=dict)
-    """Further estimated multipliers on nominal values: `motor` (motor loss) and
-    `film_<group>` (twin.spindle.conditions.FILM_GROUPS).  The loop applies them to the
-    window's conditions (so they are in the deck) and corrections.csv lists them."""
+    """Further estimated multipliers on nominal values: `motor` (motor loss),
+    `film_<group>` (twin.spindle.conditions.FILM_GROUPS) and `expansion` (every thermal
+    expansion coefficient).  The loop applies the thermal ones to the window's conditions
+    (so they are in the deck) and scales the window's displacements by `expansion`;
+    corrections.csv lists them all."""
     state_C: np.ndarray | None = field(default=None, repr=False, compare=False)
     """The analysed temperature field (°C per dof) the window starts from; None: the loop's
     own field, carried over from the previous window."""

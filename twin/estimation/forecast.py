@@ -33,13 +33,26 @@ class WindowForecast:
     sensors_anomalies_C: np.ndarray  # (b + 1, 5, N)
     drift_anomalies_um: np.ndarray  # (b + 1, N) axial nose drift of the members − mean
     end: Ensemble  # field and log-factors at the window end (before any update)
+    drift_start_um: float = 0.0  # drift_vector_um @ T of the mean at the window start
 
-    def spread_at_steps(self) -> tuple[np.ndarray, np.ndarray]:
+    @property
+    def substeps(self) -> int:
+        """Solver steps per member step."""
+        return len(self.drift_mean_um) // (len(self.drift_anomalies_um) - 1)
+
+    def drift_mean_at_members(self) -> np.ndarray:
+        """(b + 1,) the mean's drift_vector_um @ T at the window start and every member step."""
+        return np.r_[self.drift_start_um, self.drift_mean_um[self.substeps - 1::self.substeps]]
+
+    def spread_at_steps(self, drift_anomalies_um: np.ndarray | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
         """Member variance of T1..T5 (s, 5) and of the drift (s,) at every solver step,
-        linear between member steps."""
+        linear between member steps (drift anomalies (b + 1, N) other than the field's may
+        be given: the estimator's include the expansion factor)."""
         n = self.sensors_anomalies_C.shape[-1]
         var_T = np.sum(self.sensors_anomalies_C**2, axis=-1) / (n - 1)
-        var_d = np.sum(self.drift_anomalies_um**2, axis=-1) / (n - 1)
+        d_anom = self.drift_anomalies_um if drift_anomalies_um is None else drift_anomalies_um
+        var_d = np.sum(d_anom**2, axis=-1) / (n - 1)
         s, b = len(self.drift_mean_um), len(var_d) - 1
         at = np.arange(1, s + 1) * b / s
         grid = np.arange(b + 1)
@@ -77,6 +90,7 @@ def forecast_window(
     d_anom = np.empty((blocks + 1, ensemble.size))
     s_anom[0] = sensor_matrix @ D
     d_anom[0] = drift_vector_um @ D
+    d_start = float(drift_vector_um @ T)
     explicit = member_stepper.explicit
     for i in range(steps):
         T = mean_stepper.step(T)
@@ -88,4 +102,4 @@ def forecast_window(
             s_anom[b] = sensor_matrix @ D
             d_anom[b] = drift_vector_um @ D
     end = Ensemble(T, D, ensemble.log_factor_mean.copy(), dphi.copy())
-    return WindowForecast(s_mean, d_mean, s_anom, d_anom, end)
+    return WindowForecast(s_mean, d_mean, s_anom, d_anom, end, d_start)

@@ -76,7 +76,7 @@ are not updated (their spread is capped at the prior); the films and the field g
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -95,6 +95,10 @@ from twin.estimation.parameters import (
     factors_of,
     parameters,
 )
+from twin.spindle.conditions import BoundaryConditions, bearing_values
+
+HEAT_FACTORS = frozenset({"H_front", "H_rear", "motor"})
+"""The factors on heat that a stopped spindle does not generate."""
 
 BAND_Z = 1.6448536269514722
 """Half-width of a central 90 % normal interval in σ."""
@@ -108,7 +112,7 @@ class EstimatorConfig:
     parameters: tuple[str, ...] = DEFAULT_PARAMETERS
     inflation: float = 1.05
     """Multiplicative covariance inflation per analysis (ρ)."""
-    model_sd_C: float = 0.15
+    model_sd_C: float = 0.10
     """Model error of a predicted sensor value, °C (mesh, placement, lag, conductivity)."""
     sensor_sd_C: float = 0.05
     """Thermocouple noise per sample, °C."""
@@ -120,8 +124,9 @@ class EstimatorConfig:
     """Observation bins per 60 s window; each bin's mean is one observation per sensor."""
     initial_field_sd_C: float = 0.2
     """Uncertainty of the uniform start field (the mean of the first T1..T5)."""
-    drift_rel_sd: float = 0.03
-    """Relative uncertainty of the drift beyond the field (expansion ±5 %, uniform)."""
+    drift_rel_sd: float = 0.01
+    """Relative model error of the drift beyond the field and the expansion factor (the
+    structural model's own error: mesh, stiffness, the probe's point)."""
     drift_noise_um: float = 0.1
     step_s: float = STEP_S
     steps_per_window: int = STEPS_PER_WINDOW
@@ -129,10 +134,12 @@ class EstimatorConfig:
     seed: int = 0
     field_update: float = 1.0
     """Share of the analysis increment applied to the field (1: the full ETKF update)."""
-    assimilate_drift: bool = False
-    """Also update with the recorded axial nose drift (test stands with probes).  Off by
-    default: the twin's job is to predict the drift from temperatures (production has no
-    probes), and with it on the drift accuracy is a 0–60 s forecast of a measured value."""
+    assimilate_drift: bool = True
+    """Also update with the recorded axial nose drift where the run has it (valid samples of
+    its disp_z_um column measured before the window starts): the drift of window k is then
+    a 0–60 s forecast from the drift measured up to 60k s, and the expansion factor is
+    estimated.  A run without a drift column, or with its drift invalid, is filtered on
+    T1..T5 alone.  False: always T1..T5 alone (`twin replay --no-drift-assimilation`)."""
     drift_model_sd_um: float = 0.2
     """Model error of a predicted drift bin, µm (besides drift_rel_sd of the drift)."""
 
@@ -158,6 +165,8 @@ class EnsembleEstimator:
         self._bounds = np.array([p.log_bounds for p in self._params])
         S = self.model.sensor_matrix
         self._sensors = S
+        names = self.config.parameters
+        self._expansion = names.index("expansion") if "expansion" in names else None
         self._drift_um = 1e6 * np.asarray(self.model.probe_vectors[0])
 
     @property
@@ -190,12 +199,13 @@ class EnsembleEstimator:
         ens.log_factor_mean = np.clip(ens.log_factor_mean, self._bounds[:, 0], self._bounds[:, 1])
 
         factors = factors_of(cfg.parameters, ens.log_factor_mean)
-        bc = apply_factors(f.twin_state.conditions, factors)
+        bc = apply_factors(self._conditions_at(f.twin_state.conditions, ens.field_mean), factors)
         loads = bc.to_thermal_loads()
         thermal = self.model.thermal
         substeps = cfg.steps_per_window // cfg.bins_per_window
         with threadpool_limits(1):  # tiny dense blocks: BLAS threads only contend
             self._forecast_speed_rpm = f.speed_rpm
+            self._window = (ens.field_mean.copy(), thermal.transient(loads, cfg.step_s), factors)
             self._forecast = forecast_window(
                 thermal.transient(loads, cfg.step_s),
                 thermal.transient(loads, cfg.step_s * substeps),
@@ -219,9 +229,16 @@ class EnsembleEstimator:
         # and the loop's field at the window end as the forecast mean
         end.field_mean = np.asarray(f.twin_state.field_C, float)
         steps = cfg.steps_per_window
+        sim_C = np.asarray(f.simulated_C, float)
+        changed_s = speed_change_s(f, self._forecast_speed_rpm)
+        if changed_s is not None:
+            # the speed changed inside the window just ended, after its loads were fixed:
+            # that window is re-run with the speed it really had (all measured before now)
+            # so the innovations and the analysed field are free of the unforeseen input
+            sim_C, end.field_mean, fc = self._rerun(f, changed_s, fc)
         # what the thermocouples would read of the mean: its sensor values through the lag
         sim_t = np.asarray(f.simulated_time_s, float)
-        read = thermocouple_reading(sim_t, np.asarray(f.simulated_C, float), cfg.sensor_lag_s)
+        read = thermocouple_reading(sim_t, sim_C, cfg.sensor_lag_s)
         in_window = sim_t > f.start_s - cfg.window_s + 1e-9
         read, read_t = read[in_window], sim_t[in_window]
         if len(read_t) != steps:  # the loop's history must hold the whole window
@@ -242,15 +259,14 @@ class EnsembleEstimator:
             sd.append(np.sqrt(cfg.model_sd_C**2 + (cfg.lag_sd_s * rate) ** 2
                               + cfg.sensor_sd_C**2 / np.maximum(counts, 1)))
         if cfg.assimilate_drift and f.measured_drift_um is not None:
-            drift = fc.drift_mean_um - self._drift_start_um
+            drift, drift_anom = self._drift_forecast(fc)
             for i, b in enumerate(bins):
                 lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
                 m, counts = bin_mean(t_meas, np.asarray(f.measured_drift_um, float)[:, None],
                                      lo, hi)
                 observed.append(np.where(counts >= 2, m, np.nan))
                 y_mean.append(drift[b].mean(keepdims=True))
-                y_anom.append(0.5 * (fc.drift_anomalies_um[i] + fc.drift_anomalies_um[i + 1])
-                              [None, :])
+                y_anom.append(0.5 * (drift_anom[i] + drift_anom[i + 1])[None, :])
                 sd.append(np.sqrt(cfg.drift_model_sd_um**2 + (cfg.drift_rel_sd * m) ** 2
                                   + cfg.drift_noise_um**2 / np.maximum(counts, 1)))
         prior_mean, anomalies = end.stacked()
@@ -260,20 +276,87 @@ class EnsembleEstimator:
         )
         n = end.field_mean.size
         mean[:n] = prior_mean[:n] + cfg.field_update * (mean[:n] - prior_mean[:n])
-        if abs(f.speed_rpm - self._forecast_speed_rpm) > 0.5:
-            # the speed changed inside the window just ended, after its loads were fixed:
-            # the misfit is the unforeseen input, not wrong factors.  The field takes the
-            # update; the log-factors keep their forecast (mean and spread).
+        if self._forecast_speed_rpm == 0.0 and changed_s is None:
+            # a stopped window: no bearing or motor heat, so the data say nothing about
+            # their factors; what would move them is correlation left from before the stop
+            held = [n + i for i, name in enumerate(cfg.parameters) if name in HEAT_FACTORS]
+            mean[held] = prior_mean[held]
+            anomalies[held] = end.log_factor_anomalies[[h - n for h in held]]
+        if changed_s is None and abs(f.speed_rpm - self._forecast_speed_rpm) > 0.5:
+            # a speed change without the speed history to re-run it (features from another
+            # caller): the misfit is the unforeseen input, not wrong factors.  The field
+            # takes the update; the log-factors keep their forecast (mean and spread).
             mean[n:], anomalies[n:] = prior_mean[n:], end.log_factor_anomalies
         return Ensemble.from_stacked(mean, anomalies, n)
 
+    def _conditions_at(self, bc: BoundaryConditions, field_C: np.ndarray) -> BoundaryConditions:
+        """The loop's nominal conditions with the bearing heat and contact resistance taken
+        at the temperatures of `field_C` (the analysed field the window starts from, not the
+        loop's last forecast: after a missed speed change they differ by kelvins, and the
+        Palmgren heat with them)."""
+        T = self._sensors @ field_C
+        return bc.with_values(**bearing_values(self.model, bc.speed_rpm, (T[0], T[2]),
+                                               (T[1], T[3])))
+
+    def _rerun(self, f: WindowFeatures, changed_s: float,
+               fc: WindowForecast) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
+        """The window just ended re-run from its start field, with its loads up to the solver
+        step in which the speed changed and the current speed's loads (this window's nominal
+        conditions, the same factors) after it: T1..T5 history with the window replaced,
+        the end field and the forecast with that mean (the members' anomalies are kept)."""
+        cfg = self.config
+        T, before, factors = self._window
+        bc = apply_factors(self._conditions_at(f.twin_state.conditions, T), factors)
+        after = self.model.thermal.transient(bc.to_thermal_loads(), cfg.step_s)
+        steps = cfg.steps_per_window
+        start = f.start_s - cfg.window_s
+        sensors = np.empty((steps, self._sensors.shape[0]))
+        drift = np.empty(steps)
+        for i in range(steps):
+            # a step (t − Δt, t] runs at the new speed once the change is before its end
+            stepper = after if start + (i + 1) * cfg.step_s > changed_s + 0.5 * cfg.step_s \
+                else before
+            T = stepper.step(T)
+            sensors[i] = self._sensors @ T
+            drift[i] = self._drift_um @ T
+        sim_C = np.asarray(f.simulated_C, float).copy()
+        sim_C[-steps:] = sensors
+        return sim_C, T, replace(fc, drift_mean_um=drift)
+
+    def _drift_forecast(self, fc: WindowForecast) -> tuple[np.ndarray, np.ndarray]:
+        """The mean's axial nose drift since the run start at every solver step (s,) and
+        the members' anomalies at the member steps (b + 1, N), µm, with the expansion
+        factor e^φ: drift = e^φ · w·(T − T₀), so a member moves by
+        e^φ̄ (w·δT + w·(T̄ − T₀) δφ) to first order."""
+        rise = fc.drift_mean_um - self._drift_start_um
+        anomalies = fc.drift_anomalies_um
+        if self._expansion is None:
+            return rise, anomalies
+        ens = fc.end
+        scale = float(np.exp(ens.log_factor_mean[self._expansion]))
+        rise_members = fc.drift_mean_at_members() - self._drift_start_um
+        dphi = ens.log_factor_anomalies[self._expansion]
+        return scale * rise, scale * (anomalies + np.outer(rise_members, dphi))
+
     def _band_sd(self, fc: WindowForecast) -> np.ndarray:
         cfg = self.config
-        var_T, var_d = fc.spread_at_steps()
+        drift, drift_anom = self._drift_forecast(fc)
+        var_T, var_d = fc.spread_at_steps(drift_anom)
         sd_T = np.sqrt(var_T + cfg.model_sd_C**2 + cfg.sensor_sd_C**2)
-        drift = fc.drift_mean_um - self._drift_start_um
         sd_d = np.sqrt(var_d + (cfg.drift_rel_sd * drift) ** 2 + cfg.drift_noise_um**2)
         return np.column_stack([sd_T, sd_d])
+
+
+def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None:
+    """Time (s) of the first recorded speed in the window just ended that differs from the
+    speed its forecast ran at (None: no change, or no speed history).  The sample at the
+    window's end is the next window's speed (the loop's), not a change inside this one."""
+    if f.measured_speed_rpm is None:
+        return None
+    t = np.asarray(f.measured_time_s, float)
+    rows = (t > f.start_s - f.window_s + 1e-9) & (t < f.start_s - 1e-9)
+    moved = np.abs(np.asarray(f.measured_speed_rpm, float)[rows] - forecast_speed_rpm) > 0.5
+    return float(t[rows][np.argmax(moved)]) if moved.any() else None
 
 
 def thermocouple_reading(time_s: np.ndarray, metal_C: np.ndarray, lag_s: float) -> np.ndarray:

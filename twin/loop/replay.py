@@ -5,7 +5,8 @@ window starts:
 
     features (speed, ambient, T1..T5 measured and simulated so far, run time)
       → correction (open_loop | ratio | bpnn | estimator) → H_front, H_rear, R_front, R_rear
-        (an estimator also sets the analysed start field and motor/film factors)
+        (an estimator also sets the analysed start field, motor/film factors and an
+        expansion factor that scales the window's drift)
       → window deck (apdl_like) → 15 backward-Euler steps of 4 s in the persistent session
       → T1..T5 and the nose drift per step (probes), fields at the window end
 
@@ -240,13 +241,17 @@ def replay_method(
             previous_nominal=previous_nominal,
             twin_state=TwinState(T, bc),
             measured_drift_um=None if measured_drift is None else measured_drift[upto],
+            measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
         )
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
             T = np.asarray(corr.state_C, dtype=float)
-        if corr.factors:  # model-form factors (motor, film groups) go into the deck's loads
-            bc = bc.scaled(corr.factors)
+        thermal_factors = {k: v for k, v in corr.factors.items() if k != "expansion"}
+        if thermal_factors:  # model-form factors (motor, film groups) go into the deck's loads
+            bc = bc.scaled(thermal_factors)
+        # an estimated expansion factor scales every α, hence the whole thermal displacement
+        expansion = float(corr.factors.get("expansion", 1.0))
         if corr.band_sd is not None:
             if band is None:
                 band = np.full((n_steps, 6), np.nan)
@@ -255,7 +260,7 @@ def replay_method(
         T = steps[-1]
         sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
         sim_T[sl.start + 1 : sl.stop + 1] = (model.sensor_matrix @ steps.T).T
-        drift[sl] = 1e6 * ((steps - T0) @ model.probe_vectors.T)
+        drift[sl] = 1e6 * expansion * ((steps - T0) @ model.probe_vectors.T)
         records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck))
         if field_step is not None and sl.start < field_step <= sl.stop:
             fields[STEP_S * field_step] = steps[field_step - sl.start - 1].copy()

@@ -238,6 +238,20 @@ def bearing_heat_density(spec: SpindleSpec, side: str, speed_rpm: float,
     return power / spec.bearing_volume_m3(side)
 
 
+def bearing_values(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or SpindleSpec
+                   T_bearings_C: float | tuple[float, float],
+                   T_sleeves_C: float | tuple[float, float] | None = None) -> dict[str, float]:
+    """Nominal H_front, H_rear (Eq. 1, W/m³) and R_front, R_rear (Eq. 4/5, m²K/W) at the
+    given outer-ring (and sleeve; default: the ring's) temperatures, °C."""
+    spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
+    T_b = _pair(T_bearings_C, math.nan)
+    T_s = _pair(T_sleeves_C, math.nan)
+    T_s = {k: (T_b[k] if math.isnan(v) else v) for k, v in T_s.items()}
+    out = {f"H_{s}": bearing_heat_density(spec, s, speed_rpm, T_b[s]) for s in SIDES}
+    out.update({f"R_{s}": contact_resistance(spec, s, T_b[s], T_s[s]) for s in SIDES})
+    return out
+
+
 def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN001
                        coolant_C: float | None = None,
                        T_bearings_C: float | tuple[float, float] | None = None,
@@ -254,12 +268,8 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
     spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
     check_operating_point(spec, speed_rpm, ambient_C, coolant_C)
     coolant = ambient_C if coolant_C is None else float(coolant_C)
-    T_b = _pair(T_bearings_C, ambient_C)
-    T_s = _pair(T_sleeves_C, math.nan)
-    T_s = {k: (T_b[k] if math.isnan(v) else v) for k, v in T_s.items()}
-
-    H = {s: bearing_heat_density(spec, s, speed_rpm, T_b[s]) for s in SIDES}
-    R = {s: contact_resistance(spec, s, T_b[s], T_s[s]) for s in SIDES}
+    values = bearing_values(spec, speed_rpm,
+                            ambient_C if T_bearings_C is None else T_bearings_C, T_sleeves_C)
 
     m = spec.motor
     loss = motor_loss_W(speed_rpm, rated_power_W=m.rated_power_W,
@@ -277,8 +287,7 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
         convection[name] = (h, coolant if conv.fluid == "coolant" else float(ambient_C))
 
     return BoundaryConditions(
-        speed_rpm=float(speed_rpm), ambient_C=float(ambient_C), coolant_C=coolant,
-        H_front=H["front"], H_rear=H["rear"], R_front=R["front"], R_rear=R["rear"],
+        speed_rpm=float(speed_rpm), ambient_C=float(ambient_C), coolant_C=coolant, **values,
         motor_heat=motor_heat, convection=convection,
         bearing_regions={s: spec.bearing_regions(s) for s in SIDES},
         interfaces={s: spec.bearings[s].interface for s in SIDES},
