@@ -36,6 +36,10 @@ def replay(
     ),
     resume: bool = typer.Option(False, "--resume", help="skip runs already finished"),
     quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
+    drift_assimilation: bool = typer.Option(
+        True, "--drift-assimilation/--no-drift-assimilation",
+        help="estimator: also update with the recorded axial drift where the run has it",
+    ),
 ) -> None:
     """Replay recorded runs through the twin and write fields, metrics and a report."""
     from rich.console import Console
@@ -84,6 +88,7 @@ def replay(
             snapshots=snapshots.value,
             resume=resume,
             progress=tell,
+            assimilate_drift=drift_assimilation,
         )
     build_report(out, rebuild_summary=False)
     for failure in result.failed:

@@ -173,10 +173,12 @@ class BpnnCorrection:
 
 
 def make_corrector(
-    name: str, model: object | str | Path | None = None, spindle: object | None = None
+    name: str, model: object | str | Path | None = None, spindle: object | None = None,
+    estimator_config: object | None = None,
 ) -> Corrector:
     """The correction method called `name`; `bpnn` needs a model (object or model-file path),
-    `estimator` the SpindleModel it filters with (`spindle`)."""
+    `estimator` the SpindleModel it filters with (`spindle`) and takes an optional
+    `twin.estimation.method.EstimatorConfig` (None: the defaults)."""
     if name == "open_loop":
         return OpenLoop()
     if name == "ratio":
@@ -192,7 +194,7 @@ def make_corrector(
     if name == "estimator":
         if spindle is None:
             raise ValueError("the estimator needs the spindle model")
-        from twin.estimation.method import EnsembleEstimator
+        from twin.estimation.method import EnsembleEstimator, EstimatorConfig
 
-        return EnsembleEstimator(spindle)
+        return EnsembleEstimator(spindle, estimator_config or EstimatorConfig())
     raise ValueError(f"unknown correction method {name!r}; expected one of {', '.join(METHODS)}")

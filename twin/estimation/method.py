@@ -4,8 +4,10 @@ What it estimates
     The twin's temperature field (every dof) and log-factors φ on nominal boundary values
     (`twin.estimation.parameters.DEFAULT_PARAMETERS`): bearing heat (front, rear), ring/sleeve
     contact resistance (front, rear), motor loss and the film coefficients of the rotor group
-    (rotor ends, shaft, nose, internal air).  The coolant, housing and air-gap film factors
-    are available (`EstimatorConfig.parameters`) but not estimated by default.
+    (rotor ends, shaft, nose, internal air), and an effective thermal-expansion factor
+    (every material's α; it scales the nose drift and moves no temperature, so only the
+    recorded drift updates it).  The coolant, housing and air-gap film factors are available
+    (`EstimatorConfig.parameters`) but not estimated by default.
 
 Why these (sensitivity and observability study, `python -m twin.estimation.sensitivity`,
 run with the twin model itself: 30 min from a cold start, T1..T5 and the axial drift every
@@ -29,9 +31,14 @@ run with the twin model itself: 30 min from a cold start, T1..T5 and the axial d
     the drift (0.5 µm against 1.3 and 6.2).  On emulated runs with model-form error, the
     nine-parameter filter drove exactly that v7 direction to motor ≈ 1.4–2.0, coolant film
     ≈ 1.3–1.7 (truths 0.9–1.25 and 0.8–0.95): sensor fits to 0.1 K, drift 5–10 % worse.
-    Conductivity and expansion multipliers are not estimated: conductivity is nearly
-    collinear with the contact and film factors in T1..T5, and expansion moves no
-    temperature at all (it scales the drift only, which the filter does not assimilate).
+    Conductivity is not estimated: it is nearly collinear with the contact and film factors
+    in T1..T5.  Expansion moves no temperature: with T1..T5 alone it is unobservable and
+    keeps its prior (±5 %, which then widens the drift band); with the recorded drift it is
+    the one factor the drift pins down beyond what T1..T5 already fix (its sensitivity is
+    the drift itself, 5–18 µm per unit log-factor, against a probe noise of 0.05–0.3 µm),
+    and it absorbs what else scales the drift uniformly (conductivity, the structural
+    model).  The drift also sharpens the rotor film and motor loss (v7 above: the shaft,
+    which no thermocouple sees, carries 6.2 µm per unit log-factor of rotor film).
 
 The filter (Evensen 2009; REFERENCE.md §7)
     Ensemble of N members (default 24) as mean + anomalies of [T; φ] (`ensemble`; the
@@ -40,8 +47,12 @@ The filter (Evensen 2009; REFERENCE.md §7)
     T1..T5 averaged over three 20 s bins: 15 observations; invalid samples — dead, stuck,
     dropped out per the data-quality check — are left out), updating field and log-factors
     through their ensemble covariance with the predicted sensor values inside the window;
-    if the speed changed inside that window (after its loads were fixed), the misfit is
-    the unforeseen input and only the field is updated, the log-factors keep their forecast;
+    if the speed changed inside that window (after its loads were fixed), that window is
+    first re-run from its start field with the recorded speed from the change on (all of it
+    measured before the window now starting), so neither the innovations nor the analysed
+    field carry the unforeseen input (`speed_change_s`, `_rerun`); the loop's nominal
+    bearing heat and contact resistance are re-evaluated at the analysed field's
+    temperatures (Palmgren's viscosity follows the ring);
     (2) random walk of the log-factors (seeded draws: a replay is deterministic), spread
     capped at the prior, mean clipped to the bounds; (3) forecast of the next window
     (`forecast`): the mean by the FEM with the mean factors, members tangent-linear on one
@@ -60,18 +71,34 @@ Deck, analysed state and members
     reported twin trajectory exactly.  The members never appear in decks: each is the mean
     plus a tangent-linear anomaly, and only their spread is reported (the 90 % band).
 
-Drift (optional)
-    With `assimilate_drift` the recorded axial nose drift (three 20 s bins per window) joins
-    the update, its error σ² = drift_model_sd_um² + (drift_rel_sd·drift)² + noise.  Off by
-    default (see EstimatorConfig); `make bench` reports both.
+Drift (default where recorded)
+    The recorded axial nose drift (three 20 s bins per window, valid samples only) joins the
+    update, its error σ² = drift_model_sd_um² + (drift_rel_sd·drift)² + noise; the members'
+    drift is e^φα·w·(T − T₀) with the expansion factor φα, and the loop scales each window's
+    displacements by the estimated e^φα.  Window k's drift is then a 0–60 s forecast from
+    the drift measured up to 60k s (causal).  A run without a drift column, or whose drift
+    the quality check rejects, is filtered on T1..T5 alone with no switch needed;
+    `EstimatorConfig(assimilate_drift=False)` always filters on T1..T5 alone (the twin then
+    predicts the drift from temperatures, as on a machine without probes).  `make bench`
+    and the README report both.
 
 Band
     Per solver step, ±1.645 σ around the mean: σ² = member variance of the sensor value +
-    model error (`model_sd_C`) + sensor noise; for the drift, the member variance + the
-    expansion uncertainty the filter cannot see (`drift_rel_sd` of the drift) + probe noise.
+    a model-plus-noise variance; for the drift, the member variance (field and expansion
+    factor) + the structural model's error (`drift_rel_sd` of the drift) + its own
+    model-plus-noise variance.  Those two variances start at model_sd_C² + sensor_sd_C² and
+    drift_model_sd_um² + drift_noise_um² and follow the run: after each window, the mean
+    squared misfit of the reported twin to the samples just measured, less the members'
+    variance, is blended in with weight `band_learning_rate` (causal: measured before the
+    window starts).  The whole band is then scaled by an adaptive conformal step (Gibbs &
+    Candès 2021, "Adaptive conformal inference under distribution shift"): after each
+    window, × exp(band_scale_rate·(share of its samples outside − 0.1)), separately for
+    T1..T5 and the drift.  With a fixed model error a quiet run (0.02 K noise) was covered
+    100 % and a rough one 80 %; with both steps the suites' runs sit at 89–91 %.
 
-Stops: at 0 rpm the bearing and motor heat are zero, so their factors have no effect and
-are not updated (their spread is capped at the prior); the films and the field go on.
+Stops: at 0 rpm the bearing and motor heat are zero, so their factors have no effect; a
+stopped window's analysis keeps their mean and spread (what would move them is only
+correlation left from before the stop); the films and the field go on.
 """
 
 from __future__ import annotations
@@ -90,6 +117,7 @@ from twin.estimation.forecast import WindowForecast, forecast_window
 from twin.estimation.parameters import (
     BOUNDARY_VALUES,
     DEFAULT_PARAMETERS,
+    DRIFT_ONLY,
     TangentOperators,
     apply_factors,
     factors_of,
@@ -139,8 +167,20 @@ class EstimatorConfig:
     its disp_z_um column measured before the window starts): the drift of window k is then
     a 0–60 s forecast from the drift measured up to 60k s, and the expansion factor is
     estimated.  A run without a drift column, or with its drift invalid, is filtered on
-    T1..T5 alone.  False: always T1..T5 alone (`twin replay --no-drift-assimilation`)."""
+    T1..T5 alone.  False: always T1..T5 alone (the twin predicts the drift from
+    temperatures, as on a machine without probes)."""
     drift_model_sd_um: float = 0.2
+    band_learning_rate: float = 0.3
+    """Weight of the window just ended in the band's model-plus-noise variance (the running
+    value starts at model_sd_C² + sensor_sd_C², drift_model_sd_um² + drift_noise_um²;
+    0: fixed there)."""
+    band_scale_rate: float = 2.0
+    """Adaptive conformal step of the band's width: × exp(rate·(missed share − 0.1)) after
+    each window (0: no feedback)."""
+    band_floor_C: float = 0.02
+    """Least model-plus-noise spread of the T1..T5 band, °C."""
+    band_floor_um: float = 0.05
+    """Least model-plus-noise spread of the drift band, µm."""
     """Model error of a predicted drift bin, µm (besides drift_rel_sd of the drift)."""
 
 
@@ -157,6 +197,9 @@ class EnsembleEstimator:
     _rng: np.random.Generator | None = field(default=None, init=False, repr=False)
     _drift_start_um: float = field(default=0.0, init=False, repr=False)
     _forecast_speed_rpm: float = field(default=0.0, init=False, repr=False)
+    _band_var: np.ndarray | None = field(default=None, init=False, repr=False)
+    _band_scale: np.ndarray | None = field(default=None, init=False, repr=False)
+    _band_sd_used: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._params = parameters(self.config.parameters)
@@ -185,11 +228,15 @@ class EnsembleEstimator:
         if f.window == 0 or self._ensemble is None:
             self._rng = np.random.default_rng(cfg.seed)
             self._drift_start_um = float(self._drift_um @ f.twin_state.field_C)
+            self._band_var = np.array([cfg.model_sd_C**2 + cfg.sensor_sd_C**2,
+                                       cfg.drift_model_sd_um**2 + cfg.drift_noise_um**2])
+            self._band_scale = np.ones(2)
             self._ensemble = Ensemble.initial(
                 f.twin_state.field_C, cfg.initial_field_sd_C, self._prior_sd, cfg.members,
                 self._rng,
             )
         else:
+            self._calibrate_band(f)
             with threadpool_limits(1):
                 self._ensemble = self._analysis(f)
         ens = self._ensemble
@@ -214,9 +261,10 @@ class EnsembleEstimator:
                 ens, self._sensors, self._drift_um, cfg.steps_per_window,
             )
         extra = {k: v for k, v in factors.items() if k not in BOUNDARY_VALUES}
+        self._band_sd_used = self._band_sd(self._forecast)
         return Correction.relative_to(
             (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
-            factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd(self._forecast),
+            factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
         )
 
     # ------------------------------------------------------------------ steps
@@ -258,6 +306,7 @@ class EnsembleEstimator:
             rate = np.abs(read[b[-1]] - read[b[0]]) / max(hi - lo - cfg.step_s, cfg.step_s)
             sd.append(np.sqrt(cfg.model_sd_C**2 + (cfg.lag_sd_s * rate) ** 2
                               + cfg.sensor_sd_C**2 / np.maximum(counts, 1)))
+        drift_seen = False
         if cfg.assimilate_drift and f.measured_drift_um is not None:
             drift, drift_anom = self._drift_forecast(fc)
             for i, b in enumerate(bins):
@@ -265,6 +314,7 @@ class EnsembleEstimator:
                 m, counts = bin_mean(t_meas, np.asarray(f.measured_drift_um, float)[:, None],
                                      lo, hi)
                 observed.append(np.where(counts >= 2, m, np.nan))
+                drift_seen |= bool(counts[0] >= 2)
                 y_mean.append(drift[b].mean(keepdims=True))
                 y_anom.append(0.5 * (drift_anom[i] + drift_anom[i + 1])[None, :])
                 sd.append(np.sqrt(cfg.drift_model_sd_um**2 + (cfg.drift_rel_sd * m) ** 2
@@ -276,12 +326,17 @@ class EnsembleEstimator:
         )
         n = end.field_mean.size
         mean[:n] = prior_mean[:n] + cfg.field_update * (mean[:n] - prior_mean[:n])
+        held = set()
         if self._forecast_speed_rpm == 0.0 and changed_s is None:
             # a stopped window: no bearing or motor heat, so the data say nothing about
             # their factors; what would move them is correlation left from before the stop
-            held = [n + i for i, name in enumerate(cfg.parameters) if name in HEAT_FACTORS]
-            mean[held] = prior_mean[held]
-            anomalies[held] = end.log_factor_anomalies[[h - n for h in held]]
+            held |= HEAT_FACTORS
+        if not drift_seen:
+            held |= DRIFT_ONLY  # nothing but the drift sees the expansion factor
+        rows = [i for i, name in enumerate(cfg.parameters) if name in held]
+        if rows:
+            mean[[n + i for i in rows]] = prior_mean[[n + i for i in rows]]
+            anomalies[[n + i for i in rows]] = end.log_factor_anomalies[rows]
         if changed_s is None and abs(f.speed_rpm - self._forecast_speed_rpm) > 0.5:
             # a speed change without the speed history to re-run it (features from another
             # caller): the misfit is the unforeseen input, not wrong factors.  The field
@@ -339,12 +394,60 @@ class EnsembleEstimator:
         return scale * rise, scale * (anomalies + np.outer(rise_members, dphi))
 
     def _band_sd(self, fc: WindowForecast) -> np.ndarray:
-        cfg = self.config
         drift, drift_anom = self._drift_forecast(fc)
         var_T, var_d = fc.spread_at_steps(drift_anom)
-        sd_T = np.sqrt(var_T + cfg.model_sd_C**2 + cfg.sensor_sd_C**2)
-        sd_d = np.sqrt(var_d + (cfg.drift_rel_sd * drift) ** 2 + cfg.drift_noise_um**2)
+        sd_T = self._band_scale[0] * np.sqrt(var_T + self._band_var[0])
+        sd_d = self._band_scale[1] * np.sqrt(
+            var_d + (self.config.drift_rel_sd * drift) ** 2 + self._band_var[1])
         return np.column_stack([sd_T, sd_d])
+
+    def _calibrate_band(self, f: WindowFeatures) -> None:
+        """Update the band's model-plus-noise variance (T1..T5, drift) from the window just
+        ended: the mean of (measured − reported twin)² less the ensemble's own variance,
+        over its valid samples, blended into the running value with weight
+        `band_learning_rate`.  A fixed model error made the band of a quiet run (0.02 K
+        noise, twin within 0.05 K) cover 100 % and that of a rough one too little."""
+        cfg = self.config
+        fc = self._forecast
+        t = np.asarray(f.measured_time_s, float)
+        rows = t > f.start_s - cfg.window_s + 1e-9
+        if not rows.any():
+            return
+        sim_t = np.asarray(f.simulated_time_s, float)[-cfg.steps_per_window - 1:]
+        sim_C = np.asarray(f.simulated_C, float)[-cfg.steps_per_window - 1:]
+        var_T, var_d = fc.spread_at_steps(self._drift_forecast(fc)[1])
+        var_T = np.vstack([var_T[:1], var_T])  # the window start: as its first step
+        tm = t[rows]
+        twin = np.column_stack([np.interp(tm, sim_t, sim_C[:, j]) for j in range(sim_C.shape[1])])
+        spread = np.column_stack([np.interp(tm, sim_t, var_T[:, j]) for j in range(5)])
+        excess = (np.asarray(f.measured_C, float)[rows] - twin) ** 2 - spread
+        a = cfg.band_learning_rate
+        # adaptive conformal step (Gibbs & Candès 2021): widen after a window whose band
+        # missed more than 10 % of its samples, narrow after one that missed fewer
+        used = self._band_sd_used
+        band_sd = np.column_stack([np.interp(tm, sim_t[1:], used[:, j]) for j in range(6)])
+        miss_T = np.abs(np.asarray(f.measured_C, float)[rows] - twin) > BAND_Z * band_sd[:, :5]
+        valid_T = np.isfinite(np.asarray(f.measured_C, float)[rows])
+        if valid_T.any():
+            miss = float(miss_T[valid_T].mean())
+            self._band_scale[0] *= np.exp(cfg.band_scale_rate * (miss - 0.1))
+        if np.isfinite(excess).any():
+            self._band_var[0] = (1 - a) * self._band_var[0] + a * max(
+                float(np.nanmean(excess)), cfg.band_floor_C**2)
+        if f.measured_drift_um is not None:
+            drift, _ = self._drift_forecast(fc)
+            d_t = sim_t[1:]
+            twin_d = np.interp(tm, d_t, drift)
+            var_d_t = np.interp(tm, d_t, var_d)
+            dm = np.asarray(f.measured_drift_um, float)[rows]
+            e = (dm - twin_d) ** 2 - var_d_t
+            ok = np.isfinite(dm)
+            if ok.any():
+                miss = float((np.abs(dm - twin_d) > BAND_Z * band_sd[:, 5])[ok].mean())
+                self._band_scale[1] *= np.exp(cfg.band_scale_rate * (miss - 0.1))
+            if np.isfinite(e).any():
+                self._band_var[1] = (1 - a) * self._band_var[1] + a * max(
+                    float(np.nanmean(e)), cfg.band_floor_um**2)
 
 
 def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None:

@@ -27,6 +27,7 @@ class ReplayJob:
     methods: tuple[str, ...]
     model_path: str | None
     snapshots: str
+    assimilate_drift: bool = True  # the estimator's (twin.estimation.method.EstimatorConfig)
 
 
 @dataclass
@@ -49,7 +50,7 @@ def run_job(job: ReplayJob, spindle=None, overlap: bool = False) -> dict:  # noq
     try:
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
-            spindle=spindle, overlap=overlap,
+            spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -78,6 +79,7 @@ def replay_batch(
     snapshots: str = "none",
     resume: bool = False,
     progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
+    assimilate_drift: bool = True,
 ) -> BatchResult:
     """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
 
@@ -103,14 +105,15 @@ def replay_batch(
     todo: list[ReplayJob] = []
     for path, name in named:
         if resume:
-            finished = _finished(out_root / name, path, methods, model_path)
+            finished = _finished(out_root / name, path, methods, model_path, assimilate_drift)
             if finished is not None:
                 result.accuracies.append(finished)
                 result.skipped.append(name)
                 if progress:
                     progress(name, "skipped")
                 continue
-        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots))
+        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
+                              assimilate_drift))
 
     for outcome in _execute(todo, jobs, dask_address, progress):
         if "ok" in outcome:
@@ -124,11 +127,11 @@ def replay_batch(
 
 
 def _finished(out_dir: Path, path: str, methods: Sequence[str],
-              model_path: str | None) -> dict | None:
+              model_path: str | None, assimilate_drift: bool = True) -> dict | None:
     """The accuracy of a run folder --resume may keep, or None: replay it (again) when its
     token does not match or its accuracy.json is missing or unreadable."""
     try:
-        if not is_done(out_dir, resume_token(path, methods, model_path)):
+        if not is_done(out_dir, resume_token(path, methods, model_path, assimilate_drift)):
             return None
     except OSError:
         return None

@@ -61,9 +61,12 @@ def run_name(path: str | Path) -> str:
     return name
 
 
-def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None) -> dict:
+def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None,
+                 assimilate_drift: bool = True) -> dict:
     """What must match for a finished run folder to be reused by --resume."""
     token = {"input_sha256": file_digest(path), "methods": list(methods)}
+    if "estimator" in methods:
+        token["estimator_assimilate_drift"] = bool(assimilate_drift)
     if "bpnn" in methods and model_path is not None:
         token["model_sha256"] = file_digest(model_path)
     return token
@@ -89,8 +92,10 @@ def replay_run_to_dir(
     spindle=None,  # noqa: ANN001 - a loaded SpindleModel to reuse, or None
     on_window: Callable[[str, int, int], None] | None = None,
     overlap: bool = True,
+    assimilate_drift: bool = True,
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
+    `assimilate_drift`: the estimator's option (twin.estimation.method.EstimatorConfig).
 
     The folder DIR/<run-name>/ is replaced as a whole (`replaced_folder`): a shorter rerun
     leaves none of the longer run's files, and a failed one leaves no earlier result.
@@ -102,11 +107,11 @@ def replay_run_to_dir(
         raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
     with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
         return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
-                            on_window, overlap)
+                            on_window, overlap, assimilate_drift)
 
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                 on_window, overlap: bool) -> dict:  # noqa: ANN001
+                 on_window, overlap: bool, assimilate_drift: bool = True) -> dict:  # noqa: ANN001
     from twin.io.figures import load_matplotlib
     from twin.loop.report import render_run_plots
 
@@ -117,7 +122,7 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
     # solve (it imports matplotlib meanwhile) and the field files (it draws meanwhile)
     with ForkedTask(draw_plots, prepare=load_matplotlib, fork=overlap) as plots:
         accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
-                                          spindle, on_window, plots)
+                                          spindle, on_window, plots, assimilate_drift)
         plots.join()
     write_json(out_dir / "accuracy.json", accuracy)
     write_json(out_dir / DONE_FILE, token)
@@ -125,19 +130,23 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
 
 
 def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                    on_window, plots: ForkedTask) -> tuple[dict, dict]:  # noqa: ANN001
+                    on_window, plots: ForkedTask,
+                    assimilate_drift: bool = True) -> tuple[dict, dict]:  # noqa: ANN001
     """Replay and write every file but accuracy.json and the .done token; `plots` is
     started once keypoints.csv and corrections.csv (what the figures show) are written."""
     from twin.correction.methods import make_corrector
+    from twin.estimation.method import EstimatorConfig
     from twin.runs import read_run, write_quality
     from twin.spindle.model import SpindleModel
 
     model = spindle if spindle is not None else SpindleModel.load()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
-    token = resume_token(run_path, methods, model_path)
-
+    token = resume_token(run_path, methods, model_path, assimilate_drift)
+    config = EstimatorConfig(assimilate_drift=assimilate_drift)
     correctors = [
-        make_corrector(m, model_path if m == "bpnn" else None, spindle=model) for m in methods
+        make_corrector(m, model_path if m == "bpnn" else None, spindle=model,
+                       estimator_config=config)
+        for m in methods
     ]
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
