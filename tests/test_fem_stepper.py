@@ -1,5 +1,6 @@
 """twin.fem.stepper's general θ-method (theta_step, picard, march_to) on systems whose exact
-solution is known: a lumped body cooling or heating, C dT/dt + K T = f."""
+solution is known (a lumped body cooling or heating, C dT/dt + K T = f), and against the
+factorized ThermalStepper of the same system."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ import math
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
-from twin.fem import stepper
+from twin.fem import AxiMesh, Material, ThermalLoads, ThermalProblem, stepper
 from twin.fem.stepper import StepControl, SteppingError, ThetaSystem, theta_step
 
 C_J_K, K_W_K, T_INF_C = 400.0, 2.0, 20.0  # one lumped body: time constant C/K = 200 s
@@ -79,3 +81,24 @@ def test_march_to_refuses_too_many_substeps():
     n = stepper.MAX_SUBSTEPS
     with pytest.raises(SteppingError, match=f"more than {n} substeps"):
         stepper.march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 1.0, 1.0 / (n + 10))
+
+
+@pytest.mark.parametrize("theta", [0.5, 1.0])
+def test_thermal_stepper_is_theta_step_with_fixed_operators(theta):
+    """ThermalProblem.transient's factorized stepper and theta_step on the problem's own K,
+    C and f are the same θ-method: equal to round-off over ten steps (a heated disk cooled
+    by a film, no prescribed temperature)."""
+    mesh = AxiMesh.structured(np.linspace(0.0, 0.05, 11), np.linspace(0.0, 0.02, 5),
+                              boundaries={"rim": lambda r, z: np.isclose(r, 0.05)})
+    problem = ThermalProblem(mesh, {"body": Material(k=50.0, rho=7800.0, c=460.0)})
+    loads = ThermalLoads(sources={"body": 2e6}, convection={"rim": (500.0, 20.0)})
+    k_data, f = problem.system(loads)
+    system = ThetaSystem(problem.ops.csr(k_data), problem.ops.csr(problem.capacity_data), f)
+    dt, T0 = 5.0, np.full(problem.n_dofs, 20.0)
+    fixed = list(problem.transient(loads, dt, theta=theta).march(T0, 10))
+    T = T0
+    for T_fixed in fixed:
+        T = theta_step(T, dt, theta, system, lambda T1: system,
+                       lambda A, rhs: spla.spsolve(A.tocsc(), rhs), False)
+        assert np.abs(T - T_fixed).max() < 1e-9 * np.abs(T_fixed - 20.0).max()
+    assert fixed[-1].max() > 21.0  # the disk did heat up
