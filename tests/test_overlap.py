@@ -21,24 +21,26 @@ def _write_pid(path: Path) -> None:
 @needs_fork
 def test_task_runs_in_a_child_after_start_and_sees_files_written_before(tmp_path):
     prepared = tmp_path / "prepared"
-    source, done = tmp_path / "source.txt", tmp_path / "done.txt"
-    def task() -> str:
-        done.write_text(source.read_text().upper())
+    source = tmp_path / "source.txt"
+
+    def task(name: str) -> str:
+        (tmp_path / name).write_text(source.read_text().upper())
         return f"pid {os.getpid()}: ünïcode"
 
     with ForkedTask(task, prepare=lambda: _write_pid(prepared)) as side:
-        assert side.forked
+        assert side.forked and side.fresh
         source.write_text("written after the fork")  # the task reads it only after start
-        side.start()
+        side.start("dône.txt")  # chosen after the fork too
+        assert not side.fresh
         reply = side.join()
-    assert done.read_text() == "WRITTEN AFTER THE FORK"
+    assert (tmp_path / "dône.txt").read_text() == "WRITTEN AFTER THE FORK"
     assert reply == f"pid {prepared.read_text()}: ünïcode"
     assert int(prepared.read_text()) != os.getpid()
 
 
 @needs_fork
 def test_a_failing_task_raises_in_the_parent_with_its_message(tmp_path):
-    def fail() -> None:
+    def fail(_: str) -> None:
         raise ValueError("no keypoints.csv in the run folder")
 
     side = ForkedTask(fail)
@@ -54,7 +56,7 @@ def test_a_failing_preparation_fails_the_task(tmp_path):
 
     done = tmp_path / "done"
     with pytest.raises(ForkedTaskError, match="ImportError: matplotlib is missing"):
-        with ForkedTask(lambda: done.write_text("x") and None, prepare=prepare) as side:
+        with ForkedTask(lambda _: done.write_text("x") and None, prepare=prepare) as side:
             side.start()
     assert not done.exists()
 
@@ -62,7 +64,7 @@ def test_a_failing_preparation_fails_the_task(tmp_path):
 @needs_fork
 def test_a_task_returning_no_text_is_an_error_forked_or_not():
     for fork in (True, False):
-        side = ForkedTask(lambda: 42, fork=fork)
+        side = ForkedTask(lambda _: 42, fork=fork)
         with pytest.raises((ForkedTaskError, TypeError), match="text or None, not int"):
             side.start()
             side.join()
@@ -72,24 +74,24 @@ def test_a_task_returning_no_text_is_an_error_forked_or_not():
 def test_a_task_never_started_never_runs_and_the_parents_error_passes(tmp_path):
     done = tmp_path / "done"
     with pytest.raises(KeyError, match="parent failed"):
-        with ForkedTask(lambda: done.write_text("x")) as side:
+        with ForkedTask(lambda _: done.write_text("x")) as side:
             pid = side._pid
             raise KeyError("parent failed")
-    assert not done.exists()
+    assert not done.exists() and not side.fresh
     with pytest.raises(ChildProcessError):  # reaped: no zombie left behind
         os.waitpid(pid, os.WNOHANG)
 
 
 def test_without_fork_start_runs_prepare_and_task_here_in_order(tmp_path):
     calls = []
-    side = ForkedTask(lambda: calls.append(("task", os.getpid())) or "done",
+    side = ForkedTask(lambda arg: calls.append(("task", arg, os.getpid())) or "done",
                       prepare=lambda: calls.append(("prepare", os.getpid())), fork=False)
     assert not side.forked
     assert calls == []
-    side.start()
-    assert calls == [("prepare", os.getpid()), ("task", os.getpid())]
+    side.start("run folder")
+    assert calls == [("prepare", os.getpid()), ("task", "run folder", os.getpid())]
     assert side.join() == "done"
-    with pytest.raises(RuntimeError, match="started already"):
+    with pytest.raises(RuntimeError, match="started or ended already"):
         side.start()
 
 

@@ -44,8 +44,7 @@ def replay(
     """Replay recorded runs through the twin and write fields, metrics and a report."""
     from rich.console import Console
 
-    from twin.loop.batch import replay_batch
-    from twin.loop.report import build_report
+    from twin.loop.report import build_report, run_plotter
     if dask and jobs > 1:
         raise InputError("use either --jobs or --dask, not both", column="--dask")
     chosen = methods.split(",")
@@ -62,9 +61,13 @@ def replay(
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    # the first run's figures are drawn by a child forked now, which loads matplotlib on
+    # the idle core while this process imports the solver (a batch run by worker processes
+    # or dask draws in those)
+    in_this_process = not dask and (jobs <= 1 or len(paths) <= 1)
     # redrawn when a run finishes, not by rich's refresh thread: a process running no other
-    # thread may fork (twin.loop.overlap draws the figures in a forked child)
-    with Progress(
+    # thread may fork (twin.loop.overlap)
+    with run_plotter(fork=in_this_process) as plotter, Progress(
         TextColumn("{task.description}"),
         BarColumn(),
         TextColumn("{task.fields[status]}"),
@@ -73,6 +76,8 @@ def replay(
         disable=quiet,
         auto_refresh=False,
     ) as progress:
+        from twin.loop.batch import replay_batch
+
         tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="") for p in paths}
 
         def tell(name: str, status: str) -> None:
@@ -89,6 +94,7 @@ def replay(
             resume=resume,
             progress=tell,
             assimilate_drift=drift_assimilation,
+            plotter=plotter if in_this_process else None,
         )
     build_report(out, rebuild_summary=False)
     for failure in result.failed:

@@ -16,6 +16,7 @@ from pathlib import Path
 from twin.errors import InputError
 from twin.io.atomic import write_json
 from twin.loop.folders import folder_lock, remove_orphans
+from twin.loop.overlap import ForkedTask
 from twin.loop.runfiles import is_done, replay_run_to_dir, resume_token, run_name
 from twin.loop.summary import collect_summary, read_accuracy
 
@@ -43,14 +44,16 @@ class BatchResult:
         return 2 if self.failed else 0
 
 
-def run_job(job: ReplayJob, spindle=None, overlap: bool = False) -> dict:  # noqa: ANN001
+def run_job(job: ReplayJob, spindle=None, overlap: bool = False,  # noqa: ANN001
+            plotter: ForkedTask | None = None) -> dict:
     """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
-    spindle for this run), with forked helpers on the spare core if `overlap`; never
-    raises: returns {"ok": accuracy} or {"error": ...}."""
+    spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`:
+    see `replay_run_to_dir`); never raises: returns {"ok": accuracy} or {"error": ...}."""
     try:
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
             spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
+            plotter=plotter,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -80,12 +83,15 @@ def replay_batch(
     resume: bool = False,
     progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
     assimilate_drift: bool = True,
+    plotter: ForkedTask | None = None,
 ) -> BatchResult:
     """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
 
     Batches may write into one folder at once: each run folder is swapped in whole and
     summary.json is rebuilt from the folders under the folder's lock, so no finished run
     goes missing from it.  Temporary files of killed earlier batches are removed first.
+    plotter: a `twin.loop.report.run_plotter` forked earlier, for the first run replayed
+    in this process (not used by worker processes or dask).
     """
     out_root = Path(out_root)
     out_root.mkdir(parents=True, exist_ok=True)
@@ -115,7 +121,7 @@ def replay_batch(
         todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
                               assimilate_drift))
 
-    for outcome in _execute(todo, jobs, dask_address, progress):
+    for outcome in _execute(todo, jobs, dask_address, progress, plotter):
         if "ok" in outcome:
             result.accuracies.append(outcome["ok"])
         else:
@@ -138,7 +144,8 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
     return read_accuracy(out_dir / "accuracy.json")
 
 
-def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress):  # noqa: ANN001, ANN202
+def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202
+             plotter: ForkedTask | None):
     if dask_address:
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
@@ -158,7 +165,7 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
 
         spindle = SpindleModel.load() if todo else None
         for job in todo:
-            outcome = run_job(job, spindle, overlap=True)
+            outcome = run_job(job, spindle, overlap=True, plotter=plotter)
             _tell(progress, outcome)
             yield outcome
         return

@@ -2,14 +2,15 @@
 
     with ForkedTask(task, prepare) as side:   # forks now; the child runs prepare()
         ...                                   # the parent works meanwhile
-        side.start()                          # task's inputs are ready: the child runs task()
+        side.start(argument)                  # inputs ready: the child runs task(argument)
         ...                                   # the parent goes on with other work
         text = side.join()                    # waits; task's result, or raises if it failed
 
 The child is forked early so that it can `prepare` (import matplotlib, say) while the
 parent works, and it holds a copy of the parent's memory, so the task needs no pickling:
-it is any callable, and it reads what it needs from that copy or from files the parent
-wrote before `start`.  What it returns (text or None) comes back from `join`, as text
+it is any callable, and it reads what it needs from that copy, from files the parent
+wrote before `start` and from the text `start` passes on (a path, say, decided after the
+fork).  What it returns (text or None) comes back from `join`, as text
 through a pipe (UTF-8: again no pickling).  Its failure comes back as a `ForkedTaskError`
 from `join` (the message of the child's exception; the child writes nothing to stdout or
 stderr).  Leaving the `with` block without `start` (the parent failed) kills the child,
@@ -52,7 +53,7 @@ def fork_is_safe() -> bool:
 class ForkedTask:
     """`task()` in a forked child once `start` is called; see the module doc."""
 
-    def __init__(self, task: Callable[[], str | None],
+    def __init__(self, task: Callable[[str], str | None],
                  prepare: Callable[[], object] | None = None, fork: bool = True) -> None:
         self._task, self._prepare = task, prepare
         self._value: str | None = None
@@ -66,6 +67,11 @@ class ForkedTask:
     def forked(self) -> bool:
         return self._pid is not None
 
+    @property
+    def fresh(self) -> bool:
+        """Neither started nor ended: `start` may still be called."""
+        return not (self._started or self._joined)
+
     def _fork(self) -> None:
         go_r, go_w = os.pipe()
         result_r, result_w = os.pipe()
@@ -78,17 +84,18 @@ class ForkedTask:
         os.close(result_w)
         self._pid, self._go, self._result = pid, go_w, result_r
 
-    def start(self) -> None:
-        """The task's inputs are ready: run it (in the child, or here without a child)."""
-        if self._started:
-            raise RuntimeError("the task was started already")
+    def start(self, argument: str = "") -> None:
+        """The task's inputs are ready: run task(argument) (in the child, or here without a
+        child)."""
+        if not self.fresh:
+            raise RuntimeError("the task was started or ended already")
         self._started = True
         if self._pid is None:
             if self._prepare is not None:
                 self._prepare()
-            self._value = _checked(self._task())
+            self._value = _checked(self._task(argument))
             return
-        os.write(self._go, _GO)
+        _write_all(self._go, _GO + argument.encode())
         os.close(self._go)
         self._go = -1
 
@@ -104,15 +111,12 @@ class ForkedTask:
             os.kill(self._pid, signal.SIGKILL)
             os.close(self._go)
             self._go = -1
-        chunks = []
-        while chunk := os.read(self._result, 1 << 16):
-            chunks.append(chunk)
+        reply = _read_all(self._result)
         os.close(self._result)
         _, status = os.waitpid(self._pid, 0)
         code = os.waitstatus_to_exitcode(status)
         if not self._started:
             return None
-        reply = b"".join(chunks)
         if code != 0 or reply[:1] != _DONE:
             message = reply[1:].decode(errors="replace") if reply[:1] == _FAILED else ""
             raise ForkedTaskError(message or f"the forked task ended with exit code {code}")
@@ -133,7 +137,7 @@ class ForkedTask:
             pass
 
 
-def _child(prepare: Callable[[], object] | None, task: Callable[[], str | None],
+def _child(prepare: Callable[[], object] | None, task: Callable[[str], str | None],
            go: int, result: int) -> None:
     """The forked child's whole life; ends the process with os._exit (no cleanup of the
     parent's state: its buffers, atexit handlers and `finally` blocks are the parent's)."""
@@ -145,12 +149,13 @@ def _child(prepare: Callable[[], object] | None, task: Callable[[], str | None],
                 prepare()
             except BaseException as exc:  # noqa: BLE001 - reported if the task is wanted
                 failure = exc
-        if os.read(go, 1) != _GO:  # the parent ended without start: not wanted
+        message = _read_all(go)
+        if message[:1] != _GO:  # the parent ended without start: not wanted
             code = 0
             return
         if failure is not None:
             raise failure
-        value = _checked(task())
+        value = _checked(task(message[1:].decode()))
         _write_all(result, _DONE + (_NONE if value is None else _TEXT + value.encode()))
         code = 0
     except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
@@ -167,6 +172,14 @@ def _checked(value: object) -> str | None:
     if value is not None and not isinstance(value, str):
         raise TypeError(f"a forked task returns text or None, not {type(value).__name__}")
     return value
+
+
+def _read_all(fd: int) -> bytes:
+    """Everything until the writer closes the pipe."""
+    chunks = []
+    while chunk := os.read(fd, 1 << 16):
+        chunks.append(chunk)
+    return b"".join(chunks)
 
 
 def _write_all(fd: int, data: bytes) -> None:

@@ -18,10 +18,11 @@ import numpy as np
 
 from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.io.atomic import write_bytes, write_json, write_text
-from twin.io.figures import new_figure, png_bytes
+from twin.io.figures import load_matplotlib, new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
 from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
+from twin.loop.overlap import ForkedTask
 from twin.loop.summary import collect_summary, run_folder
 
 METHOD_COLORS = {
@@ -141,6 +142,16 @@ def render_run_plots(run_dir: Path) -> list[Path]:
         write_bytes(run_dir / "plots" / name, png)
         for name, png in zip(PLOTS, out, strict=True)
     ]
+
+
+def run_plotter(fork: bool = True) -> ForkedTask:
+    """A forked child that imports matplotlib now and draws one run's figures once started
+    with the run folder (`start(str(run_dir))`, when keypoints.csv and corrections.csv are
+    written); without fork (`fork=False`, or where it is unsafe) `start` draws them here."""
+    def draw(run_dir: str) -> None:
+        render_run_plots(Path(run_dir))
+
+    return ForkedTask(draw, prepare=load_matplotlib, fork=fork)
 
 
 def _image(png: Path) -> dict[str, str]:

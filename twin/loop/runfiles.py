@@ -93,6 +93,7 @@ def replay_run_to_dir(
     on_window: Callable[[str, int, int], None] | None = None,
     overlap: bool = True,
     assimilate_drift: bool = True,
+    plotter: ForkedTask | None = None,
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
     `assimilate_drift`: the estimator's option (twin.estimation.method.EstimatorConfig).
@@ -102,25 +103,26 @@ def replay_run_to_dir(
     overlap: use a second core through forked children (`twin.loop.overlap`) for part of
     the methods and for the figures; the outputs are the same either way.  A batch whose
     workers already fill the cores turns it off.
+    plotter: a `twin.loop.report.run_plotter` forked earlier (by the CLI, before its heavy
+    imports, so that matplotlib loads on the idle core); used if still fresh, else this
+    run forks its own.
     """
     if snapshots not in SNAPSHOT_CHOICES:
         raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
     with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
         return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
-                            on_window, overlap, assimilate_drift)
+                            on_window, overlap, assimilate_drift, plotter)
 
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                 on_window, overlap: bool, assimilate_drift: bool = True) -> dict:  # noqa: ANN001
-    from twin.io.figures import load_matplotlib
-    from twin.loop.report import render_run_plots
-
-    def draw_plots() -> None:
-        render_run_plots(out_dir)
+                 on_window, overlap: bool, assimilate_drift: bool,
+                 plotter: ForkedTask | None) -> dict:  # noqa: ANN001
+    from twin.loop.report import run_plotter
 
     # the report's figures are drawn by a forked child on the second core, overlapping the
     # solve (it imports matplotlib meanwhile) and the field files (it draws meanwhile)
-    with ForkedTask(draw_plots, prepare=load_matplotlib, fork=overlap) as plots:
+    fresh = plotter is not None and plotter.fresh
+    with plotter if fresh else run_plotter(fork=overlap) as plots:
         accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
                                           spindle, on_window, plots, assimilate_drift)
         plots.join()
@@ -167,7 +169,7 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
 
     _write_keypoints(out_dir / "keypoints.csv", results, meas_T, meas_drift)
     _write_corrections(out_dir / "corrections.csv", results)
-    plots.start()
+    plots.start(str(out_dir))
     write_quality(run, out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
@@ -212,7 +214,7 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
 
     others = [c for c in correctors if c.name != primary]
     away = others[: (len(others) + 1) // 2] if fork and on_window is None else []
-    side = ForkedTask(lambda: json.dumps([method_replay_to_json(replay(c)) for c in away]),
+    side = ForkedTask(lambda _: json.dumps([method_replay_to_json(replay(c)) for c in away]),
                       fork=bool(away))
     with side:
         if away:
