@@ -143,13 +143,14 @@ run, out, methods = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
 model = SpindleModel.load()
 for overlap in (True, False):
     replay_run_to_dir(run, f"{out}/{overlap}", methods, "examples/correction_model.safetensors",
-                      snapshots="none", spindle=model, overlap=overlap)
+                      snapshots="end", spindle=model, overlap=overlap)
 """
 
 
 def test_replay_with_forked_helpers_writes_the_same_files_as_without(tmp_path):
-    """The estimator (state, band and factors) and ratio replayed by a forked child and the
-    figures drawn by another give byte-identical files."""
+    """bpnn (the primary, with its field files and snapshot) and the estimator (state, band
+    and factors) replayed by a forked child, and the figures drawn by another, give
+    byte-identical files."""
     import subprocess
     import sys
 
@@ -165,6 +166,7 @@ def test_replay_with_forked_helpers_writes_the_same_files_as_without(tmp_path):
     names = sorted(p.relative_to(plain) for p in plain.rglob("*") if p.is_file())
     assert names == sorted(p.relative_to(forked) for p in forked.rglob("*") if p.is_file())
     assert {"keypoints.csv", "corrections.csv", "accuracy.json"} <= {str(n) for n in names}
-    assert any(n.suffix == ".png" for n in names) and any(n.suffix == ".vtu" for n in names)
+    assert any(n.suffix == ".vtu" for n in names)
+    assert {n.parent.name for n in names if n.suffix == ".png"} == {"plots", "snapshots"}
     for name in names:
         assert (forked / name).read_bytes() == (plain / name).read_bytes(), name

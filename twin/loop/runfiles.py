@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -152,8 +153,14 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     ]
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
+
+    def write_primary_fields(r: MethodReplay) -> None:
+        _write_fields(out_dir, model, r)
+        if snapshots != "none":
+            _write_snapshots(out_dir, model, r, snapshots, title=run.name)
+
     results = _replay_methods(run, model, correctors, primary, solver, on_window,
-                              fork=plots.forked)
+                              write_primary_fields, fork=plots.forked)
 
     first = next(iter(results.values()))
     meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
@@ -176,46 +183,53 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
         for w in r.windows:
             if w.deck is not None:
                 write_text(deck_dir / f"window_{w.window:03d}.inp", w.deck)
-    _write_fields(out_dir, model, results[primary])
-    if snapshots != "none":
-        from twin.loop.snapshot import render_snapshot
-
-        r = results[primary]
-        times = sorted(r.fields)
-        chosen = times if snapshots == "every" else times[-1:]
-        for t in chosen:
-            render_snapshot(
-                model,
-                r.fields[t],
-                out_dir / "snapshots" / f"{primary}_t{t:05.0f}s.png",
-                title=f"{run.name} · {primary} · t = {t:.0f} s",
-                T_initial_C=r.T_initial_C,
-            )
     return accuracy, token
 
 
-def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
-                    fork: bool) -> dict[str, MethodReplay]:
-    """Every method's replay, by name in the order given.
+def _write_snapshots(out_dir: Path, model, r: MethodReplay, snapshots: str,  # noqa: ANN001
+                     title: str) -> None:
+    from twin.loop.snapshot import render_snapshot
 
-    With `fork` (and no per-window callback, which could not cross processes) the first
-    half of the methods other than the primary is replayed by a forked child on the second
-    core and sent back as JSON; the parent replays the rest.  Each window's solve depends on
-    its own inputs only (the session's cached factorizations are keyed by the matrix), so
-    the split changes no number.  Should the child fail, the parent replays its methods
-    itself: the error, if it is one, is then raised here with its own type.
+    times = sorted(r.fields)
+    for t in times if snapshots == "every" else times[-1:]:
+        render_snapshot(model, r.fields[t], out_dir / "snapshots" / f"{r.method}_t{t:05.0f}s.png",
+                        title=f"{title} · {r.method} · t = {t:.0f} s", T_initial_C=r.T_initial_C)
+
+
+def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
+                    write_primary_fields: Callable[[MethodReplay], None],
+                    fork: bool) -> dict[str, MethodReplay]:
+    """Every method's replay, by name in the order given; the primary's field files are
+    written by `write_primary_fields` as soon as it is replayed.
+
+    With `fork` (and no per-window callback, which could not cross processes) a forked
+    child on the second core replays the primary and writes its fields (their structural
+    solves and stress recovery cost about as much as replaying one more method) and, with
+    four methods or more, some of the others, so that each process replays about half; it
+    sends its replays back as JSON without their fields.  The parent replays the rest meanwhile.
+    Each window's solve depends on its own inputs only (the session's cached
+    factorizations are keyed by the matrix), so the split changes no number.  Should the
+    child fail, the parent replays its methods itself: the error, if it is one, is then
+    raised here with its own type.
     """
     def replay(corrector) -> MethodReplay:  # noqa: ANN001
         callback = None
         if on_window is not None:
             callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
-        return replay_method(run, model, corrector, keep_fields=corrector.name == primary,
-                             on_window=callback, solver=solver)
+        r = replay_method(run, model, corrector, keep_fields=corrector.name == primary,
+                          on_window=callback, solver=solver)
+        if r.method == primary:
+            write_primary_fields(r)
+        return r
+
+    def replay_away(_: str) -> str:
+        return json.dumps([method_replay_to_json(replace(replay(c), fields={})) for c in away])
 
     others = [c for c in correctors if c.name != primary]
-    away = others[: (len(others) + 1) // 2] if fork and on_window is None else []
-    side = ForkedTask(lambda _: json.dumps([method_replay_to_json(replay(c)) for c in away]),
-                      fork=bool(away))
+    away = []
+    if fork and on_window is None and others:
+        away = [c for c in correctors if c.name == primary] + others[: (len(others) - 1) // 2]
+    side = ForkedTask(replay_away, fork=bool(away))
     with side:
         if away:
             side.start()
@@ -223,7 +237,7 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
         try:
             sent = json.loads(side.join() or "[]")
         except ForkedTaskError:
-            sent = [method_replay_to_json(replay(c)) for c in away]
+            sent = json.loads(replay_away(""))
     results.update((c.name, method_replay_from_json(text)) for c, text in zip(away, sent,
                                                                               strict=True))
     return {c.name: results[c.name] for c in correctors}
