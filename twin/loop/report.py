@@ -60,17 +60,34 @@ def _shade_band(ax, kp: dict, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: s
                         lw=0, label=f"{method} 90 % band")
 
 
-def render_run_plots(run_dir: Path) -> list[Path]:
+def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
     """Draw a run's report figures into run_dir/plots/ (done by the batch worker that
-    replayed the run, so a parallel batch also draws in parallel)."""
-    out: list[bytes] = []
+    replayed the run, so a parallel batch also draws in parallel).
+
+    split: draw the second figure in a forked child meanwhile (`twin.loop.overlap`; a
+    figure is some 0.2 s of matplotlib's Python, at the end of a replay's critical path).
+    """
     kp = _read_csv(run_dir / "keypoints.csv")
     if not kp:
         return []
+    corr = _read_csv(run_dir / "corrections.csv")
+    paths = [run_dir / "plots" / name for name in PLOTS]
+
+    def draw_drift(_: str) -> None:
+        write_bytes(paths[1], _drift_figure(kp, corr))
+
+    with ForkedTask(draw_drift, fork=split) as drift:
+        drift.start()
+        write_bytes(paths[0], _temperature_figure(kp))
+        drift.join()
+    return paths
+
+
+def _temperature_figure(kp: dict[str, list[str]]) -> bytes:
+    """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11)."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = _floats(kp["time_s"]) / 60.0
-
     fig = new_figure(figsize=(17, 3.2))
     axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
@@ -92,8 +109,14 @@ def render_run_plots(run_dir: Path) -> list[Path]:
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("temperature [°C]")
     axes[0].legend(fontsize=7)
-    out.append(_png(fig))
+    return _png(fig)
 
+
+def _drift_figure(kp: dict[str, list[str]], corr: dict[str, list[str]]) -> bytes:
+    """The axial nose drift measured and per method, and the correction factors per window."""
+    methods = list(dict.fromkeys(kp["method"]))
+    method_col = np.array(kp["method"])
+    t_min = _floats(kp["time_s"]) / 60.0
     fig = new_figure(figsize=(13, 3.2))
     ax1, ax2 = fig.subplots(1, 2)
     first = method_col == methods[0]
@@ -111,7 +134,6 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     ax1.set_ylabel("drift [µm]")
     ax1.grid(alpha=0.3)
     ax1.legend(fontsize=7)
-    corr = _read_csv(run_dir / "corrections.csv")
     if corr:
         cm = np.array(corr["method"])
         for m in methods:
@@ -137,11 +159,7 @@ def render_run_plots(run_dir: Path) -> list[Path]:
     ax2.grid(alpha=0.3)
     if ax2.get_lines():  # open loop alone has no factors to show
         ax2.legend(fontsize=6, ncol=2)
-    out.append(_png(fig))
-    return [
-        write_bytes(run_dir / "plots" / name, png)
-        for name, png in zip(PLOTS, out, strict=True)
-    ]
+    return _png(fig)
 
 
 def run_plotter(fork: bool = True) -> ForkedTask:
@@ -149,7 +167,7 @@ def run_plotter(fork: bool = True) -> ForkedTask:
     with the run folder (`start(str(run_dir))`, when keypoints.csv and corrections.csv are
     written); without fork (`fork=False`, or where it is unsafe) `start` draws them here."""
     def draw(run_dir: str) -> None:
-        render_run_plots(Path(run_dir))
+        render_run_plots(Path(run_dir), split=True)
 
     return ForkedTask(draw, prepare=load_matplotlib, fork=fork)
 
