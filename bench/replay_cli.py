@@ -6,13 +6,16 @@ open_loop,ratio,bpnn` in a fresh interpreter, imports, model load, solve and eve
 whose own resource usage (`os.wait4`) gives
 
     wall_s    elapsed time, start of the process to its exit
-    cpu_s     user + system CPU time of the child
-    rss_MB    peak resident set size of the child
+    cpu_s     user + system CPU time of the child and of the helpers it forks (the
+              figures' plotter, the second half of the methods: `twin.loop.overlap`),
+              which it reaps, so `os.wait4` counts them
+    rss_MB    peak resident set size of the child or of its largest helper (not a sum)
 
 and the figures reported are the best (minimum) over the repeats: on a shared machine the
 noise only ever adds time, so the minimum is the closest to the undisturbed cost.  CPU time
 is the figure to compare between commits when the machine is loaded (wall time then includes
-waiting for a core); `load_1min` records how busy the machine was.
+waiting for a core, and the replay's forked helpers need the second core to pay off);
+`load_1min` records how busy the machine was.
 
 One further run under `python -X importtime` gives the import breakdown: the top-level
 imports by cumulative time and the self time summed per top-level package.  Import times
