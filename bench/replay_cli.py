@@ -23,7 +23,9 @@ under `-X importtime` are wall times and include the tracing overhead: read them
 not as absolute costs.  A module shared by several packages is charged to whichever imports
 it first (scipy.ndimage was charged with scipy's array-API layer and numpy.f2py, which
 scipy.sparse loads anyway): check a removal by the CPU time of the cold run, not by the
-importer's cumulative figure.
+importer's cumulative figure.  The forked plotter inherits the tracing: matplotlib's imports
+are listed too, although they run in the plotter, on the other core, while the replay
+itself imports the solver.
 
 `python -m bench.replay_cli [--repeats N]` prints the figures as JSON.
 """
