@@ -21,6 +21,7 @@ import hashlib
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -118,11 +119,14 @@ def replay_run_to_dir(
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
                  on_window, overlap: bool, assimilate_drift: bool,
                  plotter: ForkedTask | None) -> dict:  # noqa: ANN001
+    from twin.io.figures import load_matplotlib
     from twin.loop.report import run_plotter
 
     # the report's figures are drawn by a forked child on the second core, overlapping the
     # solve (it imports matplotlib meanwhile) and the field files (it draws meanwhile)
     fresh = plotter is not None and plotter.fresh
+    if not fresh and overlap:
+        load_matplotlib()  # here, once per process: the plotters of later runs inherit it
     with plotter if fresh else run_plotter(fork=overlap) as plots:
         accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
                                           spindle, on_window, plots, assimilate_drift)
@@ -154,13 +158,9 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
 
-    def write_primary_fields(r: MethodReplay) -> None:
-        _write_fields(out_dir, model, r)
-        if snapshots != "none":
-            _write_snapshots(out_dir, model, r, snapshots, title=run.name)
-
     results = _replay_methods(run, model, correctors, primary, solver, on_window,
-                              write_primary_fields, fork=plots.forked)
+                              partial(_write_fields, out_dir, model), snapshots,
+                              fork=plots.forked)
 
     first = next(iter(results.values()))
     meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
@@ -177,6 +177,8 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     _write_keypoints(out_dir / "keypoints.csv", results, meas_T, meas_drift)
     _write_corrections(out_dir / "corrections.csv", results)
     plots.start(str(out_dir))
+    if snapshots != "none":
+        _write_snapshots(out_dir, model, results[primary], snapshots, title=run.name)
     write_quality(run, out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
@@ -186,18 +188,23 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     return accuracy, token
 
 
+def _snapshot_times(fields: dict[float, np.ndarray], snapshots: str) -> list[float]:
+    """The window ends pictured: none, the last one (end) or all (every)."""
+    times = sorted(fields)
+    return {"none": [], "end": times[-1:], "every": times}[snapshots]
+
+
 def _write_snapshots(out_dir: Path, model, r: MethodReplay, snapshots: str,  # noqa: ANN001
                      title: str) -> None:
     from twin.loop.snapshot import render_snapshot
 
-    times = sorted(r.fields)
-    for t in times if snapshots == "every" else times[-1:]:
+    for t in _snapshot_times(r.fields, snapshots):
         render_snapshot(model, r.fields[t], out_dir / "snapshots" / f"{r.method}_t{t:05.0f}s.png",
                         title=f"{title} · {r.method} · t = {t:.0f} s", T_initial_C=r.T_initial_C)
 
 
 def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
-                    write_primary_fields: Callable[[MethodReplay], None],
+                    write_primary_fields: Callable[[MethodReplay], None], snapshots: str,
                     fork: bool) -> dict[str, MethodReplay]:
     """Every method's replay, by name in the order given; the primary's field files are
     written by `write_primary_fields` as soon as it is replayed.
@@ -206,7 +213,8 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
     child on the second core replays the primary and writes its fields (their structural
     solves and stress recovery cost about as much as replaying one more method) and, with
     four methods or more, some of the others, so that each process replays about half; it
-    sends its replays back as JSON without their fields.  The parent replays the rest meanwhile.
+    sends its replays back as JSON with only the fields the snapshots show.  The parent
+    replays the rest meanwhile.
     Each window's solve depends on its own inputs only (the session's cached
     factorizations are keyed by the matrix), so the split changes no number.  Should the
     child fail, the parent replays its methods itself: the error, if it is one, is then
@@ -222,8 +230,11 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
             write_primary_fields(r)
         return r
 
+    def pictured(r: MethodReplay) -> MethodReplay:
+        return replace(r, fields={t: r.fields[t] for t in _snapshot_times(r.fields, snapshots)})
+
     def replay_away(_: str) -> str:
-        return json.dumps([method_replay_to_json(replace(replay(c), fields={})) for c in away])
+        return json.dumps([method_replay_to_json(pictured(replay(c))) for c in away])
 
     others = [c for c in correctors if c.name != primary]
     away = []
