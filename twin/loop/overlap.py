@@ -25,6 +25,7 @@ same.
 
 from __future__ import annotations
 
+import gc
 import os
 import signal
 import threading
@@ -75,11 +76,15 @@ class ForkedTask:
     def _fork(self) -> None:
         go_r, go_w = os.pipe()
         result_r, result_w = os.pipe()
+        # the child's garbage collector leaves the objects it inherits alone: walking them
+        # would cost it time and copy the pages it shares with the parent (Python's gc docs)
+        gc.freeze()
         pid = os.fork()
         if pid == 0:  # the child: never returns into the parent's frames
             os.close(go_w)
             os.close(result_r)
             _child(self._prepare, self._task, go_r, result_w)
+        gc.unfreeze()
         os.close(go_r)
         os.close(result_w)
         self._pid, self._go, self._result = pid, go_w, result_r
