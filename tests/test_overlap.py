@@ -170,3 +170,16 @@ def test_replay_with_forked_helpers_writes_the_same_files_as_without(tmp_path):
     assert {n.parent.name for n in names if n.suffix == ".png"} == {"plots", "snapshots"}
     for name in names:
         assert (forked / name).read_bytes() == (plain / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("platform", ["darwin", "win32"])
+def test_off_linux_nothing_is_forked_and_the_task_still_runs_once(monkeypatch, platform):
+    import sys
+
+    monkeypatch.setattr(sys, "platform", platform)
+    assert not fork_is_safe()
+    calls = []
+    side = ForkedTask(lambda arg: calls.append(arg) or arg.upper())
+    assert not side.forked
+    side.start("run folder")
+    assert side.join() == "RUN FOLDER" and calls == ["run folder"]

@@ -16,8 +16,9 @@ from `join` (the message of the child's exception; the child writes nothing to s
 stderr).  Leaving the `with` block without `start` (the parent failed) kills the child,
 which has written nothing by then; a started child is always waited for.
 
-Where fork is unavailable (Windows) or unsafe (other threads are running: a lock one of
-them holds at the fork would stay locked in the child for ever), nothing is forked:
+Where fork is unavailable or unsafe (anywhere but Linux, see `fork_is_safe`; or other
+threads are running: a lock one of them holds at the fork would stay locked in the child
+for ever), nothing is forked:
 `start` runs prepare and task in the parent, as plain sequential code would, and `join`
 returns the task's result.  Either way the task runs exactly once and its outputs are the
 same.
@@ -28,6 +29,7 @@ from __future__ import annotations
 import gc
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
 from types import TracebackType
@@ -43,12 +45,15 @@ class ForkedTaskError(RuntimeError):
 
 
 def fork_is_safe() -> bool:
-    """True where `os.fork` exists and this process runs no other Python thread.
+    """True on Linux when this process runs no other Python thread.
 
-    Native thread pools are no obstacle as long as the child does not use them: OpenBLAS
-    (numpy, scipy) quiesces its pool around a fork, and the children here never run torch
-    (used for training only), whose OpenMP pool would not survive one."""
-    return hasattr(os, "fork") and threading.active_count() == 1
+    Not on macOS, though it has fork: its system libraries (Accelerate, which numpy may use
+    there, among them) are not safe in a forked child that does not exec, which is why
+    multiprocessing spawns there; Windows has no fork.  Native thread pools are no obstacle
+    on Linux as long as the child does not use them: OpenBLAS (numpy, scipy) quiesces its
+    pool around a fork, and the children here never run torch (used for training only),
+    whose OpenMP pool would not survive one."""
+    return sys.platform.startswith("linux") and threading.active_count() == 1
 
 
 class ForkedTask:
