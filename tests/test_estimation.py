@@ -368,9 +368,10 @@ def test_the_expansion_member_is_the_drift_scaled(tmp_path, spindle_model):
 
 def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
         tmp_path, spindle_model, monkeypatch):
-    """The speed steps from 6000 to 12000 rpm at 90 s, inside window 1 whose loads were fixed
-    at 60 s.  At 120 s the estimator re-runs window 1 with the recorded speed, so window 2
-    starts from the right field; without the re-run it carries the missed heat for minutes."""
+    """The speed steps from 6000 to 12000 rpm at 76 s and down to 3000 rpm at 100 s, both
+    inside window 1 whose loads were fixed at 60 s.  At 120 s the estimator re-runs window 1
+    with the recorded speeds, so window 2 starts from the right field; without the re-run
+    it carries the missed heat for minutes."""
     from twin.runs import write_run
 
     model = spindle_model
@@ -378,7 +379,7 @@ def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
     times, temps = [0.0], [model.sensor_matrix @ T]
 
     def speed_at(t):
-        return 6000.0 if t < 90.0 else 12000.0
+        return 6000.0 if t < 76.0 else 12000.0 if t < 100.0 else 3000.0
 
     for k in range(6):
         s = model.sensor_matrix @ T

@@ -283,7 +283,7 @@ class EnsembleEstimator:
             # the speed changed inside the window just ended, after its loads were fixed:
             # that window is re-run with the speed it really had (all measured before now)
             # so the innovations and the analysed field are free of the unforeseen input
-            sim_C, end.field_mean, fc = self._rerun(f, changed_s, fc)
+            sim_C, end.field_mean, fc = self._rerun(f, fc)
         # what the thermocouples would read of the mean: its sensor values through the lag
         sim_t = np.asarray(f.simulated_time_s, float)
         read = thermocouple_reading(sim_t, sim_C, cfg.sensor_lag_s)
@@ -353,25 +353,43 @@ class EnsembleEstimator:
         return bc.with_values(**bearing_values(self.model, bc.speed_rpm, (T[0], T[2]),
                                                (T[1], T[3])))
 
-    def _rerun(self, f: WindowFeatures, changed_s: float,
-               fc: WindowForecast) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
-        """The window just ended re-run from its start field, with its loads up to the solver
-        step in which the speed changed and the current speed's loads (this window's nominal
-        conditions, the same factors) after it: T1..T5 history with the window replaced,
-        the end field and the forecast with that mean (the members' anomalies are kept)."""
+    def _rerun(self, f: WindowFeatures, fc: WindowForecast
+               ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
+        """The window just ended re-run from its start field, each solver step at the speed
+        recorded at its midpoint: the forecast's loads at the forecast's speed, this window's
+        nominal conditions at the current speed, nominal conditions at the window start's
+        temperatures for any other speed (a step up and a stop inside one window), all with
+        the same factors.  Returns T1..T5 history with the window replaced, the end field
+        and the forecast with that mean (the members' anomalies are kept)."""
+        from twin.spindle.conditions import nominal_conditions
+
         cfg = self.config
         T, before, factors = self._window
-        bc = apply_factors(self._conditions_at(f.twin_state.conditions, T), factors)
-        after = self.model.thermal.transient(bc.to_thermal_loads(), cfg.step_s)
+        current = f.twin_state.conditions
         steps = cfg.steps_per_window
         start = f.start_s - cfg.window_s
+        mid = start + (np.arange(steps) + 0.5) * cfg.step_s
+        t = np.asarray(f.measured_time_s, float)
+        recorded = np.asarray(f.measured_speed_rpm, float)
+        speeds = recorded[np.clip(np.searchsorted(t, mid - 1e-9) - 1, 0, len(t) - 1)]
+        steppers = {self._forecast_speed_rpm: before}
+
+        def stepper(speed: float):  # noqa: ANN202
+            if speed not in steppers:
+                base = current
+                if abs(speed - current.speed_rpm) > 0.5:
+                    base = nominal_conditions(self.model, speed, current.ambient_C,
+                                              current.coolant_C)
+                bc = apply_factors(self._conditions_at(base, T0), factors)
+                steppers[speed] = self.model.thermal.transient(bc.to_thermal_loads(),
+                                                               cfg.step_s)
+            return steppers[speed]
+
+        T0 = T
         sensors = np.empty((steps, self._sensors.shape[0]))
         drift = np.empty(steps)
         for i in range(steps):
-            # a step (t − Δt, t] runs at the new speed once the change is before its end
-            stepper = after if start + (i + 1) * cfg.step_s > changed_s + 0.5 * cfg.step_s \
-                else before
-            T = stepper.step(T)
+            T = stepper(float(speeds[i])).step(T)
             sensors[i] = self._sensors @ T
             drift[i] = self._drift_um @ T
         sim_C = np.asarray(f.simulated_C, float).copy()
