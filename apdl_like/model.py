@@ -28,6 +28,12 @@ ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
     "PLANE35": ("thermal", 3, True),
     # surface effect elements: they carry face loads (SFE) onto the solid's exterior faces
     "SURF151": ("surface", 2, False),
+    # thermal line and point elements (apdl_like.line_thermal): they couple their nodes
+    "LINK31": ("line", 2, False),
+    "LINK32": ("line", 2, False),
+    "LINK33": ("line", 2, False),
+    "LINK34": ("line", 2, False),
+    "MASS71": ("line", 1, False),
 }
 # ETCHG,TTS / STT pairs (thermal <-> structural)
 THERMAL_TO_STRUCTURAL = {"PLANE55": "PLANE182", "PLANE77": "PLANE183"}
@@ -41,7 +47,7 @@ class ElementType:
 
     @property
     def physics(self) -> str:
-        """thermal, structural, or unsupported (3-D types read from an archive)."""
+        """thermal, structural, surface, line, or unsupported (3-D types read from an archive)."""
         return ELEMENT_TYPES[self.name][0] if self.name in ELEMENT_TYPES else "unsupported"
 
     @property
@@ -380,6 +386,7 @@ class SolutionSettings:
     outres: str = "ALL"
     tref: float = 0.0
     tunif: float = 0.0
+    toffst: float = 0.0  # TOFFST: the absolute temperature of the model's zero (radiation)
 
 
 @dataclass
@@ -419,6 +426,8 @@ class Database:
     mesh_triangles: bool = False  # MSHAPE,1
     meshed_areas: set[int] = field(default_factory=set)
     area_elements: dict[int, np.ndarray] = field(default_factory=dict)  # AMESH: area -> elements
+    line_elements: dict[int, np.ndarray] = field(default_factory=dict)  # LMESH: line -> elements
+    keypoint_hgen: dict[int, float] = field(default_factory=dict)  # BFK,,HGEN, W/m³
     esize: float | None = None
     title: str = ""
     mp_temperatures: list[float] = field(default_factory=list)  # MPTEMP, for MPDATA

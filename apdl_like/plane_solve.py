@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.errors import ApdlError
+from apdl_like.line_thermal import LINK_KINDS, ThermalLinks, link_constants
 from apdl_like.model import Database, element_corners, record_groups
 from apdl_like.plane_elastic import solve_elastic
 from apdl_like.plane_thermal import (
@@ -66,8 +67,9 @@ def corners_and_midside(db: Database) -> tuple[np.ndarray, np.ndarray | None, np
     missing = [int(t) for t in np.unique(el.type) if int(t) not in db.element_types]
     if missing:
         raise ApdlError(f"element type {missing[0]} is used by elements but never defined (ET)")
-    solid = np.array([db.element_types[int(t)].physics != "surface" for t in el.type], bool)
-    if not solid.any():
+    physics = np.array([db.element_types[int(t)].physics for t in el.type])
+    solid = (physics != "surface") & (physics != "line")
+    if not solid.any() and not (physics == "line").any():
         raise ApdlError("the model has only surface elements")
     nodes = el.nodes
     idx = db.nodes.index(nodes.ravel()).reshape(nodes.shape)
@@ -114,10 +116,52 @@ def plane_mesh(s: SessionState) -> PlaneMesh:
     if cache.plane is None or cache.plane_key != key:
         corners, mid, solid = corners_and_midside(db)
         mesh = build_mesh(db.nodes.xy, db.nodes.ids, corners, mid, key[2] == "axisymmetric",
-                          solid)
+                          solid, _link_nodes(db))
         cache.plane, cache.plane_key = mesh, key
         cache.plane_solver = None
     return cache.plane  # type: ignore[return-value]
+
+
+def _link_nodes(db: Database) -> np.ndarray:
+    """Node indices of the line and point elements (LINK31..34, MASS71)."""
+    el = db.elements
+    line = np.array([db.element_types[int(t)].physics == "line" for t in el.type], bool)
+    nodes = el.nodes[line]
+    return db.nodes.index(np.unique(nodes[nodes > 0]))
+
+
+def thermal_links(db: Database, mesh: PlaneMesh) -> ThermalLinks | None:
+    """The deck's thermal line and point elements on the mesh's dofs (None: there are none)."""
+    el = db.elements
+    types = {t: db.element_types[t] for t in (int(u) for u in np.unique(el.type))}
+    line = np.nonzero([types[int(t)].physics == "line" for t in el.type])[0]
+    if not line.size:
+        return None
+    i = mesh.node_dof[db.nodes.index(el.nodes[line, 0])]
+    j_nodes = el.nodes[line, 1]
+    j = np.where(j_nodes > 0, mesh.node_dof[db.nodes.index(np.where(j_nodes > 0, j_nodes,
+                                                                     el.nodes[line, 0]))], i)
+    kind = np.array([LINK_KINDS[types[int(el.type[e])].name] for e in line])
+    xy = db.nodes.xy
+    length = np.hypot(*(xy[db.nodes.index(np.where(j_nodes > 0, j_nodes, el.nodes[line, 0]))]
+                        - xy[db.nodes.index(el.nodes[line, 0])]).T)
+    consts = []
+    for e in line:
+        number = int(el.ids[e])
+        real = db.real_sets.get(int(el.real[e]))
+        if real is None:
+            raise ApdlError(f"element {number}: real constant set {int(el.real[e])} is not "
+                            "defined (R)")
+        et = types[int(el.type[e])]
+        consts.append(link_constants(LINK_KINDS[et.name], real, et.keyopt, f"element {number}"))
+    bars = kind == "conduction"
+    if np.any(bars & (length <= 0.0)):
+        bad = int(el.ids[line[np.nonzero(bars & (length <= 0.0))[0][0]]])
+        raise ApdlError(f"element {bad}: a conduction bar needs two distinct node locations")
+    area, emission, film_at, capacitance = (np.array(v) for v in zip(*consts, strict=True))
+    return ThermalLinks(line, i, j, kind, length, area.astype(float), el.mat[line],
+                        film_at.astype(int), emission.astype(float), capacitance.astype(bool),
+                        db.settings.toffst)
 
 
 def deck_faces(s: SessionState) -> FaceTable:
@@ -139,8 +183,8 @@ def analysis_mode(db: Database) -> str:
         et = db.element_types.get(t)
         if et is None:
             continue
-        if et.physics == "surface":
-            continue  # SURF151 follows the solid it lies on
+        if et.physics in ("surface", "line"):
+            continue  # SURF151 follows the solid it lies on; links have no plane mode
         if et.physics == "unsupported":
             raise ApdlError(f"element type {t} ({et.name}) is not supported: use PLANE35, "
                             "PLANE55, PLANE77, PLANE182 or PLANE183")
@@ -184,27 +228,50 @@ def _is_nonlinear(db: Database, mats: list[int]) -> bool:
     return False
 
 
+def _when_used(db: Database, mat: int, label: str, why: str) -> Property:
+    """The property, or one that names what is missing when an element first needs it (a
+    material of only links need not have KXX, DENS or C)."""
+    try:
+        return material_property(db, mat, label, why)
+    except ApdlError as exc:
+        message = str(exc)
+
+        def missing(T: np.ndarray) -> np.ndarray:
+            raise ApdlError(message)
+
+        return missing
+
+
 def _properties(db: Database, transient: bool) -> tuple[dict[str, list[Property]], list[int]]:
     mats = sorted({int(m) for m in np.unique(db.elements.mat)})
     size = max(mats) + 1
     out: dict[str, list[Property]] = {"kxx": [None] * size, "kyy": [None] * size,  # type: ignore[list-item]
-                                      "rho_c": [None] * size, "enthalpy": [None] * size}
+                                      "rho_c": [None] * size, "enthalpy": [None] * size,
+                                      "hf": [None] * size, "specific_heat": [None] * size}
+    physics = np.array([db.element_types[int(t)].physics for t in db.elements.type])
+    link_only = set(mats) - {int(m) for m in np.unique(db.elements.mat[physics != "line"])}
     for mat in mats:
         if mat not in db.materials:
+            if mat in link_only:
+                continue  # MASS71 with a capacitance: no material
             raise ApdlError(f"material {mat} is used by elements but has no MP properties")
-        kxx = material_property(db, mat, "KXX", "for heat conduction")
+        kxx = _when_used(db, mat, "KXX", "for heat conduction")
         m = db.materials[mat]
         kyy = material_property(db, mat, "KYY", "") if "KYY" in m.props or "KYY" in m.tables \
             else kxx
         if transient and "ENTH" in m.tables:
             out["enthalpy"][mat], rho_c = enthalpy_table(*m.tables["ENTH"])
         elif transient:
-            dens = material_property(db, mat, "DENS", "for a transient")
-            c = material_property(db, mat, "C", "for a transient")
+            dens = _when_used(db, mat, "DENS", "for a transient")
+            c = _when_used(db, mat, "C", "for a transient")
             rho_c = _product(dens, c)
         else:
             rho_c = material_property(db, mat, "C", "", default=1.0)
         out["kxx"][mat], out["kyy"][mat], out["rho_c"][mat] = kxx, kyy, rho_c
+        if "HF" in m.props or "HF" in m.tables:
+            out["hf"][mat] = material_property(db, mat, "HF", "")
+        if "C" in m.props or "C" in m.tables:
+            out["specific_heat"][mat] = material_property(db, mat, "C", "")
     return out, mats
 
 
@@ -286,7 +353,7 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
     fixed = (mesh.node_dof[nodes_fixed], d[nodes_fixed])
     enthalpy = props["enthalpy"] if any(h is not None for h in props["enthalpy"]) else None
     return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed,
-                         enthalpy)
+                         enthalpy, props["hf"], props["specific_heat"])
 
 
 def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
@@ -324,13 +391,15 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
     settings = db.settings
     transient = settings.antype == "TRANS" and settings.timint is not False
     props, mats = _properties(db, settings.antype == "TRANS")
-    nonlinear = _is_nonlinear(db, mats)
+    links = thermal_links(db, mesh)
+    nonlinear = _is_nonlinear(db, mats) or (links is not None and
+                                            bool(np.any(links.kind == "radiation")))
     element_material = db.elements.mat
     couplings = _couplings(db, mesh)
     key = (id(mesh), element_material.tobytes(), tuple(c.tobytes() for c in couplings))
     cache = s.fem
-    if cache.plane_solver is None or cache.plane_solver[0] != key:
-        cache.plane_solver = (key, PlaneThermal(mesh, element_material, couplings))
+    if cache.plane_solver is None or cache.plane_solver[0] != key or links is not None:
+        cache.plane_solver = (key, PlaneThermal(mesh, element_material, couplings, links))
     model: PlaneThermal = cache.plane_solver[1]
     sol = s.solution
     if sol.fresh_start or sol.temperature is None or sol.temperature.size != mesh.n_dofs:

@@ -46,6 +46,7 @@ from skfem import (
 )
 
 from apdl_like.errors import ApdlError
+from apdl_like.line_thermal import ThermalLinks
 from twin.fem.stepper import (
     StepControl,
     SteppingError,
@@ -102,13 +103,15 @@ class PlaneMesh:
 
 def build_mesh(xy: np.ndarray, node_ids: np.ndarray, corners: np.ndarray,
                midside: np.ndarray | None, axisymmetric: bool,
-               solid: np.ndarray | None = None) -> PlaneMesh:
+               solid: np.ndarray | None = None,
+               point_nodes: np.ndarray | None = None) -> PlaneMesh:
     """corners (m, 4) node indices (K = L for a triangle); midside (m, 4) node indices of
     the mid-side nodes I-J, J-K, K-L, L-I (-1 none) for quadratic elements, else None;
-    solid (m,) the elements to mesh (default all)."""
+    solid (m,) the elements to mesh (default all); point_nodes the nodes of line and point
+    elements (`apdl_like.line_thermal`), which get a dof too."""
     solid = np.ones(corners.shape[0], bool) if solid is None else solid
     vertex_node = np.unique(corners[solid])
-    if axisymmetric:
+    if axisymmetric and vertex_node.size:
         x = xy[vertex_node, 0]
         if np.any(x < -1e-9 * max(1.0, float(np.abs(xy[vertex_node]).max()))):
             bad = node_ids[vertex_node[np.argmin(x)]]
@@ -128,6 +131,10 @@ def build_mesh(xy: np.ndarray, node_ids: np.ndarray, corners: np.ndarray,
         part, n_global = _part(xy, node_ids, node_dof, part_corners, part_mid, elements,
                                is_tri, edge_dof, n_global)
         parts.append(part)
+    if point_nodes is not None:
+        extra = np.setdiff1d(point_nodes, np.nonzero(node_dof >= 0)[0])
+        node_dof[extra] = n_global + np.arange(extra.size)
+        n_global += extra.size
     for part in parts:
         part.to_global = sp.csr_matrix(
             (np.ones(part.local_dofs.size), (part.local_dofs, np.arange(part.local_dofs.size))),
@@ -221,6 +228,7 @@ class ThermalInputs:
     films            (face keys, h W/m²K, T_bulk °C) groups; keys: packed corner node numbers
     fluxes           (face keys, q W/m²) groups
     fixed            (dofs, values °C)
+    hf, specific_heat  per material MP,HF and MP,C callables (or None), for the links
     enthalpy         per material H(T) J/m³ (MPDATA,ENTH) or None: a transient step's
                      capacity is then the secant (H(T1) − H(T0)) / (T1 − T0), so a step
                      across a phase change takes in exactly its latent heat
@@ -234,14 +242,17 @@ class ThermalInputs:
     fluxes: list[tuple[np.ndarray, float]]
     fixed: tuple[np.ndarray, np.ndarray]
     enthalpy: list[Property | None] | None = None
+    hf: list[Property | None] | None = None
+    specific_heat: list[Property | None] | None = None
 
 
 class PlaneThermal:
     """Assembly and solves on one `PlaneMesh` with per-element material numbers."""
 
     def __init__(self, mesh: PlaneMesh, element_material: np.ndarray,
-                 couplings: list[np.ndarray]) -> None:
+                 couplings: list[np.ndarray], links: ThermalLinks | None = None) -> None:
         self.mesh = mesh
+        self.links = links if links is not None and links.size else None
         self.groups = []  # per part: material -> cells
         for part in mesh.parts:
             mats = element_material[part.elements]
@@ -284,6 +295,8 @@ class PlaneThermal:
             C = C + part.to_global @ mass.assemble(b, c=c, axisymmetric=ax) @ part.to_global.T
         if self.mesh.lumped:
             C = sp.diags(np.asarray(C.sum(axis=1)).ravel())
+        if self.links is not None:
+            C = C + self.links.capacity(T1, inputs.rho_c, inputs.specific_heat or [], n)
         return C.tocsr()
 
     def operators(self, inputs: ThermalInputs, T: np.ndarray,
@@ -327,6 +340,10 @@ class PlaneThermal:
                     f = f + S @ load.assemble(fb, g=flux, axisymmetric=ax)
         if self.mesh.lumped:
             C = sp.diags(np.asarray(C.sum(axis=1)).ravel()).tocsr()
+        if self.links is not None:
+            K = K + self.links.stiffness(T, inputs.kxx, inputs.hf or [], n)
+            C = C + self.links.capacity(T, inputs.rho_c, inputs.specific_heat or [], n)
+            f = f + self.links.heat_load(inputs.hgen, n)
         out = ThetaSystem(K.tocsr(), C.tocsr(), f)
         if not nonlinear:
             self._linear_cache = (inputs, out)
@@ -397,6 +414,12 @@ class PlaneThermal:
             found |= np.isin(wanted, part.elements)
             if cells.size:
                 out += part.to_global @ self._cells_heat(k, inputs, T, cells)
+        if self.links is not None:
+            which = np.isin(self.links.elements, wanted)
+            found |= np.isin(wanted, self.links.elements)
+            if which.any():
+                out += self.links.nodal_heat(T, inputs.kxx, inputs.hf or [], inputs.hgen,
+                                             which, self.mesh.n_dofs)
         if not found.all():
             raise ApdlError("the element is not part of the thermal mesh")
         return out

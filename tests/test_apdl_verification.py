@@ -614,3 +614,37 @@ SET,LAST
     assert p["T_14"] == pytest.approx(0.0, abs=1e-9)
     assert p["T_END"] == pytest.approx(6.0, abs=1e-9)
     assert p["T_LAST"] == p["T_END"]
+
+
+@pytest.mark.parametrize("midside", [",5", ",5,6", ",5,6,7"])
+def test_plane77_with_mid_side_nodes_left_out_holds_a_linear_field(midside):
+    """MAPDL's E takes PLANE77 with any trailing mid-side nodes omitted (and ET its ninth
+    field, INOPR).  A 1×1 planar square held at 0 °C on x = 0 and 100 °C on x = 1 conducts
+    linearly: T = 100 x at every node, whichever mid-side nodes exist."""
+    s = run(f"""/PREP7
+ET,1,PLANE77,,,0,,,,1
+MP,KXX,1,3
+N,1,0,0
+N,2,1,0
+N,3,1,1
+N,4,0,1
+N,5,0.5,0
+N,6,1,0.5
+N,7,0.5,1
+N,8,0,0.5
+E,1,2,3,4{midside}
+NSEL,S,LOC,X,0
+D,ALL,TEMP,0
+NSEL,S,LOC,X,1
+D,ALL,TEMP,100
+ALLSEL
+FINISH
+/SOLU
+SOLVE
+FINISH
+/POST1
+*GET,T5,NODE,5,TEMP
+*GET,T3,NODE,3,TEMP
+""")
+    assert s.params["T5"] == pytest.approx(50.0, abs=1e-9)
+    assert s.params["T3"] == pytest.approx(100.0, abs=1e-9)

@@ -16,6 +16,19 @@ every computed value is within the tolerance of its target (relative; a zero tar
 
 Unknown or unsupported commands (warnings) are listed in every case: they are what a deck
 that fails most likely needs.
+
+The candidate set (issue 16, "2-D thermal and axisymmetric thermal-stress decks"): from the
+Verification Manual decks of ansys-mapdl-core 0.74.1 (ansys/mapdl/core/examples/verif),
+every deck whose ET commands name only 2-D thermal solids and the thermal elements a 2-D
+model uses -- PLANE35, PLANE55, PLANE77, SURF151, SURF152, LINK31, LINK32, LINK33, LINK34,
+MASS71 -- optionally switched to PLANE42/82/182/183 for a thermal-stress step.  26 decks:
+
+    vm28 vm32 vm58 vm92 vm93 vm94 vm98 vm99 vm100 vm102 vm104 vm105 vm106 vm107 vm109
+    vm110 vm111 vm112 vm113 vm114 vm115 vm116 vm163 vm164 vm227 vm228
+
+(LINK33 is MAPDL's "3-D" conduction bar; the decks above use it for 1-D problems.  Left
+out by the rule: vm159, whose COMBIN37 controller is not thermal-only, and decks with
+SOLID70, SHELL131 or MATRIX50.)
 """
 
 from __future__ import annotations

@@ -4,9 +4,10 @@ The radiating surfaces are the exterior element faces loaded with RDSF (SF/SFL/S
 emissivity, enclosure number).  View factors are computed when VFQUERY first needs them
 (`apdl_like.radiation`: numerical integration with shading by every face of the enclosure),
 planar or, after V2DOPT,1, axisymmetric (faces revolved about the Y axis).  VFOPT's file
-options change nothing: the factors are always computed from the model.  STEF, TOFFST,
-SPCTEMP, RADOPT and HEMIOPT only serve a radiosity solve, which apdl_like does not run (a
-thermal SOLVE with RDSF faces is refused).
+options change nothing: the factors are always computed from the model.  STEF, SPCTEMP,
+RADOPT and HEMIOPT only serve a radiosity solve, which apdl_like does not run (a thermal
+SOLVE with RDSF faces is refused).  TOFFST sets the temperature offset that LINK31
+radiation links use (`apdl_like.line_thermal`).
 """
 
 from __future__ import annotations
@@ -101,8 +102,18 @@ def vfquery(s: SessionState, c: Call) -> None:
     s.say(f"VFQUERY: average view factor {s.radiation.average:.6f}")
 
 
+@command("TOFFST", MODEL, 1)
+def toffst(s: SessionState, c: Call) -> None:
+    """TOFFST,VALUE: the absolute temperature of the model's zero (460 for °F, 273.15 for
+    °C); radiation works with T + VALUE."""
+    value = c.num(1, 0.0, what="VALUE")
+    if value < 0.0:
+        raise ApdlError(f"field 1 (VALUE) must not be negative, got {value!r}")
+    s.db.settings.toffst = value
+
+
 COMMANDS = (
-    *specs_of(v2dopt, vfquery),
+    *specs_of(v2dopt, vfquery, toffst),
     *(CommandSpec(name, MODEL, 8, ignored)
-      for name in ("STEF", "TOFFST", "SPCTEMP", "RADOPT", "HEMIOPT", "VFOPT")),
+      for name in ("STEF", "SPCTEMP", "RADOPT", "HEMIOPT", "VFOPT")),
 )

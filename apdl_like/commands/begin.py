@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import ANY, Call, CommandSpec, command, ignored, specs_of
-from apdl_like.commands.post26 import get_variable
+from apdl_like.commands.post26 import get_variable, variable_at
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
 
@@ -62,6 +62,9 @@ def star_get(s: SessionState, c: Call) -> None:
     entity = c.label(2)
     item, sub = c.label(4), c.label(5)
     db = s.db
+    if entity == "VARI" and item == "RTIME":
+        s.params[name] = variable_at(s, c.int(3, what="variable"), c.num(5, what="time"))
+        return
     if entity == "VARI":
         s.params[name] = get_variable(s, c.int(3, what="variable"), item, sub)
         return

@@ -351,6 +351,44 @@ def bfe(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+@command("BFK", LOADS, 6)
+def bfk(s: SessionState, c: Call) -> None:
+    """BFK,KPOI|ALL,HGEN,VAL1: heat generation at keypoints.  As MAPDL transfers keypoint
+    body loads, a meshed line or area whose keypoints all carry one takes it: along a line
+    it varies linearly between the two end values (each element gets the value at its
+    midpoint); an area takes a value only when its keypoints agree."""
+    if c.label(2) != "HGEN":
+        raise ApdlError(f"field 2: BFK supports HGEN, got {c.label(2) or '(empty)'!r}")
+    db = s.db
+    if c.label(1) == "ALL":
+        chosen = [n for n in sorted(db.keypoints) if n not in db.unselected_keypoints]
+    else:
+        chosen = [c.entity(1, "KPOI")]
+    for num in chosen:
+        if num not in db.keypoints:
+            raise ApdlError(f"keypoint {num} does not exist")
+        db.keypoint_hgen[num] = c.num(3, what="VAL1")
+    el = db.elements
+    el.flush()
+    loads = db.keypoint_hgen
+    for num, elements in db.line_elements.items():
+        ln = db.lines[num]
+        if ln.k1 in loads and ln.k2 in loads:
+            idx = el.index(elements)
+            p1, p2 = (np.array(db.keypoints[k], float) for k in (ln.k1, ln.k2))
+            mid = 0.5 * (db.nodes.xy[db.nodes.index(el.nodes[idx, 0])] +
+                         db.nodes.xy[db.nodes.index(el.nodes[idx, 1])])
+            f = np.clip((mid - p1) @ (p2 - p1) / float((p2 - p1) @ (p2 - p1)), 0.0, 1.0)
+            values = loads[ln.k1] + f * (loads[ln.k2] - loads[ln.k1])
+            for value in np.unique(values):
+                _set_hgen(s, idx[values == value], float(value))
+    for num, elements in db.area_elements.items():
+        kps = db.areas[num]
+        if all(k in loads for k in kps) and len({loads[k] for k in kps}) == 1:
+            _set_hgen(s, el.index(elements), loads[kps[0]])
+    s.note_load(c)
+
+
 @command("BFEDELE", LOADS, 2)
 def bfedele(s: SessionState, c: Call) -> None:
     lab = c.label(2, "ALL")
@@ -386,5 +424,6 @@ def tref(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfedele, ic, tunif, bfunif, tref),
+    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfedele, ic, tunif, bfunif,
+              tref),
 )

@@ -74,12 +74,16 @@ def nsol(s: SessionState, c: Call) -> None:
 
 @command("ESOL", POST26, 7)
 def esol(s: SessionState, c: Call) -> None:
-    """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes."""
+    """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes;
+    ESOL,NVAR,ELEM,,SMISC,1,Name: a thermal link's HEAT RATE (LINK31..34)."""
     nvar = _variable(c)
     el = s.db.elements
     e = int(el.index(c.int(2, what="ELEM"))[0])
     if e < 0:
         raise ApdlError(f"element {c.raw(2)} does not exist")
+    if c.label(4) == "SMISC":
+        _link_heat_rate(s, c, nvar, e)
+        return
     node = c.int(3, what="NODE")
     if node not in el.nodes[e]:
         raise ApdlError(f"node {node} is not a node of element {c.raw(2)}")
@@ -90,6 +94,55 @@ def esol(s: SessionState, c: Call) -> None:
     times, temps = thermal_history(s)
     values = np.array([model.element_heat(inputs, T, e)[dof] for T in temps])
     s.variables[nvar] = (c.label(6, "HEAT"), times, values)
+
+
+def _link_heat_rate(s: SessionState, c: Call, nvar: int, e: int) -> None:
+    if c.int(5, what="component") != 1:
+        raise ApdlError("field 5: SMISC supports component 1 (a link's HEAT RATE)")
+    model, inputs = _plane(s)
+    links = model.links
+    where = None if links is None else np.nonzero(links.elements == e)[0]
+    if where is None or not where.size or links.kind[where[0]] == "mass":
+        raise ApdlError(f"element {c.raw(2)}: SMISC,1 is the HEAT RATE of a LINK31..34 "
+                        "element")
+    times, temps = thermal_history(s)
+    k = int(where[0])
+    values = np.array([links.heat_rate(T, inputs.kxx, inputs.hf or [])[k] for T in temps])
+    s.variables[nvar] = (c.label(6, "SMIS1"), times, values)
+
+
+@command("INT1", POST26, 10)
+def int1(s: SessionState, c: Call) -> None:
+    """INT1,IR,IY,IX,,Name,,,FACTA,FACTB,CONST: IR = ∫ FACTA·IY d(FACTB·IX) + CONST over
+    the stored points (trapezoidal rule; IX 1 is TIME)."""
+    nvar = _variable(c)
+    y_name, x_name = c.int(2, what="IY"), c.int(3, 1, what="IX")
+    factor_y, factor_x = c.num(8, 1.0, what="FACTA"), c.num(9, 1.0, what="FACTB")
+    const = c.num(10, 0.0, what="CONST")
+    if y_name not in s.variables:
+        raise ApdlError(f"variable {y_name} is not defined (NSOL or ESOL first)")
+    _, times, y = s.variables[y_name]
+    if x_name == 1:
+        x = times
+    elif x_name in s.variables:
+        x = s.variables[x_name][2]
+    else:
+        raise ApdlError(f"variable {x_name} is not defined (NSOL or ESOL first)")
+    fy, fx = factor_y * np.asarray(y), factor_x * np.asarray(x)
+    steps = 0.5 * (fy[1:] + fy[:-1]) * np.diff(fx)
+    s.variables[nvar] = (c.label(5, "INT1"), times,
+                         const + np.concatenate([[0.0], np.cumsum(steps)]))
+
+
+def variable_at(s: SessionState, n: int, time: float) -> float:
+    """*GET,Par,VARI,n,RTIME,time: the variable at a time, linear between stored points."""
+    if n not in s.variables:
+        raise ApdlError(f"variable {n} is not defined (NSOL or ESOL first)")
+    _, times, values = s.variables[n]
+    if not times[0] - 1e-9 * abs(times[-1]) <= time <= times[-1] * (1 + 1e-9):
+        raise ApdlError(f"time {time:g} lies outside the stored results "
+                        f"({times[0]:g} .. {times[-1]:g})")
+    return float(np.interp(time, times, values))
 
 
 @command("PRVAR", POST26, 6)
@@ -168,6 +221,6 @@ def fsum(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(nsol, esol, prvar, prnld, fsum),
+    *specs_of(nsol, esol, int1, prvar, prnld, fsum),
     CommandSpec("STORE", POST26, 2, ignored),  # variables are computed when defined
 )

@@ -38,11 +38,12 @@ def _element_name(c: Call) -> str:
     if name in CONTACT_TYPES or name in ELEMENT_TYPES or name in FOREIGN_TYPES.values():
         return name
     raise ApdlError(f"element {text} is not supported (PLANE35, PLANE55, PLANE77, PLANE182, "
-                    "PLANE183)")
+                    "PLANE183, SURF151, LINK31, LINK32, LINK33, LINK34, MASS71)")
 
 
-@command("ET", PREP7, 8)
+@command("ET", PREP7, 9)
 def et(s: SessionState, c: Call) -> None:
+    """ET,ITYPE,Ename,KOP1..KOP6,INOPR (INOPR, print suppression, changes nothing here)."""
     itype = c.entity(1, "ITYPE")
     name = _element_name(c)
     if name in CONTACT_TYPES:
@@ -208,8 +209,10 @@ def n(s: SessionState, c: Call) -> None:
 
 
 # node counts E accepts (quadratic elements without mid-side nodes get them from EMID)
-_NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (3, 4, 8),
-                "PLANE183": (3, 4, 8), "PLANE35": (3, 6), "SURF151": (2, 3)}
+# MAPDL lets any mid-side node of PLANE77/183 be left out (E with 5..7 nodes, or 0 in a field)
+_NODE_COUNTS = {"PLANE55": (3, 4), "PLANE182": (3, 4), "PLANE77": (3, 4, 5, 6, 7, 8),
+                "PLANE183": (3, 4, 5, 6, 7, 8), "PLANE35": (3, 6), "SURF151": (2, 3),
+                "LINK31": (2,), "LINK32": (2,), "LINK33": (2,), "LINK34": (2,), "MASS71": (1,)}
 
 
 @command("E", PREP7, 8)
@@ -224,7 +227,7 @@ def e(s: SessionState, c: Call) -> None:
     nums = [c.entity(i, "node") for i in given]
     if et_.name not in _NODE_COUNTS:
         raise ApdlError(f"element type {db.active_type} ({et_.name}) is not supported: "
-                        "PLANE35, PLANE55, PLANE77, PLANE182 or PLANE183")
+                        "PLANE35, PLANE55, PLANE77, PLANE182, PLANE183 or a thermal link")
     allowed = (3, 6) if et_.triangle6 else _NODE_COUNTS[et_.name]
     if len(nums) not in allowed:
         shape = "6-node triangle" if et_.triangle6 else et_.name
@@ -235,7 +238,7 @@ def e(s: SessionState, c: Call) -> None:
     if et_.physics == "surface":
         if nums[0] == nums[1]:
             raise ApdlError("a surface element needs two different nodes (I, J)")
-    elif len(set(nums[:3])) < 3:
+    elif et_.physics != "line" and len(set(nums[:3])) < 3:  # links may join coincident nodes
         raise ApdlError("the first three nodes (I, J, K) must be distinct")
     if len(nums) == 3 and not et_.triangle6 and et_.physics != "surface":
         nums.append(nums[2])  # the triangle is the quad with K = L

@@ -1,5 +1,5 @@
 """/PREP7 solid model and meshing: K, KGEN, L, LESIZE, A, AL, RECTNG, ESIZE, MSHAPE, MSHKEY,
-AMESH.
+AMESH, LMESH.
 
 A 4-sided area whose opposite sides have as many divisions (LESIZE, or ESIZE) is meshed
 mapped, with quads (8-node ones for a quadratic element type); any other area, or MSHAPE,1
@@ -15,7 +15,7 @@ import numpy as np
 from apdl_like.call import PREP7, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.commands.generate import from_cartesian, to_cartesian
 from apdl_like.errors import ApdlError
-from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped
+from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped, place_nodes, side_fractions
 from apdl_like.model import Line
 
 if TYPE_CHECKING:
@@ -235,7 +235,64 @@ def amesh(s: SessionState, c: Call) -> None:
     db.meshed_areas.update(chosen)
 
 
+@command("LMESH", PREP7, 3)
+def lmesh(s: SessionState, c: Call) -> None:
+    """LMESH,NL1,NL2,NINC: line elements (LINK33, LINK34 ...) along lines, NDIV from LESIZE
+    (with its spacing ratio) or ESIZE.  Node numbering as MAPDL's: a line's end keypoints
+    first (when they have no node yet), then its interior nodes from k1 to k2."""
+    db = s.db
+    lines = db.lines
+    if c.label(1, "ALL") == "ALL":
+        chosen = sorted(lines)
+    else:
+        first = c.entity(1, "NL1")
+        last = c.entity(2, "NL2") if c.given(2) else first
+        step = c.int(3, 1, what="NINC")
+        if step < 1:
+            raise ApdlError("field 3 (NINC) must be ≥ 1")
+        chosen = list(range(first, last + 1, step))
+        for num in chosen:
+            if num not in lines:
+                raise ApdlError(f"line {num} does not exist")
+    et = db.element_types.get(db.active_type)
+    if et is None:
+        raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
+    if et.physics != "line":
+        raise ApdlError(f"LMESH meshes line elements; type {db.active_type} is {et.name}")
+    for num in chosen:
+        if num in db.line_elements:
+            continue
+        ln = lines[num]
+        p1, p2 = (np.array(db.keypoints[k], float) for k in (ln.k1, ln.k2))
+        length = float(np.hypot(*(p2 - p1)))
+        if ln.ndiv:
+            n = ln.ndiv
+        elif db.esize_divisions:
+            n = db.esize_divisions
+        elif db.esize is not None:
+            n = max(1, int(np.ceil(length / db.esize - 1e-9)))
+        else:
+            raise ApdlError(f"line {num} has no element size: give LESIZE or ESIZE first")
+        if n > MAX_DIVISIONS:
+            raise ApdlError(f"line {num}: {n} divisions exceed {MAX_DIVISIONS}")
+        f = side_fractions(n, ln.space)
+        points = p1 + f[:, None] * (p2 - p1)
+        order = [0, n, *range(1, n)]
+        numbers = np.empty(n + 1, np.int64)
+        numbers[order] = place_nodes(s, points[order], max(length, 1e-300))
+        el = db.elements
+        el.flush()
+        start = int(el.ids.max()) + 1 if len(el.ids) else 1
+        for e in range(n):
+            el.add(start + e, db.active_type, db.active_mat, db.active_real,
+                   (int(numbers[e]), int(numbers[e + 1])))
+        el.flush()
+        db.line_elements[num] = np.arange(start, start + n)
+    s.say(f"LMESH: {len(chosen)} line(s) meshed")
+
+
 COMMANDS = (
-    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, blc4, esize, mshape, amesh),
+    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, blc4, esize, mshape, amesh,
+              lmesh),
     CommandSpec("MSHKEY", PREP7, 1, ignored),  # mapped wherever the area allows
 )

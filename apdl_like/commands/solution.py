@@ -154,8 +154,11 @@ def ldread(s: SessionState, c: Call) -> None:
 @command("SOLVE", SOLU, 0)
 def solve(s: SessionState, c: Call) -> None:
     s.budget.unsolved = None
-    types = {s.db.element_types[int(t)].physics for t in np.unique(s.db.elements.type)
-             if int(t) in s.db.element_types} - {"surface"}  # SURF151 only carries loads
+    s.db.elements.flush()
+    physics = {s.db.element_types[int(t)].physics for t in np.unique(s.db.elements.type)
+               if int(t) in s.db.element_types}
+    # SURF151 only carries loads; thermal links and masses join a thermal model
+    types = physics - {"surface", "line"} or ({"thermal"} if "line" in physics else set())
     if s.record_only:
         from apdl_like.loadset import record_solve
 
