@@ -23,6 +23,36 @@ def run(text: str) -> Session:
     return s
 
 
+def cooling_mass(cap: float, h: float, area: float, t0: float, t_air: float, t_end: float,
+                 n: int) -> str:
+    """MASS71 (capacitance cap) at node 1 tied by LINK34 (h, area) to air held at node 2,
+    starting at t0, n fixed backward-Euler substeps to t_end; ends in /SOLU after SOLVE."""
+    return f"""/PREP7
+ANTYPE,TRANS
+ET,1,MASS71,,,1
+ET,2,LINK34
+R,1,{cap}
+R,2,{area}
+MP,HF,1,{h}
+N,1
+N,2
+E,1
+TYPE,2
+REAL,2
+E,1,2
+FINISH
+/SOLU
+TIME,{t_end}
+NSUBST,{n}
+AUTOTS,OFF
+BFUNIF,TEMP,{t0}
+KBC,1
+D,2,TEMP,{t_air}
+SOLVE
+FINISH
+"""
+
+
 def test_composite_wall_of_bars_and_convection_links_is_a_series_of_resistances():
     """Fluid 1 -LINK34- wall a (LINK33) - wall b (LINK33) -LINK34- fluid 2, unit area:
     q = ΔT / (1/h1 + La/ka + Lb/kb + 1/h2); the inner wall temperatures follow."""
@@ -167,29 +197,7 @@ def test_thermal_mass_cools_exponentially_through_a_convection_link():
     (T0 − T∞) exp(−hA t / C).  Backward Euler with n steps gives (1 + hA Δt / C)^−n
     exactly; with small steps both agree with the exponential to 1e-3."""
     cap, h, area, t0, t_air, t_end, n = 2.7e-4, 2.0, 0.0081812, 300.0, 100.0, 0.0125, 400
-    s = run(f"""/PREP7
-ANTYPE,TRANS
-ET,1,MASS71,,,1
-ET,2,LINK34
-R,1,{cap}
-R,2,{area}
-MP,HF,1,{h}
-N,1
-N,2
-E,1
-TYPE,2
-REAL,2
-E,1,2
-FINISH
-/SOLU
-TIME,{t_end}
-NSUBST,{n}
-AUTOTS,OFF
-BFUNIF,TEMP,{t0}
-KBC,1
-D,2,TEMP,{t_air}
-SOLVE
-FINISH
+    s = run(cooling_mass(cap, h, area, t0, t_air, t_end, n) + """
 /POST1
 *GET,T1,NODE,1,TEMP
 """)
@@ -261,29 +269,7 @@ def test_link_heat_rate_history_integrates_to_the_heat_the_mass_lost():
     C (T_1 − T_n), plus Δt (Q_1 − Q_n) / 2; *GET,,VARI,,RTIME reads the history between
     stored times linearly."""
     cap, h, area, t0, t_air, t_end, n = 2.7e-4, 2.0, 0.0081812, 300.0, 100.0, 0.05, 500
-    s = run(f"""/PREP7
-ANTYPE,TRANS
-ET,1,MASS71,,,1
-ET,2,LINK34
-R,1,{cap}
-R,2,{area}
-MP,HF,1,{h}
-N,1
-N,2
-E,1
-TYPE,2
-REAL,2
-E,1,2
-FINISH
-/SOLU
-TIME,{t_end}
-NSUBST,{n}
-AUTOTS,OFF
-BFUNIF,TEMP,{t0}
-KBC,1
-D,2,TEMP,{t_air}
-SOLVE
-FINISH
+    s = run(cooling_mass(cap, h, area, t0, t_air, t_end, n) + f"""
 /POST26
 NSOL,2,1,TEMP
 ESOL,3,2,,SMISC,1

@@ -198,21 +198,26 @@ def mshape(s: SessionState, c: Call) -> None:
     s.db.mesh_triangles = key == 1
 
 
+def _range_of(c: Call, table: dict, what: str, field: str) -> list[int]:
+    """Fields 1..3 of AMESH/LMESH: ALL (or blank), or N1, N2, NINC (each must exist)."""
+    if c.label(1, "ALL") == "ALL":
+        return sorted(table)
+    first = c.entity(1, f"{field}1")
+    last = c.entity(2, f"{field}2") if c.given(2) else first
+    step = c.int(3, 1, what="NINC")
+    if step < 1:
+        raise ApdlError("field 3 (NINC) must be ≥ 1")
+    chosen = list(range(first, last + 1, step))
+    for num in chosen:
+        if num not in table:
+            raise ApdlError(f"{what} {num} does not exist")
+    return chosen
+
+
 @command("AMESH", PREP7, 3)
 def amesh(s: SessionState, c: Call) -> None:
     areas = s.db.areas
-    if c.label(1, "ALL") == "ALL":
-        chosen = sorted(areas)
-    else:
-        first = c.entity(1, "NA1")
-        last = c.entity(2, "NA2") if c.given(2) else first
-        step = c.int(3, 1, what="NINC")
-        if step < 1:
-            raise ApdlError("field 3 (NINC) must be ≥ 1")
-        chosen = list(range(first, last + 1, step))
-        for num in chosen:
-            if num not in areas:
-                raise ApdlError(f"area {num} does not exist")
+    chosen = _range_of(c, areas, "area", "NA")
     chosen = [num for num in chosen if num not in s.db.meshed_areas]
     if not chosen:
         raise ApdlError("no unmeshed areas to mesh")
@@ -242,18 +247,7 @@ def lmesh(s: SessionState, c: Call) -> None:
     first (when they have no node yet), then its interior nodes from k1 to k2."""
     db = s.db
     lines = db.lines
-    if c.label(1, "ALL") == "ALL":
-        chosen = sorted(lines)
-    else:
-        first = c.entity(1, "NL1")
-        last = c.entity(2, "NL2") if c.given(2) else first
-        step = c.int(3, 1, what="NINC")
-        if step < 1:
-            raise ApdlError("field 3 (NINC) must be ≥ 1")
-        chosen = list(range(first, last + 1, step))
-        for num in chosen:
-            if num not in lines:
-                raise ApdlError(f"line {num} does not exist")
+    chosen = _range_of(c, lines, "line", "NL")
     et = db.element_types.get(db.active_type)
     if et is None:
         raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
