@@ -11,14 +11,20 @@ import pytest
 
 from twin.loop.overlap import ForkedTask, ForkedTaskError, fork_is_safe
 
-needs_fork = pytest.mark.skipif(not fork_is_safe(), reason="no safe os.fork here")
+
+@pytest.fixture
+def needs_fork() -> None:
+    """Checked when the test runs, not when it is collected: a test before it may have left
+    threads running (a dask cluster's), and then this process may not fork."""
+    if not fork_is_safe():
+        pytest.skip("no safe os.fork in this process now (not Linux, or threads running)")
 
 
 def _write_pid(path: Path) -> None:
     path.write_text(str(os.getpid()))
 
 
-@needs_fork
+@pytest.mark.usefixtures("needs_fork")
 def test_task_runs_in_a_child_after_start_and_sees_files_written_before(tmp_path):
     prepared = tmp_path / "prepared"
     source = tmp_path / "source.txt"
@@ -38,7 +44,7 @@ def test_task_runs_in_a_child_after_start_and_sees_files_written_before(tmp_path
     assert int(prepared.read_text()) != os.getpid()
 
 
-@needs_fork
+@pytest.mark.usefixtures("needs_fork")
 def test_a_failing_task_raises_in_the_parent_with_its_message(tmp_path):
     def fail(_: str) -> None:
         raise ValueError("no keypoints.csv in the run folder")
@@ -49,7 +55,7 @@ def test_a_failing_task_raises_in_the_parent_with_its_message(tmp_path):
         side.join()
 
 
-@needs_fork
+@pytest.mark.usefixtures("needs_fork")
 def test_a_failing_preparation_fails_the_task(tmp_path):
     def prepare() -> None:
         raise ImportError("matplotlib is missing")
@@ -61,7 +67,7 @@ def test_a_failing_preparation_fails_the_task(tmp_path):
     assert not done.exists()
 
 
-@needs_fork
+@pytest.mark.usefixtures("needs_fork")
 def test_a_task_returning_no_text_is_an_error_forked_or_not():
     for fork in (True, False):
         side = ForkedTask(lambda _: 42, fork=fork)
@@ -70,7 +76,7 @@ def test_a_task_returning_no_text_is_an_error_forked_or_not():
             side.join()
 
 
-@needs_fork
+@pytest.mark.usefixtures("needs_fork")
 def test_a_task_never_started_never_runs_and_the_parents_error_passes(tmp_path):
     done = tmp_path / "done"
     with pytest.raises(KeyError, match="parent failed"):
