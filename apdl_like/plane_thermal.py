@@ -462,6 +462,25 @@ class PlaneThermal:
                 r = r - load.assemble(fb, g=flux, axisymmetric=ax)
         return r
 
+    def film_heat(self, inputs: ThermalInputs, T: np.ndarray, keys: np.ndarray) -> np.ndarray:
+        """Per exterior face (node-pair key) the heat its film takes out of the model,
+        ∫ h (T − T_bulk) dA (W; consistent integral, 2πr in an axisymmetric model); 0 on a
+        face without a film."""
+        out = np.zeros(keys.size)
+        ax = self.mesh.axisymmetric
+        for part in self.mesh.parts:
+            T_local = T[part.local_dofs]
+            for group_keys, h, tb in inputs.films:
+                for n in np.nonzero(np.isin(keys, group_keys))[0]:
+                    facets = np.nonzero(part.facet_keys == keys[n])[0]
+                    if not facets.size:
+                        continue
+                    fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets[:1])
+                    H = mass.assemble(fb, c=h, axisymmetric=ax)
+                    out[n] += float((H @ T_local).sum()
+                                    - load.assemble(fb, g=h * tb, axisymmetric=ax).sum())
+        return out
+
     def reaction(self, inputs: ThermalInputs, T: np.ndarray) -> np.ndarray:
         """Heat flow into the model at each dof (W; nonzero at fixed temperatures), steady."""
         K, _, f = self.operators(inputs, T, nonlinear=True)

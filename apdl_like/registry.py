@@ -15,6 +15,7 @@ from apdl_like.commands import (
     aux12,
     begin,
     blocks,
+    etable,
     generate,
     loads,
     post1,
@@ -26,8 +27,8 @@ from apdl_like.commands import (
     tables,
 )
 
-FAMILIES = (aux12, begin, blocks, generate, loads, post1, post26, prep7, selection, solid,
-            solution, tables)
+FAMILIES = (aux12, begin, blocks, etable, generate, loads, post1, post26, prep7, selection,
+            solid, solution, tables)
 
 
 def build_registry(specs: Iterable[CommandSpec]) -> Mapping[str, CommandSpec]:

@@ -170,6 +170,9 @@ class SessionState:
     # /POST26 variables: number -> (name, times s, values); FSUM's last total heat, W
     variables: dict[int, tuple[str, np.ndarray, np.ndarray]] = field(default_factory=dict)
     fsum_heat: float | None = None
+    # ETABLE columns (per element of the table) and SSUM's last totals
+    element_table: dict[str, np.ndarray] = field(default_factory=dict)
+    element_sums: dict[str, float] = field(default_factory=dict)
     radiation: Radiation = field(default_factory=Radiation)
     load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving

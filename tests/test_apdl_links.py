@@ -55,7 +55,8 @@ FINISH
 
 def test_composite_wall_of_bars_and_convection_links_is_a_series_of_resistances():
     """Fluid 1 -LINK34- wall a (LINK33) - wall b (LINK33) -LINK34- fluid 2, unit area:
-    q = ΔT / (1/h1 + La/ka + Lb/kb + 1/h2); the inner wall temperatures follow."""
+    q = ΔT / (1/h1 + La/ka + Lb/kb + 1/h2); the inner wall temperatures follow, and each
+    bar's HEAT RATE (ETABLE,,SMISC,1, summed by SSUM over the two) is q."""
     h1, ka, la, kb, lb, h2 = 12.0, 0.8, 0.75, 0.1, 0.4, 2.0
     t1, t2 = 3000.0, 80.0
     s = run(f"""/PREP7
@@ -87,6 +88,10 @@ FINISH
 /POST1
 *GET,T2,NODE,2,TEMP
 *GET,T4,NODE,4,TEMP
+ESEL,S,ELEM,,2,3
+ETABLE,QB,SMISC,1
+SSUM
+*GET,QBARS,SSUM,,ITEM,QB
 FINISH
 /POST26
 ESOL,2,1,1,HEAT
@@ -95,6 +100,7 @@ ESOL,2,1,1,HEAT
     q = (t1 - t2) / (1 / h1 + la / ka + lb / kb + 1 / h2)
     p = s.params
     assert p["Q"] == pytest.approx(q, rel=1e-10)
+    assert p["QBARS"] == pytest.approx(2 * q, rel=1e-10)  # both bars' HEAT RATE (ETABLE)
     assert p["T2"] == pytest.approx(t1 - q / h1, rel=1e-10)
     assert p["T4"] == pytest.approx(t2 + q / h2, rel=1e-10)
 

@@ -419,6 +419,36 @@ SOLVE
     assert s.params["T_END"] == pytest.approx(wall_end_C(100.0, 20.0, 50.0), rel=1e-9)
 
 
+@pytest.mark.parametrize("quadratic", [False, True])
+def test_bfa_heat_leaves_through_the_surf151_films_etable_ssum(quadratic):
+    """BFA heats the slab's area (q̇ W/m³), SURF151 films carry it away at x = 0.1 (h, T_b),
+    every other side insulated.  Steady: the films' heat rates (ETABLE,,SMISC,2; SSUM) add
+    up to q̇ · area (unit thickness), and the 1-D wall gives T(L) = T_b + q̇ L / h."""
+    qdot, h, tb, length = 2e5, 80.0, 20.0, 0.1
+    solid = "PLANE77" if quadratic else "PLANE55"
+    s = run(convecting_slab(0.01, f"ET,1,{solid}\nET,2,SURF151",
+                            "ESLN,S,0\nTYPE,2\nESURF") + f"""
+ALLSEL
+BFA,1,HGEN,{qdot}
+/SOLU
+ESEL,S,TYPE,,2
+SFE,ALL,1,CONV,1,{h}
+SFE,ALL,1,CONV,2,{tb}
+ALLSEL
+SOLVE
+FINISH
+/POST1
+*GET,T_END,NODE,NODE(0.1,0,0),TEMP
+ESEL,S,TYPE,,2
+ETABLE,QF,SMISC,2
+SSUM
+*GET,Q,SSUM,,ITEM,QF
+""")
+    p = s.params
+    assert p["Q"] == pytest.approx(qdot * length * 0.05, rel=1e-9)
+    assert p["T_END"] == pytest.approx(tb + qdot * length / h, rel=1e-9)
+
+
 def test_lswrite_lssolve_solves_each_written_load_step():
     """Two load steps written with LSWRITE and solved by LSSOLVE: a slab with T_0 at x = 0
     and convection h = 50, T_b = 20 at x = L: T(L) = T_b + (T_0 − T_b)/(1 + hL/k)."""

@@ -75,6 +75,12 @@ def star_get(s: SessionState, c: Call) -> None:
             raise ApdlError("FSUM supports *GET,Par,FSUM,,ITEM,HEAT")
         s.params[name] = s.fsum_heat
         return
+    if entity == "SSUM":
+        label = c.label(5)
+        if item != "ITEM" or label not in s.element_sums:
+            raise ApdlError(f"SSUM has no total {label!r} (ETABLE, then SSUM)")
+        s.params[name] = s.element_sums[label]
+        return
     if entity == "RAD":
         if item != "VFAVG":
             raise ApdlError(f"field 4: RAD supports VFAVG, got {item or '(empty)'!r}")

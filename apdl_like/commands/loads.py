@@ -351,22 +351,29 @@ def bfe(s: SessionState, c: Call) -> None:
     s.note_load(c)
 
 
+def _solid_entities(c: Call, command_name: str, table: dict, unselected: set[int],
+                    field_name: str, what: str) -> list[int]:
+    """The keypoints or areas of BFK/BFA field 1 (ALL: the selected ones); field 2 HGEN."""
+    if c.label(2) != "HGEN":
+        raise ApdlError(f"field 2: {command_name} supports HGEN, got "
+                        f"{c.label(2) or '(empty)'!r}")
+    chosen = [n for n in sorted(table) if n not in unselected] if c.label(1) == "ALL" else \
+        [c.entity(1, field_name)]
+    for num in chosen:
+        if num not in table:
+            raise ApdlError(f"{what} {num} does not exist")
+    return chosen
+
+
 @command("BFK", LOADS, 6)
 def bfk(s: SessionState, c: Call) -> None:
     """BFK,KPOI|ALL,HGEN,VAL1: heat generation at keypoints.  As MAPDL transfers keypoint
     body loads, a meshed line or area whose keypoints all carry one takes it: along a line
     it varies linearly between the two end values (each element gets the value at its
     midpoint); an area takes a value only when its keypoints agree."""
-    if c.label(2) != "HGEN":
-        raise ApdlError(f"field 2: BFK supports HGEN, got {c.label(2) or '(empty)'!r}")
     db = s.db
-    if c.label(1) == "ALL":
-        chosen = [n for n in sorted(db.keypoints) if n not in db.unselected_keypoints]
-    else:
-        chosen = [c.entity(1, "KPOI")]
-    for num in chosen:
-        if num not in db.keypoints:
-            raise ApdlError(f"keypoint {num} does not exist")
+    for num in _solid_entities(c, "BFK", db.keypoints, db.unselected_keypoints, "KPOI",
+                               "keypoint"):
         db.keypoint_hgen[num] = c.num(3, what="VAL1")
     el = db.elements
     el.flush()
@@ -386,6 +393,20 @@ def bfk(s: SessionState, c: Call) -> None:
         kps = db.areas[num]
         if all(k in loads for k in kps) and len({loads[k] for k in kps}) == 1:
             _set_hgen(s, el.index(elements), loads[kps[0]])
+    s.note_load(c)
+
+
+@command("BFA", LOADS, 6)
+def bfa(s: SessionState, c: Call) -> None:
+    """BFA,AREA|ALL,HGEN,VAL1: heat generation on the elements of meshed areas (ALL: the
+    selected ones), as MAPDL transfers an area body load to its elements."""
+    db = s.db
+    value = c.num(3, what="VAL1")
+    db.elements.flush()
+    for num in _solid_entities(c, "BFA", db.areas, db.unselected_areas, "AREA", "area"):
+        if num not in db.area_elements:
+            raise ApdlError(f"area {num} is not meshed: AMESH it before BFA")
+        _set_hgen(s, db.elements.index(db.area_elements[num]), value)
     s.note_load(c)
 
 
@@ -424,6 +445,6 @@ def tref(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfedele, ic, tunif, bfunif,
+    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfa, bfedele, ic, tunif, bfunif,
               tref),
 )

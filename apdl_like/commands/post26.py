@@ -43,7 +43,7 @@ def thermal_history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
     return np.array(times), temps
 
 
-def _plane(s: SessionState):  # noqa: ANN202 - (PlaneThermal, ThermalInputs)
+def plane_solution(s: SessionState):  # noqa: ANN201 - (PlaneThermal, ThermalInputs)
     solver = s.fem.plane_solver
     if solver is None or s.fem.plane_inputs is None:
         raise ApdlError("element heat flows need a thermal solution of the deck's own mesh")
@@ -65,7 +65,7 @@ def nsol(s: SessionState, c: Call) -> None:
     if c.label(3, "TEMP") != "TEMP":
         raise ApdlError(f"field 3: NSOL supports TEMP, got {c.label(3)!r}")
     times, temps = thermal_history(s)
-    model, _ = _plane(s)
+    model, _ = plane_solution(s)
     dof = model.mesh.node_dof[i]
     if dof < 0:
         raise ApdlError(f"node {c.raw(2)} is not attached to an element")
@@ -89,7 +89,7 @@ def esol(s: SessionState, c: Call) -> None:
         raise ApdlError(f"node {node} is not a node of element {c.raw(2)}")
     if c.label(4) != "HEAT":
         raise ApdlError(f"field 4: ESOL supports HEAT, got {c.label(4) or '(empty)'!r}")
-    model, inputs = _plane(s)
+    model, inputs = plane_solution(s)
     dof = model.mesh.node_dof[s.node_index(node)]
     times, temps = thermal_history(s)
     values = np.array([model.element_heat(inputs, T, e)[dof] for T in temps])
@@ -99,7 +99,7 @@ def esol(s: SessionState, c: Call) -> None:
 def _link_heat_rate(s: SessionState, c: Call, nvar: int, e: int) -> None:
     if c.int(5, what="component") != 1:
         raise ApdlError("field 5: SMISC supports component 1 (a link's HEAT RATE)")
-    model, inputs = _plane(s)
+    model, inputs = plane_solution(s)
     links = model.links
     where = None if links is None else np.nonzero(links.elements == e)[0]
     if where is None or not where.size or links.kind[where[0]] == "mass":
@@ -179,7 +179,7 @@ def get_variable(s: SessionState, n: int, what: str, sub: str) -> float:
 def reactions(s: SessionState) -> tuple[np.ndarray, np.ndarray]:
     """(node indices with a fixed temperature, their reaction heat flow, W) of the result
     shown in /POST1 (steady conduction with the last solve's loads)."""
-    model, inputs = _plane(s)
+    model, inputs = plane_solution(s)
     res = s.result()
     if res.analysis != "thermal":
         raise ApdlError("reaction heats need a thermal result")
@@ -207,7 +207,7 @@ def fsum(s: SessionState, c: Call) -> None:
     (*GET,Par,FSUM,,ITEM,HEAT).  MAPDL sums the element nodal heat flows, counted positive
     into the model: a film that heats the model adds, a fixed temperature that takes heat
     out adds; over all elements and nodes it is minus the total reaction heat."""
-    model, inputs = _plane(s)
+    model, inputs = plane_solution(s)
     res = s.result()
     if res.analysis != "thermal":
         raise ApdlError("FSUM sums heat flows of a thermal result")
