@@ -15,19 +15,33 @@ from twin.runs import write_run
 PLANT = ToyPlant()
 
 
-def _toy_simulator(run):
+def _toy_simulator(run, anchored=True):
+    """The toy plant's open-loop run with window-fit-like targets (the truth factors) and,
+    for the anchored networks, an anchor 5 % above nominal and input rows made of the
+    measured-minus-simulated T1..T4 at each window start."""
     speed = float(run.speed_rpm[0])
     ambient = float(run.ambient_C[0])
     t = np.arange(0.0, run.time_s[-1] + 1e-9, 4.0)
     H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
     T = PLANT.simulate(t, speed, ambient, H, R)
-    nominal = np.tile(np.r_[H, R], (int(np.ceil(t[-1] / 60.0)), 1))
-    return [SimulatedRun(t, T, nominal, nominal, "open_loop")]
+    windows = int(np.ceil(t[-1] / 60.0))
+    nominal = np.tile(np.r_[H, R], (windows, 1))
+    if not anchored:
+        return [SimulatedRun(t, T, nominal, nominal, "open_loop")]
+    starts = 60.0 * np.arange(windows)
+    error = (np.array([np.interp(starts, run.time_s, run.T_C[:, j]) for j in range(4)])
+             - np.array([np.interp(starts, t, T[:, j]) for j in range(4)])).T
+    rows = np.stack([np.column_stack([np.full(windows, speed), np.full(windows, 0.05),
+                                      error[:, j], error[:, (j + 1) % 4], starts,
+                                      np.zeros(windows)]) for j in range(4)], axis=1)
+    return [SimulatedRun(t, T, nominal, nominal, "fit", fitted=nominal * [1.1, 1.1, 1.2, 1.2],
+                         anchors=nominal * 1.05, anchored_inputs=rows)]
 
 
 @pytest.fixture
 def runs(tmp_path, monkeypatch):
-    monkeypatch.setattr(training, "training_simulator", lambda rule="fit": _toy_simulator)
+    monkeypatch.setattr(training, "training_simulator",
+                        lambda rule="fit", spindle=None: _toy_simulator)
     paths = []
     for i, speed in enumerate((6000.0, 8000.0, 11000.0)):
         t = np.arange(0, 901, 5.0)
@@ -57,11 +71,15 @@ def test_train_writes_model_and_report(runs, tmp_path):
                       "--seed", "3", "--quiet"])
     assert result.exit_code == 0, result.output
     model = load_model(out)
-    assert model.config_name == "default"
+    assert model.config_name == "anchored"
     assert model.metadata["training_runs"] == ["run_11000", "run_6000", "run_8000"]
+    # the closed-loop check replayed the held-out run with every group of networks
+    assert set(model.metadata["networks_kept"]) <= {"heat", "resistance"}
+    assert set(model.metadata["held_out_temperature_accuracy_pct"]) == {
+        "anchor", "resistance", "heat", "heat+resistance"}
     report = json.loads((out.parent / "m.safetensors.report.json").read_text())
-    assert set(report["configs"]) == {"default", "paper"}
-    assert report["configs"]["default"]["r2"]["heat_front"]["epochs"] <= 60
+    assert set(report["configs"]) == {"anchored", "paper"}
+    assert report["configs"]["anchored"]["r2"]["heat_front"]["epochs"] <= 60
     page = (out.parent / "m.safetensors.report.html").read_text()
     assert page.count("data:image/png;base64,") == 3
     assert [p.read_bytes() for p in runs] == before  # inputs never modified
@@ -77,8 +95,24 @@ def test_train_writes_model_and_report(runs, tmp_path):
     assert load_model(paper).config_name == "paper"
 
 
+@pytest.mark.slow
+def test_anchored_networks_need_the_fit_targets(runs, tmp_path, monkeypatch):
+    # the ratio-rule simulation records no anchor: the default networks cannot learn from
+    # it (exit 2, naming --targets); the paper's configuration can
+    monkeypatch.setattr(training, "training_simulator",
+                        lambda rule="fit", spindle=None: lambda run: _toy_simulator(run, False))
+    out = tmp_path / "m.safetensors"
+    result = _invoke(["train", *map(str, runs), "--out", str(out), "--targets", "ratio",
+                      "--epochs", "5", "--quiet"])
+    assert result.exit_code == 2 and "--targets" in result.output
+    assert not out.exists()
+    assert _invoke(["train", *map(str, runs), "--out", str(out), "--targets", "ratio",
+                    "--epochs", "5", "--paper-config", "--quiet"]).exit_code == 0
+
+
 def test_train_bad_run_exits_2(tmp_path, monkeypatch):
-    monkeypatch.setattr(training, "training_simulator", lambda rule="fit": _toy_simulator)
+    monkeypatch.setattr(training, "training_simulator",
+                        lambda rule="fit", spindle=None: _toy_simulator)
     bad = tmp_path / "bad.csv"
     bad.write_text("time_s,speed_rpm\n0,9000\n")
     result = _invoke(["train", str(bad), "--out", str(tmp_path / "m.safetensors")])

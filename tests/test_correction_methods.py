@@ -112,9 +112,11 @@ def test_ratio_dead_sensor_keeps_previous_value():
 
 
 class _ConstantNet:
-    """A stand-in model: every network answers nominal × 1.2."""
+    """A stand-in model of the paper's kind: every network answers nominal × 1.2."""
 
-    def predict(self, output, x):
+    anchored = False
+
+    def predict(self, output, x, anchor=None):
         return np.asarray(x)[:, 5] * 1.2
 
 
@@ -133,6 +135,49 @@ def test_bpnn_dead_sensor_keeps_previous_factor_on_moving_nominal():
     # front resistance: the previous factor 1.07 on the new nominal, not the held value
     assert factor[2] == pytest.approx(1.07, rel=1e-12)
     assert factor[[0, 1, 3]] == pytest.approx([1.2, 1.2, 1.2], rel=1e-12)
+
+
+class _ConstantCorrection:
+    """A stand-in anchored model: every network answers anchor × 1.2."""
+
+    anchored = True
+
+    def predict(self, output, x, anchor=None):
+        return np.asarray(anchor) * 1.2
+
+
+def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_sleeve():
+    from twin.correction.methods import ratio_anchor
+
+    t, T = _measured()
+    T = T.copy()
+    T[:, 2] = np.nan  # T3 (rear ring) stuck, excluded by the quality check
+    nominal = _nominal()
+    previous = BoundaryValues(*(np.array(nominal) * 1.05))
+    sim = T + np.array([0.3, 0.2, 0.0, 0.4, 0.0])  # the twin runs hot on the rear sleeve
+    sim[:, 2] = sim[:, 3] + 0.5
+    upto = t <= 600
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto], t[upto], sim[upto],
+                       nominal, previous, previous_factors=(1.05, 1.05, 1.05, 1.05))
+    assert f.dead_rings() == ("rear",)
+    anchor = ratio_anchor(f, np.full(4, 1.05))
+    # the ratio law alone has no T3 and holds the rear heat factor; the anchor reads the
+    # sleeve instead, which the twin overshoots: the rear heat comes down
+    ratio = np.array(RatioCorrection().correct(f).values)
+    assert ratio[1] / nominal[1] == pytest.approx(1.05, rel=1e-12)
+    assert anchor[1] / nominal[1] < 1.0
+    on_sleeve = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto][:, [0, 1, 3, 3, 4]],
+                               t[upto], sim[upto][:, [0, 1, 3, 3, 4]], nominal, previous,
+                               previous_factors=(1.05, 1.05, 1.05, 1.05))
+    assert anchor == pytest.approx(np.array(RatioCorrection().correct(on_sleeve).values),
+                                   rel=1e-12)
+    # the networks correct the anchor (× 1.2 here) where their inputs exist; the rear
+    # bearing's networks never saw a sleeve for a ring, the anchor stands there
+    method = make_corrector("bpnn", model=_ConstantCorrection())
+    method.anchor_factors = np.full(4, 1.05)
+    values = np.array(method.correct(f).values)
+    assert values[[0, 2]] == pytest.approx(1.2 * anchor[[0, 2]], rel=1e-12)
+    assert values[[1, 3]] == pytest.approx(anchor[[1, 3]], rel=1e-12)
 
 
 def test_speed_change_carries_the_factor():

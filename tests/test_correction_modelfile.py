@@ -37,7 +37,12 @@ def test_round_trip(tmp_path, config):
         for part in ("hidden_weight", "output_bias", "x_scale"):
             assert np.array_equal(getattr(back.nets[output], part),
                                   getattr(model.nets[output], part))
-        assert np.array_equal(back.predict(output, x), model.predict(output, x))
+        anchor = x[:, 5] if config.anchored else None
+        assert np.array_equal(back.predict(output, x, anchor), model.predict(output, x, anchor))
+    # the file names the inputs of its configuration
+    names = back.metadata["inputs"]["heat_front"]
+    assert ("previous_log_correction" in names) == config.anchored
+    assert ("nominal_heat_W_m3" in names) == (not config.anchored)
     assert not list(tmp_path.glob(".*.tmp"))  # atomic write left nothing behind
 
 

@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 from twin.cli import app
 from twin.correction import BoundaryValues, OpenLoop, RatioCorrection, WindowFeatures
 from twin.correction.methods import BpnnCorrection
+from twin.correction.network import ANCHORED, PAPER
 from twin.correction.samples import RunCurves, fit_samples
 from twin.correction.training import train_model
 
@@ -22,10 +23,21 @@ NOMINAL_STOPPED = BoundaryValues(0.0, 0.0, 2.1e-4, 3.1e-4)
 
 
 class _ConstantNet:
-    """A stand-in model: every network answers nominal × 1.2."""
+    """A stand-in model of the paper's kind: every network answers nominal × 1.2."""
 
-    def predict(self, output, x):  # noqa: ANN001, ANN201
+    anchored = False
+
+    def predict(self, output, x, anchor=None):  # noqa: ANN001, ANN201
         return np.asarray(x)[:, 5] * 1.2
+
+
+class _ConstantCorrection:
+    """A stand-in anchored model: every network answers anchor × 1.2."""
+
+    anchored = True
+
+    def predict(self, output, x, anchor=None):  # noqa: ANN001, ANN201
+        return np.asarray(anchor) * 1.2
 
 
 def _features(window, nominal, previous, previous_nominal=None, factors=None):  # noqa: ANN001, ANN202
@@ -36,7 +48,8 @@ def _features(window, nominal, previous, previous_nominal=None, factors=None):  
                           previous_nominal=previous_nominal, previous_factors=factors)
 
 
-@pytest.mark.parametrize("method", [OpenLoop(), RatioCorrection(), BpnnCorrection(_ConstantNet())])
+@pytest.mark.parametrize("method", [OpenLoop(), RatioCorrection(), BpnnCorrection(_ConstantNet()),
+                                    BpnnCorrection(_ConstantCorrection())])
 def test_a_stopped_bearing_gets_no_heat_and_nothing_divides_by_zero(method):
     previous = BoundaryValues(*(np.array(NOMINAL_RUNNING) * 1.1))
     with np.errstate(divide="raise", invalid="raise"):
@@ -82,17 +95,21 @@ def test_training_leaves_stopped_heat_samples_out():
     fitted = nominal * rng.uniform(0.9, 1.3, nominal.shape)
     t = np.arange(0.0, 60.0 * windows + 1e-9, 10.0)
     T = 25.0 + rng.normal(0.0, 0.1, (t.size, 5))
+    anchors = nominal * rng.uniform(0.9, 1.3, nominal.shape)  # 0 at a stop, as nominal
+    rows = rng.normal(size=(windows, 4, 6))
     curves = RunCurves("stops", t, np.where(stopped[np.minimum(t // 60, windows - 1)
                                                    .astype(int)], 0.0, 9000.0),
-                       np.full(t.size, 25.0), T, t, T, nominal, nominal, fitted=fitted)
+                       np.full(t.size, 25.0), T, t, T, nominal, nominal, fitted=fitted,
+                       anchors=anchors, anchored_inputs=rows)
     samples = fit_samples(curves)
     assert np.all(samples.targets["heat_front"][stopped] == 0.0)
-    with np.errstate(divide="raise", invalid="raise"):
-        result = train_model(samples, epochs=5)
-    for output in ("heat_front", "heat_rear"):
-        assert np.all(result.outputs[output].test_nominal > 0)
-    assert len(result.outputs["resistance_front"].test_nominal) > len(
-        result.outputs["heat_front"].test_nominal)
+    for config in (ANCHORED, PAPER):
+        with np.errstate(divide="raise", invalid="raise"):
+            result = train_model(samples, config=config, epochs=5)
+        for output in ("heat_front", "heat_rear"):
+            assert np.all(result.outputs[output].test_nominal > 0)
+        assert len(result.outputs["resistance_front"].test_nominal) > len(
+            result.outputs["heat_front"].test_nominal)
 
 
 def invoke(*args: str):  # noqa: ANN201

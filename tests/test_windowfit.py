@@ -14,7 +14,7 @@ from tests.test_replay import make_recorded_run
 from twin.correction.samples import fit_samples
 from twin.correction.training_data import run_curves
 from twin.loop.replay import replay_method
-from twin.loop.training import DRIVEN_PASSES, simulate_for_training, training_simulator
+from twin.loop.training import TRAINING_PASSES, simulate_for_training, training_simulator
 from twin.loop.windowfit import WindowFit
 from twin.runs import read_run
 
@@ -45,11 +45,14 @@ def test_fit_recovers_the_true_factors(run, spindle_model):
 
 def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
     passes = simulate_for_training(run, spindle_model)
-    assert len(passes) == 1 + len(DRIVEN_PASSES)
-    exact, driven = passes[0], passes[1]
-    # the exact pass runs on its fit; a driven pass runs off it but still targets the fit
-    assert np.array_equal(exact.used, exact.fitted)
-    assert not np.allclose(driven.used, driven.fitted)
+    assert [d for d, _ in TRAINING_PASSES] == ["anchor", "anchor", "fit"]
+    assert len(passes) == len(TRAINING_PASSES)
+    exact, driven, fit_driven = passes
+    # the first pass runs on the ratio-law anchor, the others scattered off anchor / fit;
+    # every pass targets the fit from the state it reached
+    assert np.array_equal(exact.used, exact.anchors)
+    assert not np.allclose(driven.used, driven.anchors)
+    assert not np.allclose(fit_driven.used, fit_driven.fitted)
     again = simulate_for_training(run, spindle_model)
     assert all(np.array_equal(a.fitted, b.fitted) for a, b in zip(passes, again, strict=True))
     samples = [fit_samples(c) for c in run_curves(run, training_simulator("fit", spindle_model))]
@@ -57,6 +60,36 @@ def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
     np.testing.assert_array_equal(samples[1].targets["heat_front"], driven.fitted[:, 0])
     # the inputs are what the loop shows the network at each window start
     np.testing.assert_array_equal(samples[0].inputs["heat_front"][:, 4], 60.0 * np.arange(6))
+    rows = samples[0].anchored_inputs["heat_front"]
+    assert np.isnan(rows[0, 3])  # window 0: no rise to compare yet (the anchor is used)
+    np.testing.assert_array_equal(rows[1:, 4], 60.0 * np.arange(1, 6))
+    # undriven, the network's previous correction on the anchor is none
+    np.testing.assert_allclose(rows[1:, 5], 0.0, atol=1e-12)
+    np.testing.assert_array_equal(samples[0].anchors["heat_front"], exact.anchors[:, 0])
+
+
+def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, spindle_model):
+    # driven by its anchor, the window fit's twin runs exactly as the loop runs `bpnn` with
+    # networks that output 0: the anchored design reproduces the ratio law
+    from twin.correction.methods import BpnnCorrection, RatioCorrection
+    from twin.correction.modelfile import CorrectionModel
+    from twin.correction.network import ANCHORED, TrainedNet
+
+    nets = {o: TrainedNet(ANCHORED, np.ones((10 if o.startswith("heat") else 12, 6)),
+                          np.zeros(10 if o.startswith("heat") else 12),
+                          np.zeros((1, 10 if o.startswith("heat") else 12)), np.zeros(1),
+                          np.zeros(6), np.ones(6), np.zeros(1), np.ones(1))
+            for o in ("heat_front", "heat_rear", "resistance_front", "resistance_rear")}
+    zero = BpnnCorrection(CorrectionModel(nets))
+    bpnn = replay_method(run, spindle_model, zero, keep_fields=False)
+    ratio = replay_method(run, spindle_model, RatioCorrection(), keep_fields=False)
+    fit = WindowFit(run, spindle_model, drive="anchor")
+    replay_method(run, spindle_model, fit, keep_fields=False)
+    used = np.array([list(w.correction.values) for w in bpnn.windows])
+    np.testing.assert_allclose(used, [list(w.correction.values) for w in ratio.windows],
+                               rtol=1e-12)
+    np.testing.assert_allclose(used, np.array(fit.anchors), rtol=1e-12)
+    np.testing.assert_allclose(bpnn.T_twin_C, ratio.T_twin_C, rtol=1e-12)
 
 
 def test_fit_needs_the_twin_state(run, spindle_model):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import typer
@@ -16,8 +17,10 @@ def train(
     seed: int = typer.Option(0, "--seed", min=0, help="Seed of the 80/20 split and the weights."),
     paper_config: bool = typer.Option(
         False, "--paper-config",
-        help="Save the paper's configuration (linear hidden, logistic output, logistic "
-        "scaling of X/1e6) instead of the default (tanh hidden, standardised factors).",
+        help="Save the paper's configuration (the paper's six inputs, linear hidden, "
+        "logistic output, logistic scaling of X/1e6) instead of the default (a log-correction "
+        "on the ratio-law value: tanh hidden, standardised inputs, weight decay, early "
+        "stopping on held-out runs).",
     ),
     targets: TargetRule = typer.Option(
         TargetRule.FIT, "--targets",
@@ -38,35 +41,56 @@ def train(
     from twin.correction.samples import SampleSet, samples_for
     from twin.correction.training import train_model
     from twin.correction.training_data import run_curves
+    from twin.errors import InputError
     from twin.io.destinations import check_out_file
-    from twin.loop.training import training_simulator
+    from twin.loop.training import gate_networks, training_simulator
     from twin.runs import read_run
-    from twin.spindle.spec import load_spec
+    from twin.spindle.model import SpindleModel
 
     check_out_file(out, inputs=runs, also=report_paths(out))
-    simulator = training_simulator(targets)
-    limit_rpm = load_spec(None).spindle.max_speed_rpm  # the networks train on that spindle
-    sets = []
+    spindle = SpindleModel.load()  # the networks train on that spindle
+    simulator = training_simulator(targets, spindle=spindle)
+    sets, recorded = [], {}
     for path in runs:
-        run = read_run(path, max_speed_rpm=limit_rpm)
+        run = read_run(path, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
+        recorded[str(run.name)] = run
         if not quiet:
             typer.echo(f"simulating {path.name} …", err=True)
         sets.extend(samples_for(curves) for curves in run_curves(run, simulator))
     samples = SampleSet.concatenate(sets)
     chosen = PAPER if paper_config else DEFAULT
+    if chosen.anchored and samples.anchors is None:
+        raise InputError("the default (anchored) networks learn from the window fit: use "
+                         "--targets fit, or --paper-config with --targets ratio",
+                         column="--targets")
     # file names only: the model file must not depend on where the runs were kept
     meta = {"runs": [p.name for p in runs], "simulation": getattr(simulator, "__name__", ""),
             "targets": targets.value}
     results = {}
-    for config in (DEFAULT, PAPER):
+    # the other configuration too, for the report's comparison, where the samples allow it
+    for config in (c for c in (DEFAULT, PAPER) if samples.anchors is not None or not c.anchored):
         if not quiet:
             typer.echo(f"training ({config.name} configuration) on {len(samples)} samples …",
                        err=True)
         results[config.name] = train_model(samples, config=config, epochs=epochs, seed=seed,
                                            metadata=meta)
-    save_model(results[chosen.name].model, out)
+    model = results[chosen.name].model
+    if chosen.anchored:
+        if not quiet:
+            typer.echo("checking the networks in closed loop on the held-out runs …", err=True)
+        held_out = [recorded[name] for name in model.metadata["held_out_runs"]]
+        model, gate = gate_networks(model, held_out, spindle)
+        model.metadata.update(networks_kept=gate["kept"], held_out_temperature_accuracy_pct=(
+            gate.get("held_out_temperature_accuracy_pct", {})))
+        if not quiet:
+            typer.echo(f"networks kept: {', '.join(gate['kept']) or 'none (the anchor)'}",
+                       err=True)
+    save_model(model, out)
+    results[chosen.name] = dataclasses.replace(results[chosen.name], model=model)
     json_path, html_path = write_report(out, results, chosen.name)
     if not quiet:
         for output, row in results[chosen.name].r2_table().items():
-            typer.echo(f"{output:18s} R² {row['r2_value']:.4f} (factor {row['r2_factor']:.3f})")
+            r2 = {k: "n/a" if row[k] is None else f"{row[k]:.4f}"
+                  for k in ("r2_value", "r2_factor")}
+            typer.echo(f"{output:18s} R² {r2['r2_value']} (factor {r2['r2_factor']})")
         typer.echo(f"wrote {out}, {json_path.name}, {html_path.name}")

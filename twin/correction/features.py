@@ -10,6 +10,7 @@ sleeve, T3 rear-bearing outer ring, T4 rear sleeve, T5 housing (REFERENCE.md §1
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -51,6 +52,32 @@ INPUT_NAMES = {
 """Six inputs per network (the paper's choice).  The heat networks see the ring (key-point)
 temperature; the resistance networks see the ring-to-sleeve drop, which carries the
 contact-resistance signal."""
+
+ANCHORED_INPUT_NAMES = {
+    "heat": (
+        "speed_rpm",
+        "anchor_log_factor",
+        "ring_level_error_C",
+        "ring_rise_error_C",
+        "run_time_s",
+        "previous_log_correction",
+    ),
+    "resistance": (
+        "speed_rpm",
+        "anchor_log_factor",
+        "drop_level_error_C",
+        "drop_rise_error_C",
+        "run_time_s",
+        "previous_log_correction",
+    ),
+}
+"""Six inputs per network of the anchored configuration (`twin.correction.network.ANCHORED`),
+which learns a log-correction on the ratio-law value (the anchor).  Errors are measured
+minus simulated key point (ring, or ring-to-sleeve drop) from a line through the last
+window: the level the ratio law also reads, and the *rate* (rise over the window), which it
+does not (a speed step or a lagging correction shows there first).  The anchor's log factor
+on nominal says where the ratio law stands, the previous log-correction what the network
+itself added last window.  See `WindowFeatures.anchored_inputs`."""
 
 TARGET_UNITS = {"heat": "W/m³", "resistance": "m²K/W"}
 
@@ -169,6 +196,68 @@ class WindowFeatures:
     def measured_initial(self) -> np.ndarray:
         """T1..T5 at the start of the run: the first finite sample of each sensor (°C)."""
         return first_finite(self.measured_C)
+
+    def dead_rings(self) -> tuple[str, ...]:
+        """Bearings whose ring sensor has no valid sample in the last window while the
+        sleeve sensor has (a stuck or dropped-out ring thermocouple)."""
+        level, _ = window_line_fit(self.measured_time_s, self.measured_C, self.start_s,
+                                   self.window_s)
+        return tuple(b for b in BEARINGS
+                     if not np.isfinite(level[RING_SENSOR[b]])
+                     and np.isfinite(level[SLEEVE_SENSOR[b]]))
+
+    def with_sleeve_for_dead_rings(self) -> WindowFeatures:
+        """These features with the ring column (measured and simulated) of each of
+        `dead_rings` replaced by its sleeve's.
+
+        The sleeve sits next to the ring and sees the same bearing heat a little damped, so
+        a heat correction keeps working on it; the ring-to-sleeve drop is then 0 in both,
+        which the ratio law's drop guard reads as "no information" (the resistance is held).
+        """
+        dead = self.dead_rings()
+        if not dead:
+            return self
+        measured, simulated = self.measured_C.copy(), self.simulated_C.copy()
+        for bearing in dead:
+            ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
+            measured[:, ring] = measured[:, sleeve]
+            simulated[:, ring] = simulated[:, sleeve]
+        return dataclasses.replace(self, measured_C=measured, simulated_C=simulated)
+
+    def anchored_inputs(self, anchor: ArrayLike,
+                        previous_anchor_factors: ArrayLike) -> dict[str, np.ndarray]:
+        """The (1, 6) input row of each anchored network (ANCHORED_INPUT_NAMES) for this
+        window, given the anchor values (4,) and the previous window's anchor as factors on
+        its nominal values (4,), in BoundaryValues order.
+
+        A row is NaN where it has no meaning — window 0 (no rise yet), a stopped bearing's
+        heat, a missing sensor, a dead ring (the networks never saw a sleeve standing in for
+        it) — and the correction then keeps the anchor.
+        """
+        meas_level, meas_rise = window_line_fit(self.measured_time_s, self.measured_C,
+                                                self.start_s, self.window_s)
+        sim_level, sim_rise = window_line_fit(self.simulated_time_s, self.simulated_C,
+                                              self.start_s, self.window_s)
+        level_error, rise_error = meas_level - sim_level, meas_rise - sim_rise
+        with np.errstate(divide="ignore", invalid="ignore"):
+            anchor_log = np.log(np.asarray(anchor, dtype=float)
+                                / np.asarray(self.nominal, dtype=float))
+        previous = np.log(self.previous_factor() / np.asarray(previous_anchor_factors, float))
+        dead = self.dead_rings()
+        out = {}
+        for i, output in enumerate(OUTPUTS):
+            bearing = bearing_of(output)
+            ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
+            if kind_of(output) == "heat":
+                level, rise = level_error[ring], rise_error[ring]
+            else:
+                level = level_error[ring] - level_error[sleeve]
+                rise = rise_error[ring] - rise_error[sleeve]
+            row = [self.speed_rpm, anchor_log[i], level, rise, self.start_s, previous[i]]
+            out[output] = np.asarray(row, dtype=float)[None, :]
+            if bearing in dead:
+                out[output][:] = np.nan
+        return out
 
     def network_inputs(self) -> dict[str, np.ndarray]:
         """The (1, 6) input row of each network for this window."""

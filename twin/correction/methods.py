@@ -12,10 +12,12 @@ C_H and C_C relative to the previous window, for `corrections.csv`.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from twin.correction.features import (
     BEARINGS,
@@ -23,6 +25,7 @@ from twin.correction.features import (
     RING_SENSOR,
     SLEEVE_SENSOR,
     WindowFeatures,
+    correction_factors,
     window_line_fit,
 )
 from twin.correction.formulas import (
@@ -137,37 +140,75 @@ class RatioCorrection:
         return Correction.relative_to(values, f.previous)
 
 
-@dataclass(frozen=True)
+def ratio_anchor(features: WindowFeatures, anchor_factors: ArrayLike) -> np.ndarray:
+    """The value the anchored networks correct, in BoundaryValues order: the ratio law
+    (`RatioCorrection`) applied to the previous *anchor* — `anchor_factors`, its factors
+    on the previous nominal values (ones at window 0) — not to the corrected values, with a
+    dead ring sensor's place taken by its sleeve (`WindowFeatures.with_sleeve_for_dead_rings`).
+
+    Why its own chain: the ratio law is an integral action on the key-point error.  Chained
+    on the corrected values, any lasting network output δ would settle where the ratio
+    makes up for it, i.e. with the ring off the measurement by whatever gives a ratio of
+    e^−δ; chained on itself, the anchor absorbs a lasting δ and the ring error still goes to
+    0, while the network corrects what the ratio law is slow at (steps, the contact drop).
+    With a network output of 0 the two chains coincide: the ratio law exactly.
+
+    Why the sleeve: with T3 stuck the ratio law has nothing to correct the rear heat by and
+    holds it; the twin's T4 then ran 1.8 K off on a suite run, on the sleeve 0.2 K.
+    """
+    f = features.with_sleeve_for_dead_rings()
+    factors = tuple(float(a) for a in np.asarray(anchor_factors, dtype=float))
+    f = dataclasses.replace(f, previous_factors=factors)
+    return np.asarray(RatioCorrection().correct(f).values, dtype=float)
+
+
+@dataclass
 class BpnnCorrection:
     """The trained networks (one heat and one resistance network per bearing).
 
-    Inference is plain numpy on the loaded weights (no torch needed at replay time).
-    Non-finite network inputs (a dead sensor) fall back to the previous window's correction
-    factor on the current nominal value; the output is kept within the guards' band around
-    the nominal value.  A stopped bearing has no heat: its heat network is not asked.
+    Inference is plain numpy on the loaded weights (no torch needed at replay time).  An
+    anchored model (the default) corrects the ratio-law value, `ratio_anchor`, by the
+    factor exp(output); where its inputs are not finite (window 0, a dead sensor) the
+    value is the anchor.  A paper-configuration model predicts the value itself; non-finite
+    inputs fall back to the previous window's correction factor on the current nominal
+    value.  The output is kept within the guards' band around the nominal value.  A
+    stopped bearing has no heat: its heat network is not asked.
+
+    One object replays one run at a time: window 0 restarts the anchor's chain.
     """
 
     model: object = field(repr=False)
     guards: RatioGuards = DEFAULT_GUARDS
     name: str = "bpnn"
+    anchor_factors: np.ndarray = field(default_factory=lambda: np.ones(4), repr=False)
+    """The last anchor as factors on its nominal values (held through a stop)."""
 
     def correct(self, features: WindowFeatures) -> Correction:
-        inputs = features.network_inputs()
         nominal = np.asarray(features.nominal, dtype=float)
-        carried = features.carried_previous()
+        if self.model.anchored:
+            if features.window == 0:
+                self.anchor_factors = np.ones(4)
+            # without usable inputs the network's correction is none: the anchor itself
+            fallback = ratio_anchor(features, self.anchor_factors)
+            inputs = features.anchored_inputs(fallback, self.anchor_factors)
+            self.anchor_factors = correction_factors(fallback, nominal,
+                                                     fallback=self.anchor_factors)
+        else:
+            # keep the previous window's correction *factor*: the nominal value moves
+            # with speed and with the fit's temperatures (Eq. 5), a held absolute value
+            # would drift away from it (a stuck sleeve sensor held R at its cold value)
+            fallback = features.carried_previous()
+            inputs = features.network_inputs()
         values = np.empty(4)
         for i, output in enumerate(OUTPUTS):
             x = inputs[output]
             if nominal[i] == 0.0:
                 values[i] = 0.0  # a stopped bearing: no heat to correct
-                continue
-            if not np.all(np.isfinite(x)):
-                # keep the previous window's correction *factor*: the nominal value moves
-                # with speed and with the fit's temperatures (Eq. 5), a held absolute value
-                # would drift away from it (a stuck sleeve sensor held R at its cold value)
-                values[i] = carried[i]
-                continue
-            values[i] = float(self.model.predict(output, x)[0])
+            elif not np.all(np.isfinite(x)):
+                values[i] = fallback[i]
+            else:
+                anchor = fallback[i:i + 1] if self.model.anchored else None
+                values[i] = float(self.model.predict(output, x, anchor)[0])
         values = limit_to_nominal(values, nominal, self.guards)
         return Correction.relative_to(values, features.previous)
 

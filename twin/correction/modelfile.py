@@ -26,8 +26,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from twin.correction.features import HIDDEN_SIZES, INPUT_NAMES, OUTPUTS, TARGET_UNITS, kind_of
-from twin.correction.network import CONFIGS, TrainedNet
+from twin.correction.features import (
+    ANCHORED_INPUT_NAMES,
+    HIDDEN_SIZES,
+    INPUT_NAMES,
+    OUTPUTS,
+    TARGET_UNITS,
+    kind_of,
+)
+from twin.correction.network import CONFIGS, NetConfig, TrainedNet
 from twin.errors import InputError
 from twin.io.atomic import write_bytes
 from twin.paths import read_input_bytes
@@ -46,13 +53,19 @@ class CorrectionModel:
     nets: dict[str, TrainedNet]
     metadata: dict[str, Any] = field(default_factory=dict)
 
-    def predict(self, output: str, x: ArrayLike) -> np.ndarray:
-        """Corrected values of `output` (e.g. 'heat_front') for input rows x (N, 6)."""
-        return self.nets[output].predict(x)
+    def predict(self, output: str, x: ArrayLike, anchor: ArrayLike | None = None) -> np.ndarray:
+        """Corrected values of `output` (e.g. 'heat_front') for input rows x (N, 6); an
+        anchored model needs the anchor values (N,) it corrects."""
+        return self.nets[output].predict(x, anchor)
 
     @property
     def config_name(self) -> str:
         return self.nets[OUTPUTS[0]].config.name
+
+    @property
+    def anchored(self) -> bool:
+        """True if the networks correct the ratio-law value (the anchored configuration)."""
+        return self.nets[OUTPUTS[0]].config.anchored
 
 
 class _Metadata(BaseModel):
@@ -70,6 +83,11 @@ class _Metadata(BaseModel):
     seed: int | None = None
     targets: str | None = None
     sha256: str
+
+
+def input_names(config: NetConfig) -> dict[str, tuple[str, ...]]:
+    """The six input names per network kind of a configuration."""
+    return ANCHORED_INPUT_NAMES if config.anchored else INPUT_NAMES
 
 
 def _expected_shape(part: str, hidden: int) -> tuple[int, ...]:
@@ -106,7 +124,7 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
         config=config.name,
         outputs=list(OUTPUTS),
         hidden_sizes={o: model.nets[o].hidden_size for o in OUTPUTS},
-        inputs={o: list(INPUT_NAMES[kind_of(o)]) for o in OUTPUTS},
+        inputs={o: list(input_names(config)[kind_of(o)]) for o in OUTPUTS},
         units={o: TARGET_UNITS[kind_of(o)] for o in OUTPUTS},
         sha256=_digest(tensors),
     )
@@ -150,7 +168,9 @@ def load_model(path: str | Path) -> CorrectionModel:
         )
     config = CONFIGS.get(meta.get("config"))
     if config is None:
-        raise InputError(f"unknown network configuration {meta.get('config')!r}", file=str(path))
+        raise InputError(f"unknown network configuration {meta.get('config')!r} (expected "
+                         f"one of {', '.join(CONFIGS)}; retrain with `twin train`)",
+                         file=str(path))
     if meta.get("outputs") != list(OUTPUTS):
         raise InputError(f"outputs must be {list(OUTPUTS)}", file=str(path))
 

@@ -1,31 +1,38 @@
 """The BP networks: one hidden layer, trained with Rprop in torch, evaluated in numpy.
 
-Two configurations (REFERENCE.md §1; issue 6):
+Two configurations (REFERENCE.md §1; issues 6 and 13):
 
 - `PAPER`: the paper's choices — linear ("purelin") hidden layer, logistic ("logsig")
   output, every input and the target squashed by a logistic of X/10^6 (their Eq. 8), the
-  target being the corrected value itself.
-- `DEFAULT`: tanh hidden layer, inputs standardised (z-scores of the training samples),
-  linear output on the standardised *correction factor* H''/H (R''/R), so the network
-  learns the correction, not the speed dependence the nominal value already carries.
+  target being the corrected value itself, on the paper's six inputs (INPUT_NAMES).  Its
+  output is bounded by the range of its training targets.
+- `ANCHORED` (the default): the network learns a *log-correction on the ratio-law value*
+  (the anchor, `twin.correction.methods.ratio_anchor`): value = anchor · exp(output).  tanh
+  hidden layer, inputs standardised (z-scores of the training samples), linear output; the
+  target log(value/anchor) is only divided by its RMS (no offset), so an output of 0 is the
+  ratio law exactly.  Nothing caps the value at the training range: the anchor moves with
+  the measurement, the network only corrects it.  Its inputs (ANCHORED_INPUT_NAMES) carry
+  what the ratio law does not use (rates, speed change).  A weight decay and early stopping
+  on the held-out runs shrink it towards the ratio law where the data say nothing.
 
-Training: full batch, `torch.optim.Rprop` with learning rate 0.05, up to 5000 epochs,
-stop when the training MSE (in scaled units) reaches 1e-6, float64 throughout (the
-logistic of X/10^6 leaves differences of 1e-9 and less between samples).  Deterministic
-for a seed: torch.manual_seed, deterministic algorithms and one thread while training
-(restored afterwards).
+Both keep the paper's topology (6-10-1 heat, 6-12-1 resistance) and its training: full
+batch, `torch.optim.Rprop` with learning rate 0.05, up to 5000 epochs, stop when the
+training MSE (in scaled units) reaches 1e-6, float64 throughout (the logistic of X/10^6
+leaves differences of 1e-9 and less between samples).  The anchored networks keep the
+weights of the epoch with the lowest held-out MSE.  Deterministic for a seed:
+torch.manual_seed, deterministic algorithms and one thread while training (restored
+afterwards).
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-
-from twin.correction.features import correction_factors
 
 LEARNING_RATE = 0.05
 MAX_EPOCHS = 5000
@@ -41,12 +48,24 @@ class NetConfig:
     hidden_activation: str  # "tanh" | "linear"
     output_activation: str  # "linear" | "logistic"
     scaling: str  # "standard" | "logistic"
-    target: str  # "factor" | "value"
+    target: str  # "value" | "log_anchor"
+    weight_decay: float = 0.0
+    """L2 penalty on the weights (not the biases), added to the scaled MSE."""
+    early_stopping: bool = False
+    """Keep the weights of the epoch with the lowest held-out MSE."""
+
+    @property
+    def anchored(self) -> bool:
+        """True if the network corrects an anchor value (needs it to predict)."""
+        return self.target == "log_anchor"
 
 
 PAPER = NetConfig("paper", "linear", "logistic", "logistic", "value")
-DEFAULT = NetConfig("default", "tanh", "linear", "standard", "factor")
-CONFIGS = {c.name: c for c in (PAPER, DEFAULT)}
+ANCHORED_WEIGHT_DECAY = 1e-3
+ANCHORED = NetConfig("anchored", "tanh", "linear", "standard", "log_anchor",
+                     weight_decay=ANCHORED_WEIGHT_DECAY, early_stopping=True)
+DEFAULT = ANCHORED
+CONFIGS = {c.name: c for c in (PAPER, ANCHORED)}
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -63,8 +82,8 @@ class TrainedNet:
     """Weights and scaling of one network; `predict` maps physical inputs to the value.
 
     Scaling: x_s = s((x − x_offset)/x_scale), y_s = s((y − y_offset)/y_scale), with s the
-    logistic for `scaling == "logistic"` and the identity otherwise.  For a "factor"
-    target, y is the value divided by the last input (the nominal value).
+    logistic for `scaling == "logistic"` and the identity otherwise.  For a "log_anchor"
+    target, y is log(value / anchor).
     """
 
     config: NetConfig
@@ -101,11 +120,22 @@ class TrainedNet:
         out = (h @ self.output_weight.T + self.output_bias)[:, 0]
         return _sigmoid(out) if self.config.output_activation == "logistic" else out
 
-    def predict(self, x: ArrayLike) -> np.ndarray:
-        """Corrected values (W/m³ or m²K/W) for input rows x (N, 6)."""
+    def without_correction(self) -> TrainedNet:
+        """This network with its output layer zeroed: an anchored network that reproduces
+        its anchor (see `twin.loop.training.gate_networks`)."""
+        return dataclasses.replace(self, output_weight=np.zeros_like(self.output_weight),
+                                   output_bias=np.zeros_like(self.output_bias))
+
+    def predict(self, x: ArrayLike, anchor: ArrayLike | None = None) -> np.ndarray:
+        """Corrected values (W/m³ or m²K/W) for input rows x (N, 6); an anchored network
+        needs the anchor values (N,) it corrects."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
         y = self.unscale_targets(self.forward_scaled(self.scale_inputs(x)))
-        return y * x[:, 5] if self.config.target == "factor" else y
+        if not self.config.anchored:
+            return y
+        if anchor is None:
+            raise ValueError("an anchored network needs the anchor values")
+        return np.asarray(anchor, dtype=float) * np.exp(y)
 
 
 @contextlib.contextmanager
@@ -134,6 +164,23 @@ def split_indices(
     return np.sort(order[n_test:]), np.sort(order[:n_test])
 
 
+def split_by_run(
+    runs: ArrayLike, seed: int, test_fraction: float = TEST_FRACTION
+) -> tuple[np.ndarray, np.ndarray]:
+    """(train, test) sample indices with whole runs held out (a seeded `test_fraction` of
+    the distinct runs, at least one when there are two or more).
+
+    Samples of one run (its windows, its training passes) are strongly alike; a random
+    sample split would put near-copies on both sides and make the held-out error, and the
+    early stopping that reads it, flatter than on a run never seen.
+    """
+    names = np.asarray(runs).astype(str)
+    distinct = np.unique(names)
+    _, held = split_indices(len(distinct), seed, test_fraction)
+    test = np.isin(names, distinct[held])
+    return np.flatnonzero(~test), np.flatnonzero(test)
+
+
 def r_squared(target: ArrayLike, predicted: ArrayLike) -> float:
     """Coefficient of determination 1 − SS_res/SS_tot (NaN if the target is constant)."""
     t = np.asarray(target, dtype=float)
@@ -160,9 +207,12 @@ def fit_scaling(
         return (np.zeros(x_train.shape[1]), np.full(x_train.shape[1], PAPER_SCALE),
                 np.zeros(1), np.full(1, PAPER_SCALE))
     x_std = x_train.std(axis=0)
-    y_std = np.atleast_1d(y_train.std())
+    if config.anchored:  # no offset: an output of 0 is the anchor itself
+        y_off, y_std = np.zeros(1), np.atleast_1d(np.sqrt(np.mean(y_train**2)))
+    else:
+        y_off, y_std = np.atleast_1d(y_train.mean()), np.atleast_1d(y_train.std())
     return (x_train.mean(axis=0), np.where(x_std > 0, x_std, 1.0),
-            np.atleast_1d(y_train.mean()), np.where(y_std > 0, y_std, 1.0))
+            y_off, np.where(y_std > 0, y_std, 1.0))
 
 
 def train_network(
@@ -177,16 +227,24 @@ def train_network(
     seed: int = 0,
     learning_rate: float = LEARNING_RATE,
     goal_mse: float = GOAL_MSE,
+    anchor: np.ndarray | None = None,
 ) -> tuple[TrainedNet, TrainingHistory]:
-    """Train one network on rows `train` of (x (N, 6), value (N,)); `test` is held out."""
+    """Train one network on rows `train` of (x (N, 6), value (N,)); `test` is held out.
+    An anchored configuration learns log(value / anchor) (anchor (N,))."""
     import torch
 
     if epochs < 1:
         raise ValueError("epochs must be at least 1")
     x = np.asarray(x, dtype=float)
     value = np.asarray(value, dtype=float)
-    # rows of a stopped bearing (nominal 0) carry no factor; the caller leaves them out
-    y = correction_factors(value, x[:, 5]) if config.target == "factor" else value
+    if config.anchored:
+        if anchor is None:
+            raise ValueError("an anchored configuration needs the anchor values")
+        # rows of a stopped bearing (anchor 0) carry no correction; the caller leaves them out
+        with np.errstate(divide="ignore", invalid="ignore"):
+            y = np.log(value / np.asarray(anchor, dtype=float))
+    else:
+        y = value
     x_off, x_sc, y_off, y_sc = fit_scaling(config, x[train], y[train])
     shell = TrainedNet(config, np.zeros((hidden, 6)), np.zeros(hidden), np.zeros((1, hidden)),
                        np.zeros(1), x_off, x_sc, y_off, y_sc)
@@ -196,6 +254,11 @@ def train_network(
     with deterministic_torch(seed):
         hidden_layer = torch.nn.Linear(6, hidden, dtype=torch.float64)
         output_layer = torch.nn.Linear(hidden, 1, dtype=torch.float64)
+        if config.anchored:
+            # start from the anchor itself (output 0): early stopping then can only move
+            # away from the ratio law as far as the held-out runs confirm
+            torch.nn.init.zeros_(output_layer.weight)
+            torch.nn.init.zeros_(output_layer.bias)
         params = [*hidden_layer.parameters(), *output_layer.parameters()]
         optimizer = torch.optim.Rprop(params, lr=learning_rate)
         train_idx = torch.from_numpy(np.asarray(train))
@@ -212,19 +275,33 @@ def train_network(
         x_test, y_test = xs[test_idx], ys[test_idx]
         train_curve, test_curve = [], []
         stopped = False
+        weights = (hidden_layer.weight, output_layer.weight)
+        best_test, best_state = np.inf, None
+        if config.early_stopping and len(test):
+            with torch.no_grad():
+                best_test = float(torch.mean((forward(x_test) - y_test) ** 2))
+            best_state = [p.detach().clone() for p in params]
         for _ in range(epochs):
             optimizer.zero_grad()
-            loss = torch.mean((forward(x_train) - y_train) ** 2)
+            mse = torch.mean((forward(x_train) - y_train) ** 2)
+            loss = mse + config.weight_decay * sum(torch.sum(w**2) for w in weights)
             loss.backward()
             optimizer.step()
-            train_curve.append(float(loss.detach()))
+            train_curve.append(float(mse.detach()))
             with torch.no_grad():
                 test_curve.append(
                     float(torch.mean((forward(x_test) - y_test) ** 2)) if len(test) else np.nan
                 )
+            if config.early_stopping and test_curve[-1] < best_test:
+                best_test = test_curve[-1]
+                best_state = [p.detach().clone() for p in params]
             if train_curve[-1] <= goal_mse:
                 stopped = True
                 break
+        if best_state is not None:
+            with torch.no_grad():
+                for p, best in zip(params, best_state, strict=True):
+                    p.copy_(best)
         net = TrainedNet(
             config,
             hidden_layer.weight.detach().numpy().copy(),

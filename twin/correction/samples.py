@@ -89,6 +89,11 @@ class RunCurves:
     window_s: float = WINDOW_S
     fitted: np.ndarray | None = None
     """(windows, 4): the window fit's values (the "fit" targets); None for the ratio rule."""
+    anchors: np.ndarray | None = None
+    """(windows, 4): the ratio-law value (the anchored networks' anchor) at each window."""
+    anchored_inputs: np.ndarray | None = None
+    """(windows, 4, 6): the anchored networks' input rows at each window start, in OUTPUTS
+    order (`WindowFeatures.anchored_inputs`, recorded by the simulation that saw them)."""
 
     def __post_init__(self) -> None:
         n = len(self.time_s)
@@ -125,6 +130,10 @@ class SampleSet:
     time_s: np.ndarray
     run: np.ndarray
     fit_rms_C: dict[str, float] = field(default_factory=dict)
+    anchored_inputs: dict[str, np.ndarray] | None = None
+    """Input rows (N, 6) of the anchored networks per output (None: not recorded)."""
+    anchors: dict[str, np.ndarray] | None = None
+    """The ratio-law value (N,) each anchored network corrects, per output."""
 
     def __len__(self) -> int:
         return len(self.time_s)
@@ -133,12 +142,17 @@ class SampleSet:
     def concatenate(sets: list[SampleSet]) -> SampleSet:
         if not sets:
             raise ValueError("no samples to concatenate")
+        anchored = all(s.anchors is not None for s in sets)
         return SampleSet(
             inputs={o: np.concatenate([s.inputs[o] for s in sets]) for o in OUTPUTS},
             targets={o: np.concatenate([s.targets[o] for s in sets]) for o in OUTPUTS},
             time_s=np.concatenate([s.time_s for s in sets]),
             run=np.concatenate([s.run for s in sets]),
             fit_rms_C={k: v for s in sets for k, v in s.fit_rms_C.items()},
+            anchored_inputs=({o: np.concatenate([s.anchored_inputs[o] for s in sets])
+                              for o in OUTPUTS} if anchored else None),
+            anchors=({o: np.concatenate([s.anchors[o] for s in sets]) for o in OUTPUTS}
+                     if anchored else None),
         )
 
 
@@ -241,7 +255,11 @@ def build_samples(
 
 
 def fit_samples(curves: RunCurves, guards: RatioGuards = TARGET_GUARDS) -> SampleSet:
-    """One sample per window: the loop's network inputs at its start, the fitted value."""
+    """One sample per window: the loop's network inputs at its start, the fitted value.
+
+    A window in which a bearing's ring or sleeve sensor has no valid sample gets no target
+    for that bearing (NaN): the fit had nothing to tell its heat from its resistance by, and
+    wanders (the ×/÷ 4 bound of `twin.loop.windowfit` on a run with a dead T4)."""
     c = curves
     if c.fitted is None:
         raise ValueError(f"{c.name}: no window-fit values; simulate the run with the window fit")
@@ -252,12 +270,33 @@ def fit_samples(curves: RunCurves, guards: RatioGuards = TARGET_GUARDS) -> Sampl
     nominal = c.per_window("nominal", windows)
     inputs = _inputs_at(c, t0, nominal)
     targets = limit_to_nominal(fitted, nominal, guards)
+    for k, bearing in enumerate(BEARINGS):
+        seen = _seen_in_windows(c, t0, (RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]))
+        targets[~seen, k] = np.nan
+        targets[~seen, 2 + k] = np.nan
+    anchored_inputs = anchors = None
+    if c.anchors is not None and c.anchored_inputs is not None:
+        rows = np.asarray(c.anchored_inputs, dtype=float)
+        anchored_inputs = {o: rows[:, i, :] for i, o in enumerate(OUTPUTS)}
+        anchors = {o: np.asarray(c.anchors, dtype=float)[:, i] for i, o in enumerate(OUTPUTS)}
     return SampleSet(
         inputs=inputs,
         targets={o: targets[:, i] for i, o in enumerate(OUTPUTS)},
         time_s=t0 - start,
         run=np.full(len(t0), c.name, dtype=object),
+        anchored_inputs=anchored_inputs,
+        anchors=anchors,
     )
+
+
+def _seen_in_windows(c: RunCurves, t0: np.ndarray, sensors: tuple[int, ...]) -> np.ndarray:
+    """Per window starting at t0, True if every one of `sensors` has a finite measured
+    sample in [t0, t0 + window)."""
+    seen = np.ones(len(t0), dtype=bool)
+    for i, start in enumerate(t0):
+        inside = (c.time_s >= start) & (c.time_s < start + c.window_s)
+        seen[i] = bool(np.all(np.isfinite(c.measured_C[inside][:, list(sensors)]).any(axis=0)))
+    return seen
 
 
 def samples_for(curves: RunCurves) -> SampleSet:

@@ -28,6 +28,9 @@ class SimulatedRun:
     used (windows, 4): the values the simulation ran with per window.
     method: how `used` came about ("fit", "ratio", "open_loop").
     fitted (windows, 4): the window fit's values, the training targets (None: no fit).
+    anchors (windows, 4), anchored_inputs (windows, 4, 6): the ratio-law anchor and the
+    anchored networks' input rows the simulation saw at each window start (None: not
+    recorded).
     """
 
     time_s: np.ndarray
@@ -36,6 +39,8 @@ class SimulatedRun:
     used: np.ndarray
     method: str
     fitted: np.ndarray | None = None
+    anchors: np.ndarray | None = None
+    anchored_inputs: np.ndarray | None = None
 
 
 Simulator = Callable[[object], list[SimulatedRun]]
@@ -63,4 +68,6 @@ def _curves(run: object, sim: SimulatedRun) -> RunCurves:
         nominal=np.asarray(sim.nominal, dtype=float),
         used=np.asarray(sim.used, dtype=float),
         fitted=None if sim.fitted is None else np.asarray(sim.fitted, dtype=float),
+        anchors=sim.anchors,
+        anchored_inputs=sim.anchored_inputs,
     )

@@ -23,11 +23,17 @@ of a kelvin) near its nominal:
 
     minimise  Σ (T_twin(θ) − T_meas)² / noise_C²  +  Σ θ² / prior_spread²
 
-`drive_spread` > 0 advances the twin with values scattered around the fit (seeded log-normal,
-double spread on the resistances), while the target stays the fit from the state reached.
-The networks then see windows that start with the twin off the measurement and learn how
-to pull it back, which an exact fit trajectory (twin always on the measurement) never shows
-them.
+What drives the twin from window to window (`drive`): the fit itself ("fit"), or the
+ratio-law value the anchored networks correct ("anchor", `twin.correction.methods.
+ratio_anchor`, chained on itself as in `BpnnCorrection`), so the networks see the states
+the ratio law leads the twin into — the states they will correct in the loop.  Every
+window also records the anchor and the anchored networks' input rows (`anchors`,
+`anchored_inputs`), whatever the drive.
+`drive_spread` > 0 advances the twin with the driving values scattered (seeded
+log-normal, double spread on the resistances), while the target stays the fit from the
+state reached.  The networks then see windows that start with the twin off the
+measurement and learn how to pull it back, which an exact fit trajectory (twin always on
+the measurement) never shows them.
 """
 
 from __future__ import annotations
@@ -37,7 +43,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW
-from twin.correction.features import WindowFeatures
+from twin.correction.features import OUTPUTS, WindowFeatures, correction_factors
+from twin.correction.methods import ratio_anchor
 from twin.correction.result import Correction
 from twin.loop.replay import direct_window_solver
 from twin.runs import RecordedRun
@@ -70,9 +77,19 @@ class WindowFit:
     """Forward-difference step on the log factor."""
     drive_spread: float = 0.0
     seed: int = 0
+    drive: str = "fit"
+    """"fit" or "anchor": the values the twin advances with (before the scatter)."""
     name: str = "fit"
     fitted: list[np.ndarray] = field(default_factory=list)
+    anchors: list[np.ndarray] = field(default_factory=list)
+    anchored_inputs: list[np.ndarray] = field(default_factory=list)
+    """Per window (4, 6): the anchored networks' input rows, in OUTPUTS order."""
+
+    def __post_init__(self) -> None:
+        if self.drive not in ("fit", "anchor"):
+            raise ValueError(f"WindowFit.drive must be 'fit' or 'anchor', not {self.drive!r}")
     _theta: np.ndarray = field(default_factory=lambda: np.zeros(4))
+    _anchor_factors: np.ndarray = field(default_factory=lambda: np.ones(4))
     _rng: np.random.Generator | None = None
 
     def correct(self, features: WindowFeatures) -> Correction:
@@ -80,18 +97,25 @@ class WindowFit:
         if f.twin_state is None:
             raise ValueError("the window fit needs the twin's state (run it through replay_method)")
         if f.window == 0:
-            self.fitted.clear()
+            for records in (self.fitted, self.anchors, self.anchored_inputs):
+                records.clear()
             self._theta = np.zeros(4)
+            self._anchor_factors = np.ones(4)
             self._rng = np.random.default_rng(self.seed)
         nominal = np.asarray(f.nominal, dtype=float)
         theta = self._fit(f, nominal)
         self._theta = theta
         fitted = nominal * np.exp(theta)
         self.fitted.append(fitted)
-        driven = fitted
+        anchor = ratio_anchor(f, self._anchor_factors)
+        self.anchors.append(anchor)
+        rows = f.anchored_inputs(anchor, self._anchor_factors)
+        self.anchored_inputs.append(np.vstack([rows[o] for o in OUTPUTS]))
+        self._anchor_factors = correction_factors(anchor, nominal, fallback=self._anchor_factors)
+        driven = anchor if self.drive == "anchor" else fitted
         if self.drive_spread > 0:
             scatter = self._rng.normal(0.0, self.drive_spread, 4) * DRIVE_SPREAD_WEIGHTS
-            driven = fitted * np.exp(scatter)
+            driven = driven * np.exp(scatter)
         return Correction.relative_to(driven, f.previous)
 
     def _fit(self, f: WindowFeatures, nominal: np.ndarray) -> np.ndarray:
