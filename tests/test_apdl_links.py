@@ -55,8 +55,9 @@ FINISH
 
 def test_composite_wall_of_bars_and_convection_links_is_a_series_of_resistances():
     """Fluid 1 -LINK34- wall a (LINK33) - wall b (LINK33) -LINK34- fluid 2, unit area:
-    q = ΔT / (1/h1 + La/ka + Lb/kb + 1/h2); the inner wall temperatures follow, and each
-    bar's HEAT RATE (ETABLE,,SMISC,1, summed by SSUM over the two) is q."""
+    q = ΔT / (1/h1 + La/ka + Lb/kb + 1/h2); the inner wall temperatures follow, each
+    bar's HEAT RATE (ETABLE,,SMISC,1, summed by SSUM over the two) is q, and the first
+    link's nodal heat at the hot fluid node (ESOL, positive out of the element) is −q."""
     h1, ka, la, kb, lb, h2 = 12.0, 0.8, 0.75, 0.1, 0.4, 2.0
     t1, t2 = 3000.0, 80.0
     s = run(f"""/PREP7
@@ -92,6 +93,10 @@ ESEL,S,ELEM,,2,3
 ETABLE,QB,SMISC,1
 SSUM
 *GET,QBARS,SSUM,,ITEM,QB
+ESEL,S,ELEM,,2
+ETABLE,TI,SMISC,2
+SSUM
+*GET,TI2,SSUM,,ITEM,TI
 FINISH
 /POST26
 ESOL,2,1,1,HEAT
@@ -99,8 +104,9 @@ ESOL,2,1,1,HEAT
 """)
     q = (t1 - t2) / (1 / h1 + la / ka + lb / kb + 1 / h2)
     p = s.params
-    assert p["Q"] == pytest.approx(q, rel=1e-10)
+    assert p["Q"] == pytest.approx(-q, rel=1e-10)  # heat enters the link at its hot node
     assert p["QBARS"] == pytest.approx(2 * q, rel=1e-10)  # both bars' HEAT RATE (ETABLE)
+    assert p["TI2"] == pytest.approx(t1 - q / h1, rel=1e-10)  # bar a's TI (SMISC,2)
     assert p["T2"] == pytest.approx(t1 - q / h1, rel=1e-10)
     assert p["T4"] == pytest.approx(t2 + q / h2, rel=1e-10)
 
@@ -161,7 +167,7 @@ ESOL,2,1,1,HEAT
 *GET,Q,VARI,2,EXTREM,VMAX
 """)
     sigma = 0.119e-10
-    assert s.params["Q"] == pytest.approx(
+    assert -s.params["Q"] == pytest.approx(  # the emitting node gives the heat: ESOL < 0
         sigma * emis * form * area * ((t1 + off) ** 4 - (t2 + off) ** 4), rel=1e-9)
 
 

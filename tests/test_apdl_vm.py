@@ -2,7 +2,8 @@
 
 Each deck writes its own results table with /OUT,vmNN,vrt and *VWRITE: a label, the
 published TARGET, the value apdl-like computed and their ratio.  Every computed value must
-lie within 2 % of its target.
+lie within 2 % of its target (a zero target: within 2 % of the table's largest target, as
+tools/vm_check.py judges).
 """
 
 from __future__ import annotations
@@ -20,7 +21,10 @@ DECKS = Path(__file__).parent / "data" / "apdl_vm"
 TOLERANCE = 0.02
 
 # the decks that run as published, and the rows of their results tables
-ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4, "vm99": 5, "vm227": 3}
+ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4, "vm99": 5, "vm227": 3,
+        # thermal links and masses (LINK31/33/34, MASS71) and PLANE77 without mid-side nodes
+        "vm92": 3, "vm93": 1, "vm94": 2, "vm106": 1, "vm107": 1, "vm109": 3, "vm112": 1,
+        "vm114": 6, "vm115": 6, "vm116": 1}
 
 
 def results_table(path: Path) -> list[tuple[str, float, float]]:
@@ -35,8 +39,11 @@ def test_verification_deck_runs_as_published(deck, tmp_path):
     assert done.returncode == 0, done.stderr
     rows = results_table(out / f"{deck}.vrt")
     assert len(rows) == ROWS[deck], rows
+    # a zero target (VM114's far end) is met within 2 % of the table's largest target
+    scale = max(abs(target) for _, target, _ in rows)
     for label, target, computed in rows:
-        assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), (deck, label)
+        allowed = TOLERANCE * scale if target == 0.0 else 1e-9
+        assert computed == pytest.approx(target, rel=TOLERANCE, abs=allowed), (deck, label)
 
 
 def test_vm111_sphere_center_matches_the_exact_series_solution(tmp_path):

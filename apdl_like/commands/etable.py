@@ -4,9 +4,12 @@ ETABLE,Lab,Item,Comp stores one value per selected element (0 for the others) of
 current thermal result, as MAPDL's element table does; SSUM sums every column over the
 elements selected when it runs.  The items are the thermal ones decks use:
 
-    SMISC,1  of LINK31/32/33/34  HEAT RATE Q = g (TI − TJ), W (apdl_like.line_thermal)
-    SMISC,2  of SURF151          heat rate its convection takes out of the solid,
-                                 ∫ h (T − T_bulk) dA, W
+    SMISC,1    of LINK31/32/33/34  HEAT RATE Q = g (TI − TJ), W (apdl_like.line_thermal)
+    SMISC,2/3  of LINK32/33        the node temperatures TI, TJ
+    SMISC,2    of SURF151          heat rate its convection takes out of the solid,
+                                   ∫ h (T − T_bulk) dA, W
+
+An element without the item gets 0, as in MAPDL's table.
 """
 
 from __future__ import annotations
@@ -35,12 +38,15 @@ def _smisc(s: SessionState, comp: int) -> np.ndarray:
     el = db.elements
     out = np.full(len(el.ids), np.nan)
     names = np.array([db.element_types[int(t)].name for t in el.type])
-    if comp == 1 and model.links is not None:
-        links = model.links
+    links = model.links
+    if comp == 1 and links is not None:
         rate = links.heat_rate(T, inputs.kxx, inputs.hf or [])
         ok = links.kind != "mass"
         out[links.elements[ok]] = rate[ok]
-    elif comp == 2:
+    if comp in (2, 3) and links is not None:
+        bars = links.kind == "conduction"
+        out[links.elements[bars]] = T[(links.i if comp == 2 else links.j)[bars]]
+    if comp == 2:
         surf = np.nonzero(names == "SURF151")[0]
         if surf.size:
             keys = pair_keys(el.nodes[surf, 0], el.nodes[surf, 1])
@@ -61,13 +67,13 @@ def etable(s: SessionState, c: Call) -> None:
     if item != "SMISC":
         raise ApdlError(f"field 2: ETABLE supports SMISC, got {item or '(empty)'!r}")
     comp = c.int(3, what="Comp")
-    if comp not in (1, 2):
-        raise ApdlError("field 3: SMISC supports 1 (a link's HEAT RATE) and 2 (a SURF151's "
-                        "convection heat rate)")
+    if comp not in (1, 2, 3):
+        raise ApdlError("field 3: SMISC supports 1 (a link's HEAT RATE), 2 and 3 (a bar's "
+                        "TI, TJ; 2: a SURF151's convection heat rate)")
     values = _smisc(s, comp)
     selected = s.db.elements.selected
     if not np.any(selected & ~np.isnan(values)):
-        raise ApdlError(f"no selected element has SMISC,{comp}")
+        s.say(f"ETABLE: no selected element has SMISC,{comp}; {lab} is 0")
     s.element_table[lab] = np.where(selected, np.nan_to_num(values), 0.0)
 
 

@@ -74,7 +74,8 @@ def nsol(s: SessionState, c: Call) -> None:
 
 @command("ESOL", POST26, 7)
 def esol(s: SessionState, c: Call) -> None:
-    """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes;
+    """ESOL,NVAR,ELEM,NODE,HEAT,,Name: the element's heat flow at one of its nodes
+    (positive out of the element into the node, as FSUM counts it);
     ESOL,NVAR,ELEM,,SMISC,1,Name: a thermal link's HEAT RATE (LINK31..34)."""
     nvar = _variable(c)
     el = s.db.elements
@@ -92,7 +93,11 @@ def esol(s: SessionState, c: Call) -> None:
     model, inputs = plane_solution(s)
     dof = model.mesh.node_dof[s.node_index(node)]
     times, temps = thermal_history(s)
-    values = np.array([model.element_heat(inputs, T, e)[dof] for T in temps])
+    # MAPDL's element nodal heat flow, the record FSUM adds up, is positive where heat
+    # leaves the element at the node: minus (element matrix × T − element loads).  VM99
+    # negates its FSUM at the heated wall to print a positive heat; VM92-94 print the
+    # positive heat a link delivers at its cold node J.
+    values = np.array([-model.element_heat(inputs, T, e)[dof] for T in temps])
     s.variables[nvar] = (c.label(6, "HEAT"), times, values)
 
 
