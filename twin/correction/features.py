@@ -200,11 +200,11 @@ class WindowFeatures:
     def dead_rings(self) -> tuple[str, ...]:
         """Bearings whose ring sensor has no valid sample in the last window while the
         sleeve sensor has (a stuck or dropped-out ring thermocouple)."""
-        level, _ = window_line_fit(self.measured_time_s, self.measured_C, self.start_s,
-                                   self.window_s)
-        return tuple(b for b in BEARINGS
-                     if not np.isfinite(level[RING_SENSOR[b]])
-                     and np.isfinite(level[SLEEVE_SENSOR[b]]))
+        # the span of `window_line_fit`: a column with a finite sample there has a level
+        time = self.measured_time_s
+        in_span = (time > self.start_s - self.window_s - 1e-9) & (time <= self.start_s + 1e-9)
+        seen = np.isfinite(self.measured_C[in_span]).any(axis=0)
+        return tuple(b for b in BEARINGS if not seen[RING_SENSOR[b]] and seen[SLEEVE_SENSOR[b]])
 
     def with_sleeve_for_dead_rings(self) -> WindowFeatures:
         """These features with the ring column (measured and simulated) of each of
