@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from apdl_like.errors import ApdlError
+from apdl_like.model import Line
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -34,7 +35,51 @@ def check_new_elements(s: SessionState, count: float, size: float) -> None:
         raise ApdlError(f"the model would hold more than {MAX_MODEL_ELEMENTS} elements")
 
 
-def _triangulate(polygons: list[np.ndarray], size: float) -> tuple[np.ndarray, np.ndarray]:
+ARC_OUTLINE_POINTS = 64  # points of an arc side in the outline that sorts elements to areas
+
+
+def line_points(line: Line, p1: np.ndarray, p2: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Points at fractions f of a line from p1 to p2: along the chord, or along the arc
+    about the origin (angle proportional to f) for an arc."""
+    if not line.arc:
+        return p1 + f[:, None] * (p2 - p1)
+    r = float(np.hypot(*p1))
+    t1, t2 = np.arctan2(p1[1], p1[0]), np.arctan2(p2[1], p2[0])
+    if t2 - t1 > np.pi:  # the shorter way round, as MAPDL draws it
+        t2 -= 2 * np.pi
+    elif t1 - t2 > np.pi:
+        t2 += 2 * np.pi
+    t = t1 + f * (t2 - t1)
+    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+
+def _arc_between(s: SessionState, a: int, b: int) -> Line | None:
+    """The arc line joining keypoints a and b, if there is one."""
+    for line in s.db.lines.values():
+        if line.arc and {line.k1, line.k2} == {a, b}:
+            return line
+    return None
+
+
+def area_outline(s: SessionState, area: int) -> np.ndarray:
+    """The area's boundary as a polygon: its keypoints, with arc sides sampled densely."""
+    db = s.db
+    kps = db.areas[area]
+    out = []
+    for a, b in zip(kps, [*kps[1:], kps[0]], strict=True):
+        p1, p2 = np.array(db.keypoints[a], float), np.array(db.keypoints[b], float)
+        if _arc_between(s, a, b) is None:
+            out.append(p1[None, :])
+        else:
+            f = np.linspace(0.0, 1.0, ARC_OUTLINE_POINTS, endpoint=False)
+            out.append(line_points(Line(a, b, arc=True), p1, p2, f))
+    return np.vstack(out)
+
+
+def _triangulate(polygons: list[np.ndarray], size: float,
+                 arcs: list[list[bool]] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of the polygons (sides i -> i+1; arcs[k][i]: side i of polygon k is a
+    circular arc about the origin)."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -45,9 +90,17 @@ def _triangulate(polygons: list[np.ndarray], size: float) -> tuple[np.ndarray, n
         gmsh.model.add("amesh")
         occ = gmsh.model.occ
         surfaces = []
-        for poly in polygons:
+        centre = None
+        for k, poly in enumerate(polygons):
             pts = [occ.addPoint(x, y, 0.0) for x, y in poly]
-            lines = [occ.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
+            lines = []
+            for i in range(len(pts)):
+                j = (i + 1) % len(pts)
+                if arcs is not None and arcs[k][i]:
+                    centre = centre if centre is not None else occ.addPoint(0.0, 0.0, 0.0)
+                    lines.append(occ.addCircleArc(pts[i], centre, pts[j]))
+                else:
+                    lines.append(occ.addLine(pts[i], pts[j]))
             surfaces.append((2, occ.addPlaneSurface([occ.addCurveLoop(lines)])))
         if len(surfaces) > 1:
             occ.fragment(surfaces[:1], surfaces[1:])
@@ -81,19 +134,23 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
     if et is None:
         raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
     polygons = [np.array([db.keypoints[k] for k in db.areas[a]], float) for a in area_numbers]
+    arcs = [[_arc_between(s, k, kk) is not None
+             for k, kk in zip(db.areas[a], [*db.areas[a][1:], db.areas[a][0]], strict=True)]
+            for a in area_numbers]
+    outlines = [area_outline(s, a) for a in area_numbers]
     allpts = np.vstack(polygons)
     extent = float(np.ptp(allpts, axis=0).max())
     if not extent > 0.0:
         raise ApdlError("the areas have no extent")
     size = db.esize if db.esize is not None else extent / 10.0
     total = 0.0
-    for poly in polygons:
+    for poly in outlines:
         x, y = poly[:, 0], poly[:, 1]
         total += 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
     if total <= 0.0:
         raise ApdlError("an area has zero size (check the keypoint order)")
     check_new_elements(s, 2.5 * total / size**2, size)
-    xy, tri = _triangulate(polygons, size)
+    xy, tri = _triangulate(polygons, size, arcs)
     if tri.size == 0:
         raise ApdlError("gmsh produced no triangles")
     used = np.unique(tri)
@@ -129,7 +186,7 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
         el.add(first + k, db.active_type, db.active_mat, db.active_real, conn)
     el.flush()
     centroids = xy_used[tri].mean(axis=1)
-    for num, poly in zip(area_numbers, polygons, strict=True):
+    for num, poly in zip(area_numbers, outlines, strict=True):
         inside = _inside(poly, centroids)
         db.area_elements[num] = first + np.nonzero(inside)[0]
     s.say(f"AMESH: {len(tri)} elements, {fresh} new nodes (size {size:g})")
@@ -182,6 +239,8 @@ def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
     if len(kps) != 4:
         return None
     k0, k1, k2, k3 = kps
+    if any(_arc_between(s, a, b) is not None for a, b in ((k0, k1), (k1, k2), (k2, k3), (k3, k0))):
+        return None  # curved sides: the free mesher follows them
     bottom, top = _side(s, k0, k1, size), _side(s, k3, k2, size)
     left, right = _side(s, k0, k3, size), _side(s, k1, k2, size)
     if bottom.size != top.size or left.size != right.size:

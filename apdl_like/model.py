@@ -391,13 +391,16 @@ class SolutionSettings:
 
 @dataclass
 class Line:
-    """A straight line between keypoints k1 -> k2, its divisions and spacing ratio (LESIZE;
-    the last division over the first, along k1 -> k2)."""
+    """A line between keypoints k1 -> k2, its divisions and spacing ratio (LESIZE; the last
+    division over the first, along k1 -> k2): straight, or with `arc` a circular arc about
+    the origin (L in CSYS 1 between keypoints of one radius, as MAPDL draws lines in the
+    active cylindrical system)."""
 
     k1: int
     k2: int
     ndiv: int | None = None
     space: float = 1.0
+    arc: bool = False
 
 
 @dataclass

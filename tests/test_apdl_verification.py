@@ -678,3 +678,55 @@ FINISH
 """)
     assert s.params["T5"] == pytest.approx(50.0, abs=1e-9)
     assert s.params["T3"] == pytest.approx(100.0, abs=1e-9)
+
+
+def test_line_in_csys1_is_an_arc_and_amesh_follows_it():
+    """L in CSYS 1 between keypoints of one radius is MAPDL's circular arc: a 30° sector
+    of a wire (radius R, k, generating q̇) meshed free, its arc coupled (CP) and cooled by
+    SURF151 films (h, T_b): T_s = T_b + q̇R/(2h), the centre T_s + q̇R²/(4k), and the
+    films take out q̇ × the sector's area πR²/12 (per unit thickness)."""
+    r, k, qdot, h, tb = 0.05, 20.0, 1e6, 100.0, 20.0
+    s = run(f"""/PREP7
+ET,1,PLANE35
+ET,2,SURF151
+MP,KXX,1,{k}
+CSYS,1
+K,1
+K,2,{r},-15
+K,3,{r},15
+L,2,3
+CSYS
+A,1,2,3
+AMESH,1
+CSYS,1
+NSEL,S,LOC,X,{r}
+*GET,N_ARC,NODE,,NUM,COUNT
+CP,1,TEMP,ALL
+TYPE,2
+ESURF
+NSEL,ALL
+ESEL,S,TYPE,,2
+SFE,ALL,,CONV,,{h}
+SFE,ALL,,CONV,2,{tb}
+ESEL,ALL
+BFA,1,HGEN,{qdot}
+FINISH
+/SOLU
+SOLVE
+FINISH
+/POST1
+*GET,T_C,NODE,1,TEMP
+*GET,T_S,NODE,2,TEMP
+ESEL,S,TYPE,,2
+ETABLE,Q1,SMISC,2
+SSUM
+*GET,Q,SSUM,,ITEM,Q1
+""")
+    p = s.params
+    t_s = tb + qdot * r / (2 * h)
+    assert p["N_ARC"] >= 5  # the nodes gmsh placed along the arc lie on radius R
+    # the elements' straight edges between arc nodes (length ℓ ≈ R/10) cut off a
+    # fraction ≈ (ℓ/R)²/6 of the area: the rises and the heat are within 3e-3
+    assert p["T_S"] - tb == pytest.approx(t_s - tb, rel=3e-3)
+    assert p["T_C"] - tb == pytest.approx(t_s - tb + qdot * r**2 / (4 * k), rel=3e-3)
+    assert p["Q"] == pytest.approx(qdot * math.pi * r**2 / 12, rel=3e-3)

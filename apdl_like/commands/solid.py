@@ -15,7 +15,14 @@ import numpy as np
 from apdl_like.call import PREP7, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.commands.generate import from_cartesian, to_cartesian
 from apdl_like.errors import ApdlError
-from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped, place_nodes, side_fractions
+from apdl_like.meshing import (
+    line_points,
+    mapped_grid,
+    mesh_areas,
+    mesh_mapped,
+    place_nodes,
+    side_fractions,
+)
 from apdl_like.model import Line
 
 if TYPE_CHECKING:
@@ -68,7 +75,17 @@ def line(s: SessionState, c: Call) -> None:
     if p1 == p2:
         raise ApdlError("a line needs two different keypoints")
     ndiv = c.int(3, 0, what="NDIV") or None
-    s.db.lines[max(s.db.lines, default=0) + 1] = Line(p1, p2, ndiv, c.num(4, 1.0, what="SPACE"))
+    arc = False
+    if s.db.csys == 1:
+        (r1, t1), (r2, t2) = from_cartesian(1, np.array([s.db.keypoints[p1],
+                                                         s.db.keypoints[p2]], float))
+        tol = 1e-9 * max(r1, r2, 1e-300)
+        arc = abs(r1 - r2) <= tol and abs(t1 - t2) > 1e-9 and r1 > tol
+        if not arc and abs(t1 - t2) > 1e-9 and min(r1, r2) > tol:
+            raise ApdlError("a line in CSYS 1 between different radii and angles is a spiral, "
+                            "which is not supported")
+    s.db.lines[max(s.db.lines, default=0) + 1] = Line(p1, p2, ndiv, c.num(4, 1.0, what="SPACE"),
+                                                      arc)
 
 
 @command("LESIZE", PREP7, 9)
@@ -270,7 +287,7 @@ def lmesh(s: SessionState, c: Call) -> None:
         if n > MAX_DIVISIONS:
             raise ApdlError(f"line {num}: {n} divisions exceed {MAX_DIVISIONS}")
         f = side_fractions(n, ln.space)
-        points = p1 + f[:, None] * (p2 - p1)
+        points = line_points(ln, p1, p2, f)
         order = [0, n, *range(1, n)]
         numbers = np.empty(n + 1, np.int64)
         numbers[order] = place_nodes(s, points[order], max(length, 1e-300))
