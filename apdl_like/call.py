@@ -8,7 +8,7 @@ the command name).  The table of all commands is built by `apdl_like.registry`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -30,6 +30,14 @@ AUX12 = frozenset({"AUX12"})
 MAX_ENTITY_NUMBER = 2**31 - 1  # MAPDL numbers entities with 32-bit signed integers
 
 Handler = Callable[["SessionState", "Call"], None]
+
+
+def existing(numbers: list[int], table: Mapping[int, object], what: str) -> list[int]:
+    """`numbers` as given, once each is checked to name an entity of `table` (its keys)."""
+    for num in numbers:
+        if num not in table:
+            raise ApdlError(f"{what} {num} does not exist")
+    return numbers
 
 
 @dataclass(frozen=True)

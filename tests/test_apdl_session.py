@@ -17,6 +17,7 @@ from apdl_like.errors import ApdlError
 from apdl_like.loadset import LoadSet
 from apdl_like.session import Session
 from apdl_like.writer import DeckLayout, window_deck
+from tests.apdl_decks import held_faces
 from twin.fem import AxiMesh, Material, ThermalLoads, ThermalProblem
 
 STEEL = Material(k=49.8, rho=7830.0, c=465.0, E=210e9, nu=0.265, alpha=12.2e-6)
@@ -207,18 +208,14 @@ def test_cli_run_writes_params_and_vtu(tmp_path):
     import meshio
 
     deck = tmp_path / "d.inp"
-    deck.write_text("""/PREP7
+    deck.write_text(f"""/PREP7
 ET,1,PLANE55,,,1
 MP,KXX,1,10
 RECTNG,0.01,0.02,0,0.01
 ESIZE,0.005
 AMESH,ALL
 /SOLU
-NSEL,S,LOC,X,0.01
-D,ALL,TEMP,100
-NSEL,S,LOC,X,0.02
-D,ALL,TEMP,50
-ALLSEL
+{held_faces("X", (0.01, 100), (0.02, 50))}
 SOLVE
 FINISH
 /POST1

@@ -13,6 +13,7 @@ import pytest
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
+from tests.apdl_decks import film_heat_sum, held_faces
 
 RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
 K = 50.0  # W/mK
@@ -439,10 +440,7 @@ SOLVE
 FINISH
 /POST1
 *GET,T_END,NODE,NODE(0.1,0,0),TEMP
-ESEL,S,TYPE,,2
-ETABLE,QF,SMISC,2
-SSUM
-*GET,Q,SSUM,,ITEM,QF
+{film_heat_sum("Q")}
 """)
     p = s.params
     assert p["Q"] == pytest.approx(qdot * length * 0.05, rel=1e-9)
@@ -663,11 +661,7 @@ N,6,1,0.5
 N,7,0.5,1
 N,8,0,0.5
 E,1,2,3,4{midside}
-NSEL,S,LOC,X,0
-D,ALL,TEMP,0
-NSEL,S,LOC,X,1
-D,ALL,TEMP,100
-ALLSEL
+{held_faces("X", (0, 0), (1, 100))}
 FINISH
 /SOLU
 SOLVE
@@ -717,10 +711,7 @@ FINISH
 /POST1
 *GET,T_C,NODE,1,TEMP
 *GET,T_S,NODE,2,TEMP
-ESEL,S,TYPE,,2
-ETABLE,Q1,SMISC,2
-SSUM
-*GET,Q,SSUM,,ITEM,Q1
+{film_heat_sum("Q")}
 """)
     p = s.params
     t_s = tb + qdot * r / (2 * h)

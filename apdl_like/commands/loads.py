@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import LOADS, Call, command, specs_of
+from apdl_like.call import LOADS, Call, command, existing, specs_of
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import pair_keys
@@ -359,10 +359,7 @@ def _solid_entities(c: Call, command_name: str, table: dict, unselected: set[int
                         f"{c.label(2) or '(empty)'!r}")
     chosen = [n for n in sorted(table) if n not in unselected] if c.label(1) == "ALL" else \
         [c.entity(1, field_name)]
-    for num in chosen:
-        if num not in table:
-            raise ApdlError(f"{what} {num} does not exist")
-    return chosen
+    return existing(chosen, table, what)
 
 
 @command("BFK", LOADS, 6)

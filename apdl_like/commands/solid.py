@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec, command, ignored, specs_of
+from apdl_like.call import PREP7, Call, CommandSpec, command, existing, ignored, specs_of
 from apdl_like.commands.generate import from_cartesian, to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.meshing import (
@@ -224,11 +224,7 @@ def _range_of(c: Call, table: dict, what: str, field: str) -> list[int]:
     step = c.int(3, 1, what="NINC")
     if step < 1:
         raise ApdlError("field 3 (NINC) must be ≥ 1")
-    chosen = list(range(first, last + 1, step))
-    for num in chosen:
-        if num not in table:
-            raise ApdlError(f"{what} {num} does not exist")
-    return chosen
+    return existing(list(range(first, last + 1, step)), table, what)
 
 
 @command("AMESH", PREP7, 3)
