@@ -150,3 +150,28 @@ def test_whatever_synth_writes_replay_accepts(tmp_path_factory, suite_seed, inde
     assert not summary.get("failed")
     accuracy = summary["runs"][0]["methods"]
     assert all(np.isfinite(m["temperature_accuracy_pct"]) for m in accuracy.values())
+
+
+def test_a_suite_folder_replays_as_it_is(tmp_path):
+    """`twin replay FOLDER` takes the runs in it and leaves out the truth and profile files
+    synth writes beside them (each of those would otherwise fail as a run)."""
+    suite = tmp_path / "suite"
+    assert invoke("synth", "--suite", 2, "--seed", 4, "--minutes", 3, "--out", suite,
+                  "--quiet").exit_code == 0
+    out = tmp_path / "replay"
+    result = invoke("replay", suite, "--out", out, "--methods", "open_loop",
+                    "--snapshots", "none", "--quiet")
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["failed"] == []
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["suite4_001", "suite4_002"]
+
+
+def test_a_folder_without_runs_is_a_clear_input_error(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "notes.txt").write_text("no runs here")
+    result = invoke("replay", empty, "--out", tmp_path / "out", "--quiet")
+    assert result.exit_code == 2
+    assert str(empty) in result.output and "no recorded runs" in result.output
+    assert (empty / "notes.txt").read_text() == "no runs here"

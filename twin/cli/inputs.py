@@ -53,10 +53,30 @@ def bundled_runs_dir() -> Path:
     return bundled_path("runs").resolve()
 
 
+COMPANION_SUFFIXES = (".truth.csv", ".profile.csv")
+"""Files `twin synth` writes beside a run (its truth and speed profile): not runs."""
+
+
+def runs_in(folder: Path) -> list[Path]:
+    """The recorded runs in `folder` (CSV or Parquet, sorted by name), leaving out the
+    truth and profile files `twin synth` writes beside each run, so a synth suite's
+    folder replays as it is."""
+    runs = sorted(p for p in folder.iterdir()
+                  if p.suffix in (".csv", ".parquet") and p.is_file())
+    return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
+
+
+def expand_run_folders(paths: list[Path]) -> list[Path]:
+    """Each folder among `paths` replaced by the runs in it (`runs_in`); files kept."""
+    out: list[Path] = []
+    for path in paths:
+        out.extend(runs_in(path) if path.is_dir() else [path])
+    return out
+
+
 def bundled_runs() -> list[Path]:
     """The example recorded runs shipped with the twin (their `.truth.csv` left out)."""
-    runs = sorted(bundled_runs_dir().glob("*.csv"))
-    return [r for r in runs if not r.name.endswith(".truth.csv")]
+    return runs_in(bundled_runs_dir())
 
 
 def bundled_model() -> Path | None:

@@ -11,6 +11,7 @@ from twin.cli.inputs import (
     bundled_runs,
     bundled_runs_dir,
     checked_model,
+    expand_run_folders,
     method_list,
 )
 from twin.errors import InputError
@@ -19,7 +20,8 @@ from twin.io.destinations import check_out_dir
 
 def replay(
     runs: list[Path] = typer.Argument(
-        None, help="recorded runs (CSV/Parquet); none: the bundled example runs"
+        None, help="recorded runs (CSV/Parquet) or folders of them, e.g. a `twin synth --suite` "
+        "folder; none: the bundled example runs"
     ),
     out: Path = typer.Option(..., "--out", help="output folder"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
@@ -48,11 +50,10 @@ def replay(
     if dask and jobs > 1:
         raise InputError("use either --jobs or --dask, not both", column="--dask")
     chosen = methods.split(",")
-    paths = list(runs) if runs else bundled_runs()
+    paths = expand_run_folders(list(runs)) if runs else bundled_runs()
     if not paths:
-        raise InputError(
-            "no runs given and no bundled example runs found", file=str(bundled_runs_dir())
-        )
+        where = [str(p) for p in runs] if runs else [str(bundled_runs_dir())]
+        raise InputError("no recorded runs (CSV/Parquet) found", file=", ".join(where))
     check_out_dir(out, inputs=[*paths, model], owned=[
         *(Path(p).stem for p in paths), "summary.json", "report.html"])
     model_path = checked_model(chosen, model)
