@@ -433,40 +433,39 @@ class EnsembleEstimator:
             return
         sim_t = np.asarray(f.simulated_time_s, float)[-cfg.steps_per_window - 1:]
         sim_C = np.asarray(f.simulated_C, float)[-cfg.steps_per_window - 1:]
-        var_T, var_d = fc.spread_at_steps(self._drift_forecast(fc)[1])
+        drift, drift_anom = self._drift_forecast(fc)
+        var_T, var_d = fc.spread_at_steps(drift_anom)
         var_T = np.vstack([var_T[:1], var_T])  # the window start: as its first step
         tm = t[rows]
         twin = np.column_stack([np.interp(tm, sim_t, sim_C[:, j]) for j in range(sim_C.shape[1])])
         spread = np.column_stack([np.interp(tm, sim_t, var_T[:, j]) for j in range(5)])
-        excess = (np.asarray(f.measured_C, float)[rows] - twin) ** 2 - spread
-        a = cfg.band_learning_rate
-        # adaptive conformal step (Gibbs & Candès 2021): widen after a window whose band
-        # missed more than 10 % of its samples, narrow after one that missed fewer
         used = self._band_sd_used
         band_sd = np.column_stack([np.interp(tm, sim_t[1:], used[:, j]) for j in range(6)])
-        miss_T = np.abs(np.asarray(f.measured_C, float)[rows] - twin) > BAND_Z * band_sd[:, :5]
-        valid_T = np.isfinite(np.asarray(f.measured_C, float)[rows])
-        if valid_T.any():
-            miss = float(miss_T[valid_T].mean())
-            self._band_scale[0] *= np.exp(cfg.band_scale_rate * (miss - 0.1))
-        if np.isfinite(excess).any():
-            self._band_var[0] = (1 - a) * self._band_var[0] + a * max(
-                float(np.nanmean(excess)), cfg.band_floor_C**2)
+        measured_C = np.asarray(f.measured_C, float)[rows]
+        self._adapt_band(0, measured_C, twin, spread, band_sd[:, :5], cfg.band_floor_C)
         if f.measured_drift_um is not None:
-            drift, _ = self._drift_forecast(fc)
             d_t = sim_t[1:]
-            twin_d = np.interp(tm, d_t, drift)
-            var_d_t = np.interp(tm, d_t, var_d)
-            dm = np.asarray(f.measured_drift_um, float)[rows]
-            e = (dm - twin_d) ** 2 - var_d_t
-            ok = np.isfinite(dm)
-            if ok.any():
-                miss = float((np.abs(dm - twin_d) > BAND_Z * band_sd[:, 5])[ok].mean())
-                self._band_scale[1] *= np.exp(cfg.band_scale_rate * (miss - 0.1))
-            if np.isfinite(e).any():
-                self._band_var[1] = (1 - a) * self._band_var[1] + a * max(
-                    float(np.nanmean(e)), cfg.band_floor_um**2)
+            self._adapt_band(1, np.asarray(f.measured_drift_um, float)[rows],
+                             np.interp(tm, d_t, drift), np.interp(tm, d_t, var_d),
+                             band_sd[:, 5], cfg.band_floor_um)
 
+    def _adapt_band(self, channel: int, measured: np.ndarray, twin: np.ndarray,
+                    spread: np.ndarray, band_sd: np.ndarray, floor: float) -> None:
+        """One channel's band feedback (0: T1..T5 in °C, 1: drift in µm) from the samples
+        of the window just ended: the adaptive conformal step (Gibbs & Candès 2021) widens
+        the band after a window whose band missed more than 10 % of its valid samples and
+        narrows it after one that missed fewer; the model-plus-noise variance takes in the
+        mean of (measured − twin)² beyond the members' `spread`, at least floor²."""
+        cfg = self.config
+        valid = np.isfinite(measured)
+        if valid.any():
+            miss = float((np.abs(measured - twin) > BAND_Z * band_sd)[valid].mean())
+            self._band_scale[channel] *= np.exp(cfg.band_scale_rate * (miss - 0.1))
+        excess = (measured - twin) ** 2 - spread
+        if np.isfinite(excess).any():
+            a = cfg.band_learning_rate
+            self._band_var[channel] = (1 - a) * self._band_var[channel] + a * max(
+                float(np.nanmean(excess)), floor**2)
 
 def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None:
     """Time (s) of the first recorded speed in the window just ended that differs from the
