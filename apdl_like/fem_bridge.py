@@ -22,15 +22,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from apdl_like.errors import ApdlError
-from apdl_like.model import Database, element_corners
+from apdl_like.model import Database, element_corners, pair_keys
 from twin.fem import AxiMesh
-
-PAIR_BASE = np.int64(1) << 31  # node numbers are < 2^31: (lo, hi) packs into one int64
-
-
-def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    lo, hi = np.minimum(a, b).astype(np.int64), np.maximum(a, b).astype(np.int64)
-    return lo * PAIR_BASE + hi
 
 
 class FemModel:

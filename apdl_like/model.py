@@ -19,6 +19,16 @@ import numpy as np
 
 from apdl_like.errors import ApdlError
 
+PAIR_BASE = np.int64(1) << 31  # node numbers are < 2^31: (lo, hi) packs into one int64
+
+
+def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One int64 key per unordered node pair (a[i], b[i]): an element face by its corner
+    node numbers, whichever way round an element lists them."""
+    lo, hi = np.minimum(a, b).astype(np.int64), np.maximum(a, b).astype(np.int64)
+    return lo * PAIR_BASE + hi
+
+
 # Element types this subset knows: name -> (physics, corner nodes, quadratic?)
 ELEMENT_TYPES: dict[str, tuple[str, int, bool]] = {
     "PLANE55": ("thermal", 4, False),

@@ -17,7 +17,7 @@ import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.line_thermal import LINK_KINDS, ThermalLinks, link_constants
-from apdl_like.model import Database, element_corners, record_groups
+from apdl_like.model import Database, element_corners, pair_keys, record_groups
 from apdl_like.plane_elastic import solve_elastic
 from apdl_like.plane_thermal import (
     PlaneMesh,
@@ -26,7 +26,6 @@ from apdl_like.plane_thermal import (
     ThermalInputs,
     build_mesh,
     march,
-    pair_keys,
 )
 from apdl_like.state import StepResult
 

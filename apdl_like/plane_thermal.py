@@ -47,6 +47,7 @@ from skfem import (
 
 from apdl_like.errors import ApdlError
 from apdl_like.line_thermal import ThermalLinks
+from apdl_like.model import pair_keys
 from twin.fem.stepper import (
     StepControl,
     SteppingError,
@@ -57,15 +58,9 @@ from twin.fem.stepper import (
 )
 
 STEP_TOLERANCE = 1e-5
-PAIR_BASE = np.int64(1) << 31
 
 # k(T) [W/mK] etc. from temperature at quadrature points
 Property = Callable[[np.ndarray], np.ndarray]
-
-
-def pair_keys(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    lo, hi = np.minimum(a, b).astype(np.int64), np.maximum(a, b).astype(np.int64)
-    return lo * PAIR_BASE + hi
 
 
 @dataclass

@@ -21,7 +21,7 @@ import numpy as np
 from apdl_like.call import POST, Call, command, specs_of
 from apdl_like.commands.post26 import plane_solution
 from apdl_like.errors import ApdlError
-from apdl_like.plane_thermal import pair_keys
+from apdl_like.model import pair_keys
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState

@@ -14,7 +14,7 @@ import numpy as np
 from apdl_like.call import LOADS, Call, command, existing, specs_of
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
-from apdl_like.fem_bridge import pair_keys
+from apdl_like.model import pair_keys
 from apdl_like.solve import face_table
 
 if TYPE_CHECKING:
