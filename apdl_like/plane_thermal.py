@@ -63,6 +63,12 @@ STEP_TOLERANCE = 1e-5
 Property = Callable[[np.ndarray], np.ndarray]
 
 
+def row_sum_lumped(matrix: sp.spmatrix) -> sp.dia_matrix:
+    """The row-sum diagonal of a capacity or film matrix: how MAPDL's linear thermal
+    elements diagonalize them."""
+    return sp.diags(np.asarray(matrix.sum(axis=1)).ravel())
+
+
 @dataclass
 class Part:
     """The elements of one shape (quads or triangles) as a scikit-fem basis."""
@@ -289,7 +295,7 @@ class PlaneThermal:
                     c[cells] = np.where(moved, sec, c[cells])
             C = C + part.to_global @ mass.assemble(b, c=c, axisymmetric=ax) @ part.to_global.T
         if self.mesh.lumped:
-            C = sp.diags(np.asarray(C.sum(axis=1)).ravel())
+            C = row_sum_lumped(C)
         if self.links is not None:
             C = C + self.links.capacity(T1, inputs.rho_c, inputs.specific_heat or [], n)
         return C.tocsr()
@@ -326,7 +332,7 @@ class PlaneThermal:
                 if fb is not None:
                     Hf = mass.assemble(fb, c=h, axisymmetric=ax)
                     if self.mesh.lumped:
-                        Hf = sp.diags(np.asarray(Hf.sum(axis=1)).ravel())
+                        Hf = row_sum_lumped(Hf)
                     K = K + S @ Hf @ S.T
                     f = f + S @ load.assemble(fb, g=h * tb, axisymmetric=ax)
             for keys, flux in inputs.fluxes:
@@ -334,7 +340,7 @@ class PlaneThermal:
                 if fb is not None:
                     f = f + S @ load.assemble(fb, g=flux, axisymmetric=ax)
         if self.mesh.lumped:
-            C = sp.diags(np.asarray(C.sum(axis=1)).ravel()).tocsr()
+            C = row_sum_lumped(C).tocsr()
         if self.links is not None:
             K = K + self.links.stiffness(T, inputs.kxx, inputs.hf or [], n)
             C = C + self.links.capacity(T, inputs.rho_c, inputs.specific_heat or [], n)
@@ -448,7 +454,7 @@ class PlaneThermal:
                 fb = FacetBasis(part.basis.mesh, part.basis.elem, facets=facets)
                 H = mass.assemble(fb, c=h, axisymmetric=ax)
                 if self.mesh.lumped:
-                    H = sp.diags(np.asarray(H.sum(axis=1)).ravel())
+                    H = row_sum_lumped(H)
                 r = r + H @ T_local - load.assemble(fb, g=h * tb, axisymmetric=ax)
         for keys, flux in inputs.fluxes:
             facets = own[np.isin(part.facet_keys[own], keys)]
