@@ -366,15 +366,12 @@ def test_the_expansion_member_is_the_drift_scaled(tmp_path, spindle_model):
     np.testing.assert_allclose(rise[fc.substeps - 1::fc.substeps], mean_scale * rise_members[1:])
 
 
-def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
-        tmp_path, spindle_model, monkeypatch):
-    """The speed steps from 6000 to 12000 rpm at 76 s and down to 3000 rpm at 100 s, both
-    inside window 1 whose loads were fixed at 60 s.  At 120 s the estimator re-runs window 1
-    with the recorded speeds, so window 2 starts from the right field; without the re-run
-    it carries the missed heat for minutes."""
+def write_speed_step_run(path, model):  # noqa: ANN001, ANN201
+    """A 6-window run of the nominal model whose speed steps from 6000 to 12000 rpm at 76 s
+    and down to 3000 rpm at 100 s, both inside window 1 (loads fixed at 60 s); each step
+    at the speed recorded at its start, ideal thermocouples.  Returns `path`."""
     from twin.runs import write_run
 
-    model = spindle_model
     T = np.full(model.n_dofs, 24.0)
     times, temps = [0.0], [model.sensor_matrix @ T]
 
@@ -395,10 +392,20 @@ def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
             times.append(t_end)
             temps.append(model.sensor_matrix @ T)
     t, temps = np.array(times), np.array(temps)
-    write_run(tmp_path / "step.csv", {"time_s": t, "speed_rpm": [speed_at(x) for x in t],
-                                      "ambient_C": np.full(t.size, 24.0),
-                                      **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
-    run = read_run(tmp_path / "step.csv")
+    write_run(path, {"time_s": t, "speed_rpm": [speed_at(x) for x in t],
+                     "ambient_C": np.full(t.size, 24.0),
+                     **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
+    return path
+
+
+def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
+        tmp_path, spindle_model, monkeypatch):
+    """The speed steps from 6000 to 12000 rpm at 76 s and down to 3000 rpm at 100 s, both
+    inside window 1 whose loads were fixed at 60 s.  At 120 s the estimator re-runs window 1
+    with the recorded speeds, so window 2 starts from the right field; without the re-run
+    it carries the missed heat for minutes."""
+    model = spindle_model
+    run = read_run(write_speed_step_run(tmp_path / "step.csv", model))
 
     def error_after_the_change():
         replay = estimate(run, model, sensor_lag_s=0.0)[1]

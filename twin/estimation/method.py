@@ -110,6 +110,7 @@ from threadpoolctl import threadpool_limits
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import WindowFeatures
+from twin.correction.rerun import recorded_step_speeds, rerun_window, speed_change_s
 from twin.correction.result import Correction
 from twin.estimation.analysis import etkf_update
 from twin.estimation.ensemble import Ensemble, add_random_walk, cap_spread
@@ -356,25 +357,21 @@ class EnsembleEstimator:
     def _rerun(self, f: WindowFeatures, fc: WindowForecast
                ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
         """The window just ended re-run from its start field, each solver step at the speed
-        recorded at its midpoint: the forecast's loads at the forecast's speed, this window's
-        nominal conditions at the current speed, nominal conditions at the window start's
-        temperatures for any other speed (a step up and a stop inside one window), all with
-        the same factors.  Returns T1..T5 history with the window replaced, the end field
-        and the forecast with that mean (the members' anomalies are kept)."""
+        recorded at its midpoint (`twin.correction.rerun`): the forecast's loads at the
+        forecast's speed, this window's nominal conditions at the current speed, nominal
+        conditions at the window start's temperatures for any other speed (a step up and a
+        stop inside one window), all with the same factors.  Returns T1..T5 history with the
+        window replaced, the end field and the forecast with that mean (the members'
+        anomalies are kept)."""
         from twin.spindle.conditions import nominal_conditions
 
         cfg = self.config
-        T, before, factors = self._window
+        T0, before, factors = self._window
         current = f.twin_state.conditions
         steps = cfg.steps_per_window
-        start = f.start_s - cfg.window_s
-        mid = start + (np.arange(steps) + 0.5) * cfg.step_s
-        t = np.asarray(f.measured_time_s, float)
-        recorded = np.asarray(f.measured_speed_rpm, float)
-        speeds = recorded[np.clip(np.searchsorted(t, mid - 1e-9) - 1, 0, len(t) - 1)]
         steppers = {self._forecast_speed_rpm: before}
 
-        def stepper(speed: float):  # noqa: ANN202
+        def advance(speed: float, T: np.ndarray, n: int, _start_s: float) -> np.ndarray:
             if speed not in steppers:
                 base = current
                 if abs(speed - current.speed_rpm) > 0.5:
@@ -383,18 +380,15 @@ class EnsembleEstimator:
                 bc = apply_factors(self._conditions_at(base, T0), factors)
                 steppers[speed] = self.model.thermal.transient(bc.to_thermal_loads(),
                                                                cfg.step_s)
-            return steppers[speed]
+            return np.array(list(steppers[speed].march(T, n)))
 
-        T0 = T
-        sensors = np.empty((steps, self._sensors.shape[0]))
-        drift = np.empty(steps)
-        for i in range(steps):
-            T = stepper(float(speeds[i])).step(T)
-            sensors[i] = self._sensors @ T
-            drift[i] = self._drift_um @ T
+        fields = rerun_window(T0, f.start_s - cfg.window_s,
+                              recorded_step_speeds(f, steps, cfg.step_s), cfg.step_s, advance)
         sim_C = np.asarray(f.simulated_C, float).copy()
-        sim_C[-steps:] = sensors
-        return sim_C, T, replace(fc, drift_mean_um=drift)
+        # row by row, as the forecast computes them (a matrix product may round differently)
+        sim_C[-steps:] = [self._sensors @ T for T in fields]
+        drift = np.array([self._drift_um @ T for T in fields])
+        return sim_C, fields[-1], replace(fc, drift_mean_um=drift)
 
     def _drift_forecast(self, fc: WindowForecast) -> tuple[np.ndarray, np.ndarray]:
         """The mean's axial nose drift since the run start at every solver step (s,) and
@@ -466,18 +460,6 @@ class EnsembleEstimator:
             a = cfg.band_learning_rate
             self._band_var[channel] = (1 - a) * self._band_var[channel] + a * max(
                 float(np.nanmean(excess)), floor**2)
-
-def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None:
-    """Time (s) of the first recorded speed in the window just ended that differs from the
-    speed its forecast ran at (None: no change, or no speed history).  The sample at the
-    window's end is the next window's speed (the loop's), not a change inside this one."""
-    if f.measured_speed_rpm is None:
-        return None
-    t = np.asarray(f.measured_time_s, float)
-    rows = (t > f.start_s - f.window_s + 1e-9) & (t < f.start_s - 1e-9)
-    moved = np.abs(np.asarray(f.measured_speed_rpm, float)[rows] - forecast_speed_rpm) > 0.5
-    return float(t[rows][np.argmax(moved)]) if moved.any() else None
-
 
 def thermocouple_reading(time_s: np.ndarray, metal_C: np.ndarray, lag_s: float) -> np.ndarray:
     """First-order lag τ dy/dt = x − y of metal temperatures (rows at time_s), starting

@@ -1,0 +1,76 @@
+"""Re-running the window just ended with the speed it really had (a causal state correction).
+
+A window's loads are fixed at its start (causality), so a speed step or a stop inside
+window k−1 is missing from its forecast: the twin ends the window with the wrong field
+(50 s of changed heat it never saw).  By the start of window k the recorded speed of the
+whole window k−1 is known, so a method may re-run that window from its start field with
+the recorded speed, step by step, and start window k from the re-run's end field and
+read its errors off the re-run instead of the forecast that missed the input.
+
+One implementation serves every method that does it: the `estimator`
+(`twin.estimation.method`, with its analysed factors) and the loop's state correction for
+`bpnn` and the training fit (`twin.loop.replay`, through the window decks).  Each passes
+its own `advance(speed_rpm, T, n_steps, start_s)`, the solver of one constant-speed
+stretch; this module finds the change, the speed of every solver step and the stretches.
+
+    changed = speed_change_s(features, forecast_speed_rpm)   # None: nothing to re-run
+    speeds = recorded_step_speeds(features, steps, step_s)
+    fields = rerun_window(T_start, start_s, speeds, step_s, advance)   # (steps, n_dofs)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from twin.correction.features import WindowFeatures
+
+Advance = Callable[[float, np.ndarray, int, float], np.ndarray]
+"""(speed_rpm, T at the stretch start, n_steps, stretch start s) → T after each step
+(n_steps, n_dofs)."""
+
+
+def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None:
+    """Time (s) of the first recorded speed in the window just ended that differs from the
+    speed its forecast ran at (None: no change, or no speed history).  The sample at the
+    window's end is the next window's speed (the loop's), not a change inside this one."""
+    if f.measured_speed_rpm is None:
+        return None
+    t = np.asarray(f.measured_time_s, float)
+    rows = (t > f.start_s - f.window_s + 1e-9) & (t < f.start_s - 1e-9)
+    moved = np.abs(np.asarray(f.measured_speed_rpm, float)[rows] - forecast_speed_rpm) > 0.5
+    return float(t[rows][np.argmax(moved)]) if moved.any() else None
+
+
+def recorded_step_speeds(f: WindowFeatures, steps: int, step_s: float) -> np.ndarray:
+    """The recorded speed (rpm) of each solver step of the window just ended, read at the
+    step's midpoint (the last sample at or before it; `f.measured_speed_rpm` required)."""
+    start = f.start_s - f.window_s
+    mid = start + (np.arange(steps) + 0.5) * step_s
+    t = np.asarray(f.measured_time_s, float)
+    recorded = np.asarray(f.measured_speed_rpm, float)
+    return recorded[np.clip(np.searchsorted(t, mid - 1e-9) - 1, 0, len(t) - 1)]
+
+
+def speed_stretches(speeds: np.ndarray) -> list[tuple[float, int, int]]:
+    """(speed rpm, first step, number of steps) of each run of equal speeds, in order."""
+    speeds = np.asarray(speeds, float)
+    edges = np.flatnonzero(np.abs(np.diff(speeds)) > 0.5) + 1
+    bounds = np.r_[0, edges, speeds.size]
+    return [(float(speeds[a]), int(a), int(b - a)) for a, b in zip(bounds[:-1], bounds[1:],
+                                                                   strict=True)]
+
+
+def rerun_window(T_start: np.ndarray, start_s: float, speeds: np.ndarray, step_s: float,
+                 advance: Advance) -> np.ndarray:
+    """The window re-run from `T_start` (°C per dof, at `start_s`) with `speeds` (one per
+    solver step of `step_s`): each stretch of equal speed solved by `advance` from where the
+    last one ended.  Returns the field after every step, (steps, n_dofs)."""
+    out = []
+    T = np.asarray(T_start, float)
+    for speed, first, n in speed_stretches(speeds):
+        fields = np.asarray(advance(speed, T, n, start_s + first * step_s), float)
+        out.append(fields)
+        T = fields[-1]
+    return np.vstack(out)
