@@ -40,17 +40,19 @@ ARC_OUTLINE_POINTS = 64  # points of an arc side in the outline that sorts eleme
 
 def line_points(line: Line, p1: np.ndarray, p2: np.ndarray, f: np.ndarray) -> np.ndarray:
     """Points at fractions f of a line from p1 to p2: along the chord, or along the arc
-    about the origin (angle proportional to f) for an arc."""
+    about its centre (angle proportional to f) for an arc."""
     if not line.arc:
         return p1 + f[:, None] * (p2 - p1)
-    r = float(np.hypot(*p1))
-    t1, t2 = np.arctan2(p1[1], p1[0]), np.arctan2(p2[1], p2[0])
+    centre = np.asarray(line.centre, float)
+    d1, d2 = p1 - centre, p2 - centre
+    r = float(np.hypot(*d1))
+    t1, t2 = np.arctan2(d1[1], d1[0]), np.arctan2(d2[1], d2[0])
     if t2 - t1 > np.pi:  # the shorter way round, as MAPDL draws it
         t2 -= 2 * np.pi
     elif t1 - t2 > np.pi:
         t2 += 2 * np.pi
     t = t1 + f * (t2 - t1)
-    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+    return centre + np.column_stack([r * np.cos(t), r * np.sin(t)])
 
 
 def _arc_between(s: SessionState, a: int, b: int) -> Line | None:
@@ -68,18 +70,19 @@ def area_outline(s: SessionState, area: int) -> np.ndarray:
     out = []
     for a, b in zip(kps, [*kps[1:], kps[0]], strict=True):
         p1, p2 = np.array(db.keypoints[a], float), np.array(db.keypoints[b], float)
-        if _arc_between(s, a, b) is None:
+        arc = _arc_between(s, a, b)
+        if arc is None:
             out.append(p1[None, :])
         else:
             f = np.linspace(0.0, 1.0, ARC_OUTLINE_POINTS, endpoint=False)
-            out.append(line_points(Line(a, b, arc=True), p1, p2, f))
+            out.append(line_points(arc, p1, p2, f))
     return np.vstack(out)
 
 
 def _triangulate(polygons: list[np.ndarray], size: float,
-                 arcs: list[list[bool]] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles of the polygons (sides i -> i+1; arcs[k][i]: side i of polygon k is a
-    circular arc about the origin)."""
+                 arcs: list[list[Line | None]] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of the polygons (sides i -> i+1; arcs[k][i]: the circular arc that is
+    side i of polygon k, None for a straight side)."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -90,15 +93,17 @@ def _triangulate(polygons: list[np.ndarray], size: float,
         gmsh.model.add("amesh")
         occ = gmsh.model.occ
         surfaces = []
-        centre = None
+        centres: dict[tuple[float, float], int] = {}
         for k, poly in enumerate(polygons):
             pts = [occ.addPoint(x, y, 0.0) for x, y in poly]
             lines = []
             for i in range(len(pts)):
                 j = (i + 1) % len(pts)
-                if arcs is not None and arcs[k][i]:
-                    centre = centre if centre is not None else occ.addPoint(0.0, 0.0, 0.0)
-                    lines.append(occ.addCircleArc(pts[i], centre, pts[j]))
+                arc = arcs[k][i] if arcs is not None else None
+                if arc is not None:
+                    if arc.centre not in centres:
+                        centres[arc.centre] = occ.addPoint(*arc.centre, 0.0)
+                    lines.append(occ.addCircleArc(pts[i], centres[arc.centre], pts[j]))
                 else:
                     lines.append(occ.addLine(pts[i], pts[j]))
             surfaces.append((2, occ.addPlaneSurface([occ.addCurveLoop(lines)])))
@@ -134,7 +139,7 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
     if et is None:
         raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
     polygons = [np.array([db.keypoints[k] for k in db.areas[a]], float) for a in area_numbers]
-    arcs = [[_arc_between(s, k, kk) is not None
+    arcs = [[_arc_between(s, k, kk)
              for k, kk in zip(db.areas[a], [*db.areas[a][1:], db.areas[a][0]], strict=True)]
             for a in area_numbers]
     outlines = [area_outline(s, a) for a in area_numbers]
@@ -239,8 +244,6 @@ def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
     if len(kps) != 4:
         return None
     k0, k1, k2, k3 = kps
-    if any(_arc_between(s, a, b) is not None for a, b in ((k0, k1), (k1, k2), (k2, k3), (k3, k0))):
-        return None  # curved sides: the free mesher follows them
     bottom, top = _side(s, k0, k1, size), _side(s, k3, k2, size)
     left, right = _side(s, k0, k3, size), _side(s, k1, k2, size)
     if bottom.size != top.size or left.size != right.size:
@@ -249,10 +252,16 @@ def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
     p0, p1, p2, p3 = (np.array(db.keypoints[k], float) for k in kps)
     u = 0.5 * (bottom + top)[None, :, None]
     v = 0.5 * (left + right)[:, None, None]
-    b = p0 + bottom[None, :, None] * (p1 - p0)
-    t = p3 + top[None, :, None] * (p2 - p3)
-    lft = p0 + left[:, None, None] * (p3 - p0)
-    rgt = p1 + right[:, None, None] * (p2 - p1)
+
+    def side(a: int, b: int, pa: np.ndarray, pb: np.ndarray, f: np.ndarray) -> np.ndarray:
+        """Points of the side a -> b at fractions f: on its arc when it is one (a Coons
+        patch then keeps the mesh on the curved boundary)."""
+        return line_points(_arc_between(s, a, b) or Line(a, b), pa, pb, f)
+
+    b = side(k0, k1, p0, p1, bottom)[None, :, :]
+    t = side(k3, k2, p3, p2, top)[None, :, :]
+    lft = side(k0, k3, p0, p3, left)[:, None, :]
+    rgt = side(k1, k2, p1, p2, right)[:, None, :]
     corner = (1 - u) * (1 - v) * p0 + u * (1 - v) * p1 + u * v * p2 + (1 - u) * v * p3
     return (1 - v) * b + v * t + (1 - u) * lft + u * rgt - corner
 

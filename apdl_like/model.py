@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from apdl_like.coordinates import GLOBAL_SYSTEMS, CoordinateSystem
 from apdl_like.errors import ApdlError
 
 PAIR_BASE = np.int64(1) << 31  # node numbers are < 2^31: (lo, hi) packs into one int64
@@ -403,14 +404,15 @@ class SolutionSettings:
 class Line:
     """A line between keypoints k1 -> k2, its divisions and spacing ratio (LESIZE; the last
     division over the first, along k1 -> k2): straight, or with `arc` a circular arc about
-    the origin (L in CSYS 1 between keypoints of one radius, as MAPDL draws lines in the
-    active cylindrical system)."""
+    `centre`, the origin of the active cylindrical system (L in CSYS 1 or a cylindrical
+    LOCAL between keypoints of one radius, as MAPDL draws lines in the active system)."""
 
     k1: int
     k2: int
     ndiv: int | None = None
     space: float = 1.0
     arc: bool = False
+    centre: tuple[float, float] = (0.0, 0.0)  # of an arc: the cylindrical system's origin
 
 
 @dataclass
@@ -445,13 +447,25 @@ class Database:
     title: str = ""
     mp_temperatures: list[float] = field(default_factory=list)  # MPTEMP, for MPDATA
     node_history: list[int] = field(default_factory=list)  # the last two nodes N defined
-    csys: int = 0  # active coordinate system (0 Cartesian, 1 cylindrical: x = r, y = θ in °)
+    csys: int = 0  # active coordinate system (0 Cartesian, 1 cylindrical, ≥ 11 LOCAL)
+    local_systems: dict[int, CoordinateSystem] = field(default_factory=dict)  # LOCAL, CLOCAL
     # coupled DOF sets (CP): set number -> (label, node numbers)
     couplings: dict[int, tuple[str, np.ndarray]] = field(default_factory=dict)
     last_real: tuple[int, int] | None = None  # (set, next location) for RMORE
     # contact interface (of an AxiMesh session) -> its real-constant set (TCC at 14)
     contact_real_sets: dict[str, int] = field(default_factory=dict)
     load_records: int = 0  # a counter: every load command gets its own record id
+
+    @property
+    def active_system(self) -> CoordinateSystem:
+        """The coordinate system CSYS (or the last LOCAL) made active."""
+        return self.coordinate_system(self.csys)
+
+    def coordinate_system(self, number: int) -> CoordinateSystem:
+        system = GLOBAL_SYSTEMS.get(number) or self.local_systems.get(number)
+        if system is None:
+            raise ApdlError(f"coordinate system {number} is not defined (LOCAL)")
+        return system
 
     def next_record(self) -> int:
         self.load_records += 1

@@ -214,11 +214,16 @@ class SessionState:
             raise ApdlError(f"node {n:g} does not exist")
         return i
 
+    def node_location(self, n: float) -> np.ndarray:
+        """(X, Y) of node n in the active coordinate system (MAPDL's NX, NY, *GET LOC)."""
+        i = self.node_index(n)  # first: it merges pending nodes, which replaces .xy
+        return self.db.active_system.from_global(self.db.nodes.xy[i])[0]
+
     def _nx(self, n: float) -> float:
-        return float(self.db.nodes.xy[self.node_index(n), 0])
+        return float(self.node_location(n)[0])
 
     def _ny(self, n: float) -> float:
-        return float(self.db.nodes.xy[self.node_index(n), 1])
+        return float(self.node_location(n)[1])
 
     def _nz(self, n: float) -> float:
         self.node_index(n)
@@ -226,7 +231,8 @@ class SessionState:
 
     def _node(self, x: float, y: float, z: float = 0.0) -> float:
         db = self.db
-        i = nearest_node(db.nodes.xy, db.nodes.selected, np.array([x, y]))
+        point = np.array(db.active_system.to_global(x, y))  # given in the active system
+        i = nearest_node(db.nodes.xy, db.nodes.selected, point)
         return 0.0 if i < 0 else float(db.nodes.ids[i])
 
     def _temp(self, n: float) -> float:

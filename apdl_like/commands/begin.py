@@ -55,7 +55,8 @@ _STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
 
 @command("*GET", ANY, 8)
 def star_get(s: SessionState, c: Call) -> None:
-    """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM ...)."""
+    """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM MAX|MIN,
+    COUNT ...)."""
     name = c.raw(1).upper()
     if not is_parameter_name(name):
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
@@ -90,6 +91,8 @@ def star_get(s: SessionState, c: Call) -> None:
         return
     if entity not in ("NODE", "ELEM"):
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
+    if item == "COUNT":  # MAPDL's spelling: *GET,Par,NODE,0,COUNT
+        item, sub = "NUM", "COUNT"
     if item == "NUM":
         table = db.nodes if entity == "NODE" else db.elements
         ids = table.ids[table.selected]
@@ -116,8 +119,7 @@ def star_get(s: SessionState, c: Call) -> None:
         elif item == "LOC":
             if sub not in ("X", "Y", "Z"):
                 raise ApdlError(f"field 5: LOC takes X, Y or Z, got {sub or '(empty)'!r}")
-            i = s.node_index(n)
-            value = 0.0 if sub == "Z" else float(db.nodes.xy[i, 0 if sub == "X" else 1])
+            value = 0.0 if sub == "Z" else float(s.node_location(n)["XY".index(sub)])
         else:
             raise ApdlError(f"field 4: NODE item must be TEMP, U, S, LOC or NUM, got "
                             f"{item or '(empty)'!r}")

@@ -1,19 +1,20 @@
 """/PREP7 generation: CSYS, FILL, NGEN, EGEN, EMID, NUMMRG and coupled sets (CP, CPNGEN,
 CPSGEN).
 
-Coordinates are stored Cartesian (x = r, y = z for an axisymmetric model).  With CSYS,1 the
-fields of N, FILL and NGEN are cylindrical: X is the radius, Y the angle θ in degrees, and
-FILL interpolates in (r, θ), as MAPDL does.
+Coordinates are stored global Cartesian (x = r, y = z for an axisymmetric model).  The
+fields of N, FILL and NGEN are in the active system (`apdl_like.coordinates`): in CSYS,1 or
+a cylindrical LOCAL X is the radius and Y the angle θ in degrees, and FILL interpolates in
+(r, θ), as MAPDL does.
 """
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, command, specs_of
+from apdl_like.call import ANY, PREP7, Call, command, specs_of
+from apdl_like.coordinates import FIRST_LOCAL, CoordinateSystem
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
@@ -23,29 +24,71 @@ MAX_GENERATED = 1_000_000
 COUPLING_LABELS = ("TEMP", "UX", "UY", "ALL")
 
 
-def to_cartesian(csys: int, a: float, b: float) -> tuple[float, float]:
-    """(x, y) of a point given in coordinate system `csys` (1: r, θ in degrees)."""
-    if csys == 0:
-        return a, b
-    t = math.radians(b)
-    return a * math.cos(t), a * math.sin(t)
-
-
-def from_cartesian(csys: int, xy: np.ndarray) -> np.ndarray:
-    """Coordinates of points (n, 2) in `csys` (1: r, θ in degrees in (-180, 180])."""
-    if csys == 0:
-        return xy
-    return np.column_stack([np.hypot(xy[:, 0], xy[:, 1]),
-                            np.degrees(np.arctan2(xy[:, 1], xy[:, 0]))])
-
-
-@command("CSYS", PREP7 | {"SOLU", "POST1", "BEGIN", "POST26"}, 1)
+@command("CSYS", ANY, 1)
 def csys(s: SessionState, c: Call) -> None:
+    """CSYS,KCN: the active coordinate system (0 Cartesian, 1 cylindrical, ≥ 11 LOCAL)."""
     kcn = c.int(1, 0, what="KCN")
-    if kcn not in (0, 1):
-        raise ApdlError(f"field 1: coordinate system must be 0 (Cartesian) or 1 (cylindrical), "
-                        f"got {kcn}")
+    if kcn in (2, 3, 4, 5, 6) or 7 <= kcn < FIRST_LOCAL:
+        raise ApdlError(f"field 1 (KCN): coordinate system {kcn} is not supported in a 2-D "
+                        "model (use 0, 1 or a LOCAL system)")
+    s.db.coordinate_system(kcn)  # an undefined local system is an error
     s.db.csys = kcn
+
+
+def _define_system(s: SessionState, c: Call, relative: bool) -> None:
+    """LOCAL/CLOCAL,KCN,KCS,XC,YC,ZC,THXY,THYZ,THZX,PAR1: a local system, made active."""
+    kcn = c.int(1, what="KCN")
+    if kcn < FIRST_LOCAL:
+        raise ApdlError(f"field 1 (KCN): a local system's number must be ≥ {FIRST_LOCAL}, "
+                        f"got {kcn}")
+    kind = c.label(2, "0")
+    cylindrical = {"0": False, "CART": False, "1": True, "CYLIN": True}.get(kind)
+    if cylindrical is None:
+        raise ApdlError(f"field 2 (KCS): only 0 (Cartesian) and 1 (cylindrical) exist in a "
+                        f"2-D model, got {kind!r}")
+    for i, what in ((5, "ZC"), (7, "THYZ"), (8, "THZX")):
+        if c.num(i, 0.0, what=what) != 0.0:
+            raise ApdlError(f"field {i} ({what}) must be 0: the system would leave the XY "
+                            "plane of a 2-D model")
+    if c.num(9, 1.0, what="PAR1") != 1.0:
+        raise ApdlError("field 9 (PAR1): elliptical systems are not supported")
+    a, b, theta = c.num(3, 0.0, what="XC"), c.num(4, 0.0, what="YC"), c.num(6, 0.0, what="THXY")
+    if relative:  # CLOCAL: origin and rotation given in the active system
+        active = s.db.active_system
+        a, b = active.to_global(a, b)
+        theta += active.theta_xy_deg
+        if active.cylindrical:  # its X axis points along the radius through the origin
+            theta += float(active.from_global(np.array([[a, b]]))[0, 1])
+    s.db.local_systems[kcn] = CoordinateSystem(cylindrical, (a, b), theta)
+    s.db.csys = kcn  # MAPDL: the new system becomes the active one
+
+
+@command("LOCAL", ANY, 10)
+def local(s: SessionState, c: Call) -> None:
+    """LOCAL,KCN,KCS,XC,YC,ZC,THXY: origin (global Cartesian) and rotation about Z."""
+    _define_system(s, c, relative=False)
+
+
+@command("CLOCAL", ANY, 10)
+def clocal(s: SessionState, c: Call) -> None:
+    """CLOCAL,KCN,KCS,XL,YL,ZL,THXY: a local system placed in the active one."""
+    _define_system(s, c, relative=True)
+
+
+@command("CSDELE", ANY, 3)
+def csdele(s: SessionState, c: Call) -> None:
+    """CSDELE,KCN1,KCN2,KCINC: delete local systems (ALL: every one)."""
+    systems = s.db.local_systems
+    if c.label(1, "ALL") == "ALL":
+        chosen = list(systems)
+    else:
+        first = c.int(1, what="KCN1")
+        chosen = list(range(first, c.int(2, first, what="KCN2") + 1,
+                            max(c.int(3, 1, what="KCINC"), 1)))
+    for n in chosen:
+        systems.pop(n, None)
+    if s.db.csys in chosen:
+        s.db.csys = 0  # MAPDL falls back to the global Cartesian system
 
 
 def _node_xy(s: SessionState, number: int) -> np.ndarray:
@@ -53,7 +96,7 @@ def _node_xy(s: SessionState, number: int) -> np.ndarray:
     i = int(nodes.index(number)[0])
     if i < 0:
         raise ApdlError(f"node {number} does not exist")
-    return from_cartesian(s.db.csys, nodes.xy[i : i + 1])[0]
+    return s.db.active_system.from_global(nodes.xy[i : i + 1])[0]
 
 
 def _spacing(n: int, space: float) -> np.ndarray:
@@ -93,7 +136,7 @@ def fill(s: SessionState, c: Call) -> None:
     for k in range(itime):
         a, b = _node_xy(s, n1 + k * inc), _node_xy(s, n2 + k * inc)
         for j, f in enumerate(fractions):
-            x, y = to_cartesian(s.db.csys, *(a + f * (b - a)))
+            x, y = s.db.active_system.to_global(*(a + f * (b - a)))
             s.db.nodes.add(nstrt + k * inc + j * ninc, x, y)
 
 
@@ -119,10 +162,11 @@ def ngen(s: SessionState, c: Call) -> None:
         raise ApdlError("field 8 (DZ) must be 0 in a 2-D model")
     if pattern.size * max(itime - 1, 0) > MAX_GENERATED:
         raise ApdlError(f"NGEN would make more than {MAX_GENERATED} nodes")
-    local = from_cartesian(s.db.csys, nodes.xy[nodes.index(pattern)])
+    system = s.db.active_system
+    local = system.from_global(nodes.xy[nodes.index(pattern)])
     for k in range(1, itime):
         for num, (a, b) in zip(pattern.tolist(), local, strict=True):
-            x, y = to_cartesian(s.db.csys, a + k * dx, b + k * dy)
+            x, y = system.to_global(a + k * dx, b + k * dy)
             nodes.add(num + k * inc, x, y)
 
 
@@ -351,5 +395,6 @@ def cpsgen(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(csys, fill, ngen, egen, emid, nummrg, esurf, cp, cpngen, cpsgen),
+    *specs_of(csys, local, clocal, csdele, fill, ngen, egen, emid, nummrg, esurf, cp, cpngen,
+              cpsgen),
 )

@@ -7,7 +7,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import PREP7, Call, CommandSpec, command, specs_of
-from apdl_like.commands.generate import to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
 
@@ -201,7 +200,7 @@ def n(s: SessionState, c: Call) -> None:
         nodes.flush()
         num = int(nodes.ids.max()) + 1 if len(nodes.ids) else 1
         num = max([num, *nodes.pending]) if nodes.pending else num
-    x, y = to_cartesian(s.db.csys, c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
+    x, y = s.db.active_system.to_global(c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
     if c.given(4) and c.num(4) != 0.0:
         raise ApdlError("field 4 (Z) must be 0 in a 2-D model")
     nodes.add(num, x, y)

@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import MODEL, Call, Handler, command, specs_of
-from apdl_like.commands.generate import from_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 from apdl_like.selection import combine, in_range, number_range
@@ -58,7 +57,7 @@ def _nodes_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
             raise ApdlError(f"field 3: LOC takes X or Y (Z is 0 in a 2-D model), got {comp!r}")
         vmin = c.num(4, 0.0, what="VMIN")  # MAPDL: a blank VMIN is 0
         vmax = c.num(5, vmin, what="VMAX")
-        local = from_cartesian(s.db.csys, nodes.xy)
+        local = s.db.active_system.from_global(nodes.xy)
         values = np.zeros(len(nodes.ids)) if comp == "Z" else local[:, "XY".index(comp)]
         return in_range(values, vmin, vmax)
     raise ApdlError(f"field 2: item must be NODE or LOC, got {item!r}")
@@ -164,7 +163,7 @@ def _select_numbered(s: SessionState, c: Call, numbers: list[int], xy: np.ndarra
                 raise ApdlError(f"field 3: LOC takes X or Y, got {comp!r}")
             vmin = c.num(4, 0.0, what="VMIN")
             vmax = c.num(5, vmin, what="VMAX")
-            local = from_cartesian(s.db.csys, xy.reshape(-1, 2))
+            local = s.db.active_system.from_global(xy)
             return in_range(local[:, "XY".index(comp)], vmin, vmax)
         raise ApdlError(f"field 2: item must be {item_name} or LOC, got {item!r}")
 

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import PREP7, Call, CommandSpec, command, existing, ignored, specs_of
-from apdl_like.commands.generate import from_cartesian, to_cartesian
 from apdl_like.errors import ApdlError
 from apdl_like.meshing import (
     line_points,
@@ -40,7 +39,7 @@ def k(s: SessionState, c: Call) -> None:
         num = max(kps, default=0) + 1
     if c.given(4) and c.num(4) != 0.0:
         raise ApdlError("field 4 (Z) must be 0 in a 2-D model")
-    kps[num] = to_cartesian(s.db.csys, c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
+    kps[num] = s.db.active_system.to_global(c.num(2, 0.0, what="X"), c.num(3, 0.0, what="Y"))
 
 
 @command("KGEN", PREP7, 8)
@@ -58,11 +57,12 @@ def kgen(s: SessionState, c: Call) -> None:
     dx, dy = c.num(5, 0.0, what="DX"), c.num(6, 0.0, what="DY")
     kinc = c.int(8, 0, what="KINC")
     top = max(kps, default=0)
+    system = s.db.active_system
     for j in range(1, itime):
         for idx, n in enumerate(pattern):
-            a, b = from_cartesian(s.db.csys, np.array([kps[n]]))[0]
+            a, b = system.from_global(np.array([kps[n]]))[0]
             new = n + j * kinc if kinc else top + (j - 1) * len(pattern) + idx + 1
-            kps[new] = to_cartesian(s.db.csys, a + j * dx, b + j * dy)
+            kps[new] = system.to_global(a + j * dx, b + j * dy)
 
 
 @command("L", PREP7, 4)
@@ -76,16 +76,17 @@ def line(s: SessionState, c: Call) -> None:
         raise ApdlError("a line needs two different keypoints")
     ndiv = c.int(3, 0, what="NDIV") or None
     arc = False
-    if s.db.csys == 1:
-        (r1, t1), (r2, t2) = from_cartesian(1, np.array([s.db.keypoints[p1],
-                                                         s.db.keypoints[p2]], float))
+    system = s.db.active_system
+    if system.cylindrical:
+        (r1, t1), (r2, t2) = system.from_global(np.array([s.db.keypoints[p1],
+                                                          s.db.keypoints[p2]], float))
         tol = 1e-9 * max(r1, r2, 1e-300)
         arc = abs(r1 - r2) <= tol and abs(t1 - t2) > 1e-9 and r1 > tol
         if not arc and abs(t1 - t2) > 1e-9 and min(r1, r2) > tol:
-            raise ApdlError("a line in CSYS 1 between different radii and angles is a spiral, "
-                            "which is not supported")
+            raise ApdlError("a line in a cylindrical CSYS between different radii and angles "
+                            "is a spiral, which is not supported")
     s.db.lines[max(s.db.lines, default=0) + 1] = Line(p1, p2, ndiv, c.num(4, 1.0, what="SPACE"),
-                                                      arc)
+                                                      arc, system.origin)
 
 
 @command("LESIZE", PREP7, 9)
