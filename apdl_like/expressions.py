@@ -27,8 +27,13 @@ import math
 import re
 from collections.abc import Callable, Mapping
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 from apdl_like.errors import ApdlError
+from apdl_like.table_array import TableArray, table_index, table_value
+
+if TYPE_CHECKING:
+    import numpy as np
 
 MAX_EXPRESSION_CHARS = 640  # the APDL command-line length
 MAX_DEPTH = 32  # nesting of parentheses, unary signs and function calls
@@ -282,11 +287,21 @@ def array_value(name: str, array: object, subscripts: list[float]) -> float:
     """NAME(i, j, k) of a numeric array parameter (1-based subscripts, missing ones 1)."""
     if not hasattr(array, "shape"):
         raise ApdlError(f"{name} is not an array parameter")
+    if isinstance(array, TableArray):
+        return table_value(name, array, subscripts)
     index = array_index(name, array.shape, subscripts)  # type: ignore[attr-defined]
     value = array[index]  # type: ignore[index]
     if isinstance(value, str):
         raise ApdlError(f"{name} is a character array (a number is needed here)")
     return float(value)
+
+
+def element_index(name: str, array: np.ndarray, subscripts: list[float]) -> tuple[int, ...]:
+    """0-based storage index of the element `NAME(i, j, k)` an assignment or *VWRITE names
+    (a TABLE's index row and column are subscripts 0)."""
+    if isinstance(array, TableArray):
+        return table_index(name, array, subscripts)
+    return array_index(name, array.shape, subscripts)
 
 
 def array_index(name: str, shape: tuple[int, ...], subscripts: list[float]) -> tuple[int, ...]:

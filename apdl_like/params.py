@@ -14,8 +14,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from apdl_like.errors import ApdlError
-from apdl_like.expressions import array_index, compile_expression, is_parameter_name
+from apdl_like.expressions import compile_expression, element_index, is_parameter_name
 from apdl_like.parser import split_fields
+from apdl_like.table_array import new_table
 
 Value = float | str | np.ndarray
 MAX_ARRAY_SIZE = 10_000_000
@@ -66,7 +67,7 @@ def store(params: dict[str, Value], name: str, subs: list[float],
     array = params.get(name)
     if not isinstance(array, np.ndarray):
         raise ApdlError(f"{name} is not an array (define it with *DIM first)")
-    start = array_index(name, array.shape, subs)
+    start = element_index(name, array, subs)
     if start[0] + len(values) > array.shape[0]:
         raise ApdlError(f"{len(values)} values from row {start[0] + 1} overrun {name}, which "
                         f"has {array.shape[0]} rows")
@@ -83,7 +84,7 @@ def store(params: dict[str, Value], name: str, subs: list[float],
 
 
 def dimension(params: dict[str, Value], name: str, kind: str, shape: tuple[int, int, int]) -> None:
-    """*DIM: a new array of zeros (ARRAY) or blanks (CHAR, STRING)."""
+    """*DIM: a new array of zeros (ARRAY, TABLE) or blanks (CHAR, STRING)."""
     if any(n < 1 for n in shape) or shape[0] * shape[1] * shape[2] > MAX_ARRAY_SIZE:
         raise ApdlError(f"array dimensions {shape} out of range (1.., at most "
                         f"{MAX_ARRAY_SIZE} elements)")
@@ -91,8 +92,11 @@ def dimension(params: dict[str, Value], name: str, kind: str, shape: tuple[int, 
         params[name] = np.zeros(shape)
     elif kind in ("CHAR", "STRING"):
         params[name] = np.full(shape, "", dtype=object)
+    elif kind == "TABLE":
+        params[name] = new_table(shape)
     else:
-        raise ApdlError(f"field 2: array type must be ARRAY, CHAR or STRING, got {kind!r}")
+        raise ApdlError(f"field 2: array type must be ARRAY, TABLE, CHAR or STRING, got "
+                        f"{kind!r}")
 
 
 def column(params: Mapping[str, Value], name: str, subs: list[float]) -> list[float | str]:
@@ -102,5 +106,5 @@ def column(params: Mapping[str, Value], name: str, subs: list[float]) -> list[fl
         if name not in params:
             raise ApdlError(f"undefined parameter {name}")
         return [params[name]]  # type: ignore[list-item]
-    start = array_index(name, array.shape, subs)
+    start = element_index(name, array, subs)
     return [array[(i, *start[1:])] for i in range(start[0], array.shape[0])]

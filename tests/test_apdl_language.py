@@ -310,3 +310,46 @@ def test_trailing_blank_fields_are_no_input():
     run("/PREP7\nTUNIF,20,,,\nFINISH\n")
     with pytest.raises(ApdlError, match="TUNIF.*takes at most"):
         run("/PREP7\nTUNIF,20,,,5\nFINISH\n")
+
+
+def test_table_parameters_interpolate_between_their_index_values():
+    """*DIM,TABLE: row 0 / column 0 hold index values; TB(x[,y]) interpolates linearly
+    (hand arithmetic below) and holds the end value outside the index range."""
+    s = run("""*DIM,TB,TABLE,3,1,1,TIME
+TB(1,0) = 0,10,20
+TB(1,1) = 1,2,3
+A = TB(15)
+B = TB(-5)
+C = TB(99)
+*DIM,T2,TABLE,2,2
+T2(1,0) = 0,1
+T2(0,1) = 0
+T2(0,2) = 2
+T2(1,1) = 0,10
+T2(1,2) = 20,30
+D = T2(0.5,1)
+*VFILL,TB(1,1),RAMP,5,5
+E = TB(5)
+""")
+    p = s.params
+    assert (p["A"], p["B"], p["C"]) == (2.5, 1.0, 3.0)
+    # T2 (assignments fill down a column): x = 0 → (0, 20), x = 1 → (10, 30) at y = 0, 2;
+    # halfway in both: 15
+    assert p["D"] == pytest.approx(15.0)
+    assert p["E"] == pytest.approx(7.5)  # the RAMP refilled column 1 with 5, 10, 15
+    with pytest.raises(ApdlError, match=r"deck.inp:2: TB=: subscript 1 of table TB is 4"):
+        run("*DIM,TB,TABLE,3\nTB(4,1) = 1\n")
+
+
+def test_cfwrite_substitutes_parameter_values_and_keeps_labels():
+    """MAPDL's *CFWRITE writes the command with numeric parameters and expressions
+    replaced by their values; labels (ALL, TEMP) and quoted text stay as written."""
+    s = run("""NN = 7
+*DIM,V,ARRAY,2
+V(2) = 2.5
+*CFOPEN,cmds,inp
+*CFWRITE,D,NN,TEMP,V(2)*2
+*CFWRITE,NSEL,ALL
+*CFCLOS
+""")
+    assert s.state.listing.files["cmds.inp"] == ["D,7,TEMP,5", "NSEL,ALL"]

@@ -16,8 +16,17 @@ import numpy as np
 
 from apdl_like.call import ANY, Call, CommandSpec, command, specs_of
 from apdl_like.errors import ApdlError
+from apdl_like.expressions import compile_expression, element_index
 from apdl_like.fortran_format import format_c_line, format_line, parse_format
-from apdl_like.params import column, dimension, split_target, store, subscripts, value_of
+from apdl_like.params import (
+    column,
+    dimension,
+    is_text,
+    split_target,
+    store,
+    subscripts,
+    value_of,
+)
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -49,8 +58,6 @@ def star_dim(s: SessionState, c: Call) -> None:
     if subs:
         raise ApdlError("field 1: the array name without subscripts")
     kind = c.label(2, "ARRAY")
-    if kind == "TABLE":
-        raise ApdlError("TABLE arrays are not supported (ARRAY, CHAR or STRING)")
     shape = (c.int(3, 1, what="IMAX"), c.int(4, 1, what="JMAX"), c.int(5, 1, what="KMAX"))
     if kind == "STRING":
         shape = (shape[1], 1, 1)  # *DIM,Par,STRING,length,rows: rows of one string
@@ -73,7 +80,7 @@ def star_vfill(s: SessionState, c: Call) -> None:
                   for i in range(3, last + 1)]
     elif func == "RAMP":
         start, step = c.num(3, 0.0, what="start"), c.num(4, 0.0, what="increment")
-        rows = array.shape[0] - int(round(subs[0])) + 1
+        rows = array.shape[0] - element_index(name, array, subs)[0]
         values = [start + k * step for k in range(rows)]
     else:
         raise ApdlError(f"field 2: *VFILL supports DATA and RAMP, got {func!r}")
@@ -147,9 +154,22 @@ def cfopen(s: SessionState, c: Call) -> None:
 
 @command("*CFWRITE", ANY, 40)
 def cfwrite(s: SessionState, c: Call) -> None:
+    """*CFWRITE,Command,...: the command written, not run; as MAPDL documents, numeric
+    parameters and expressions in its fields are replaced by their values (labels such as
+    ALL or TEMP, quoted text and an assignment stay as written)."""
     if s.listing.command_file is None:
         raise ApdlError("no command file is open (*CFOPEN first)")
+    fields = list(c.statement.fields)
     text = c.statement.text.split(",", 1)[1] if "," in c.statement.text else ""
+    if fields and "=" not in text:
+        for i, field in enumerate(fields[1:], start=1):
+            if not field or is_text(field):
+                continue
+            try:
+                fields[i] = f"{compile_expression(field)(s.params, s.model_functions):.10g}"
+            except ApdlError:
+                pass  # a label: written as it is
+        text = ",".join(fields)
     s.listing.files[s.listing.command_file].append(text.rstrip())
 
 
