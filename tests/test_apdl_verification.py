@@ -721,3 +721,111 @@ FINISH
     assert p["T_S"] - tb == pytest.approx(t_s - tb, rel=3e-3)
     assert p["T_C"] - tb == pytest.approx(t_s - tb + qdot * r**2 / (4 * k), rel=3e-3)
     assert p["Q"] == pytest.approx(qdot * math.pi * r**2 / 12, rel=3e-3)
+
+
+TWO_BLOCKS = """/PREP7
+ET,1,PLANE77
+MP,KXX,1,{k1}
+MP,KXX,2,{k2}
+K,1,0,0
+K,2,1,0
+KGEN,2,1,2,1,0,0.5
+L,1,2
+L,2,4
+L,4,3
+L,3,1
+AL,1,2,3,4
+LESIZE,1,,,4
+LESIZE,3,,,4
+LESIZE,2,,,2
+LESIZE,4,,,2
+MAT,1
+AMESH,1
+*GET,NE_MAPPED,ELEM,0,COUNT
+N,1001,1,0
+N,1005,2,0
+FILL
+NGEN,3,10,1001,1005,1,,0.25
+MAT,2
+E,1001,1002,1012,1011
+*REPEAT,4,1,1,1,1
+EGEN,2,10,-4
+EMID
+*GET,NE,ELEM,0,COUNT
+NSEL,S,LOC,X,1
+*GET,N_FACE,NODE,0,COUNT
+ALLSEL
+{join}
+NSEL,S,LOC,X,0
+D,ALL,TEMP,{t_hot}
+NSEL,S,LOC,X,2
+D,ALL,TEMP,0
+ALLSEL
+/SOLU
+SOLVE
+FINISH
+/POST1
+T_FACE=TEMP(NODE(1,0.25,0))
+T_MID2=TEMP(NODE(1.5,0.25,0))
+T_MID1=TEMP(NODE(0.5,0.25,0))
+"""
+
+
+@pytest.mark.parametrize("join", ["CPINTF,TEMP", "NUMMRG,NODE"])
+def test_two_blocks_built_two_ways_and_joined_conduct_in_series(join):
+    """Block 1 (0 ≤ x ≤ 1, k1) from K/KGEN/L/AL/LESIZE and a mapped AMESH of PLANE77; block
+    2 (1 ≤ x ≤ 2, k2) from N/FILL/NGEN/E/*REPEAT/EGEN with EMID's mid-side nodes; the
+    coincident nodes at x = 1 joined by CPINTF (coupled sets) or NUMMRG (merged).  Held at
+    T_hot and 0: one flux through resistances 1/k1 + 1/k2, T_face = T_hot·(1/k2)/(1/k1 + 1/k2),
+    linear within each block (exact for quadratic elements)."""
+    k1, k2, t_hot = 1.0, 3.0, 100.0
+    s = run(TWO_BLOCKS.format(k1=k1, k2=k2, t_hot=t_hot, join=join))
+    p = s.params
+    assert (p["NE_MAPPED"], p["NE"]) == (8, 16)  # 4 × 2 mapped quads, then 4 × 2 by E/EGEN
+    assert p["N_FACE"] == 10  # 3 corner + 2 mid-side nodes on each side of x = 1
+    t_face = t_hot * (1 / k2) / (1 / k1 + 1 / k2)
+    assert p["T_FACE"] == pytest.approx(t_face, rel=1e-9)
+    assert p["T_MID1"] == pytest.approx(0.5 * (t_hot + t_face), rel=1e-9)
+    assert p["T_MID2"] == pytest.approx(0.5 * t_face, rel=1e-9)
+
+
+def test_cpsgen_copies_a_coupled_set_to_the_next_node_pair():
+    """Two PLANE55 strips, x 0..1 (nodes 1-3, 11-13) and 1..2 (101-103, 111-113), touching at
+    x = 1: CP couples 3 with 101, CPSGEN,2,10 the copy 13 with 111; in series the face sits
+    at T_hot·(1/k2)/(1/k1 + 1/k2)."""
+    k1, k2, t_hot = 2.0, 1.0, 60.0
+    s = run(f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,{k1}
+MP,KXX,2,{k2}
+N,1,0,0
+N,3,1,0
+FILL
+N,101,1,0
+N,103,2,0
+FILL
+NGEN,2,10,1,3,1,,1
+NGEN,2,10,101,103,1,,1
+MAT,1
+E,1,2,12,11
+EGEN,2,1,-1
+MAT,2
+E,101,102,112,111
+EGEN,2,1,-1
+CP,1,TEMP,3,101
+CPSGEN,2,10,1
+NSEL,S,LOC,X,0
+D,ALL,TEMP,{t_hot}
+NSEL,S,LOC,X,2
+D,ALL,TEMP,0
+ALLSEL
+/SOLU
+SOLVE
+FINISH
+/POST1
+*GET,T3,NODE,3,TEMP
+*GET,T111,NODE,111,TEMP
+""")
+    t_face = t_hot * (1 / k2) / (1 / k1 + 1 / k2)
+    assert s.params["T3"] == pytest.approx(t_face, rel=1e-9)
+    assert s.params["T111"] == pytest.approx(t_face, rel=1e-9)

@@ -1,5 +1,5 @@
-"""/PREP7 generation: CSYS, FILL, NGEN, EGEN, EMID, NUMMRG and coupled sets (CP, CPNGEN,
-CPSGEN).
+"""/PREP7 generation: CSYS, LOCAL, FILL, NGEN, EGEN, EMID, NUMMRG and coupled sets (CP,
+CPNGEN, CPINTF, CPSGEN).
 
 Coordinates are stored global Cartesian (x = r, y = z for an axisymmetric model).  The
 fields of N, FILL and NGEN are in the active system (`apdl_like.coordinates`): in CSYS,1 or
@@ -373,6 +373,32 @@ def cpngen(s: SessionState, c: Call) -> None:
     _add_coupling(s, nset, label, wanted[s.db.nodes.index(wanted) >= 0])
 
 
+@command("CPINTF", PREP7, 2)
+def cpintf(s: SessionState, c: Call) -> None:
+    """CPINTF,Lab,TOLER: one coupled set per group of coincident selected nodes (within
+    TOLER, default 1e-4, in every coordinate): the two sides of an interface meshed apart."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    label = _coupling_label(c, 1)
+    toler = c.num(2, 1e-4, what="TOLER")
+    nodes = s.db.nodes
+    nodes.flush()
+    chosen = np.nonzero(nodes.selected)[0]
+    pairs = cKDTree(nodes.xy[chosen]).query_pairs(toler, p=np.inf, output_type="ndarray")
+    if not pairs.size:
+        return
+    n = chosen.size
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, group = connected_components(graph, directed=False)
+    sizes = np.bincount(group)
+    for g in np.nonzero(sizes > 1)[0]:
+        members = nodes.ids[chosen[group == g]]
+        _add_coupling(s, max(s.db.couplings, default=0) + 1, label, members)
+    s.say(f"CPINTF: {int(np.sum(sizes > 1))} coupled sets")
+
+
 @command("CPSGEN", PREP7, 6)
 def cpsgen(s: SessionState, c: Call) -> None:
     """CPSGEN,ITIME,INC,NSET1,NSET2,NINC: copies of coupled sets, node numbers + k·INC."""
@@ -396,5 +422,5 @@ def cpsgen(s: SessionState, c: Call) -> None:
 
 COMMANDS = (
     *specs_of(csys, local, clocal, csdele, fill, ngen, egen, emid, nummrg, esurf, cp, cpngen,
-              cpsgen),
+              cpintf, cpsgen),
 )
