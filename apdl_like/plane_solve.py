@@ -406,6 +406,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
         sol.time = 0.0
         sol.fresh_start = False
         sol.previous_loads = None
+        sol.history_times, sol.history_temperatures = [], []
     now = _LoadState.of(db)
     T0 = sol.temperature
     if not transient:
@@ -435,6 +436,8 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
                              nonlinear, adaptive, dt_min, dt_max, scale)
     sol.temperature, sol.time = temps[-1], times[-1]
     sol.substep_times, sol.substep_temperatures = times, temps
+    sol.history_times += times
+    sol.history_temperatures += temps
     sol.previous_loads = now
     s.fem.plane_inputs = steady_inputs if transient else inputs
     return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature,

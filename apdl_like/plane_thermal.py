@@ -15,7 +15,10 @@ reports them).  Conductivity may be orthotropic (KXX, KYY in the global axes) an
 and c, depend on temperature (MP with C1..C4, or MPTEMP/MPDATA tables).
 
 Nonlinear problems (k, ρc depending on T) are solved by Picard iteration: the operators are
-assembled at the last iterate until it converges (`twin.fem.stepper.picard`).
+assembled at the last iterate until it converges (`twin.fem.stepper.picard`): until the
+largest nodal change of an iterate is at most 1e-8 × (1 + max |T|) °C (PICARD_TOLERANCE),
+in at most 200 iterations (PICARD_ITERATIONS), else the SOLVE stops with a located error.
+Steady and every transient substep iterate alike (MAPDL's NEQIT/CNVTOL are not read).
 
 Transient load steps use twin.fem's θ-method (`twin.fem.stepper.theta_step`, `march_to`;
 TINTP sets θ, 1 backward Euler by default).  With AUTOTS the step size follows a

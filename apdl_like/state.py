@@ -102,6 +102,10 @@ class Solution:
     body_temperature: StepResult | None = None  # LDREAD: the thermal result to apply
     substep_times: list[float] = field(default_factory=list)  # of the last load step, s
     substep_temperatures: list[np.ndarray] = field(default_factory=list)
+    # every substep of every load step of the current analysis on a deck's own mesh (what
+    # OUTRES,ALL keeps in MAPDL's results file: SET by TIME and NSOL read it), s and °C
+    history_times: list[float] = field(default_factory=list)
+    history_temperatures: list[np.ndarray] = field(default_factory=list)
     results: list[StepResult] = field(default_factory=list)
     post_index: int = -1  # result set shown in /POST1 (SET)
     post_result: StepResult | None = None  # SET,,,,,TIME: a set between stored times

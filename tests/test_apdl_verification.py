@@ -829,3 +829,106 @@ FINISH
     t_face = t_hot * (1 / k2) / (1 / k1 + 1 / k2)
     assert s.params["T3"] == pytest.approx(t_face, rel=1e-9)
     assert s.params["T111"] == pytest.approx(t_face, rel=1e-9)
+
+
+@pytest.mark.parametrize("element", ["PLANE35", "PLANE55\nMSHAPE,1", "PLANE55",
+                                     "PLANE77\nMSHAPE,1", "PLANE77", "PLANE55,,,1",
+                                     "PLANE77,,,1"])
+def test_wall_held_and_cooled_by_surf151_films_every_element_kind(element):
+    """A wall 0.5 ≤ x ≤ 1.5 (height 0.5, k = 2) held at 100 at x = 0.5 and cooled at
+    x = 1.5 by SURF151 films (h = 10, T_b = 0), meshed as native quads, degenerate
+    triangles (MSHAPE,1) and 6-node triangles, planar or axisymmetric (KEYOPT(3) = 1):
+    the heat Q = ΔT / (R_wall + R_film) (planar per unit thickness: R = L/(kA) + 1/(hA);
+    axisymmetric R = ln(ro/ri)/(2πkH) + 1/(h 2π ro H)) is what FSUM finds at the held
+    nodes over every element (the films' SURF151 included) and what the films take out
+    (ETABLE SMISC 2, SSUM); the film face sits at T_b + Q/(hA)."""
+    k, h, t_held, ri, ro, height = 2.0, 10.0, 100.0, 0.5, 1.5, 0.5
+    s = run(f"""/PREP7
+ET,1,{element}
+MP,KXX,1,{k}
+RECTNG,{ri},{ro},0,{height}
+ESIZE,0.1
+AMESH,1
+ET,2,SURF151
+TYPE,2
+NSEL,S,LOC,X,{ro}
+ESURF
+ESEL,S,TYPE,,2
+SFE,ALL,,CONV,,{h}
+SFE,ALL,,CONV,2,0
+ALLSEL
+NSEL,S,LOC,X,{ri}
+D,ALL,TEMP,{t_held}
+ALLSEL
+/SOLU
+SOLVE
+FINISH
+/POST1
+*GET,T_S,NODE,NODE({ro},{height / 2},0),TEMP
+NSEL,S,LOC,X,{ri}
+FSUM
+*GET,Q_HELD,FSUM,0,ITEM,HEAT
+ALLSEL
+ESEL,S,TYPE,,2
+ETABLE,HF,SMISC,2
+SSUM
+*GET,Q_FILM,SSUM,,ITEM,HF
+""")
+    if element.endswith(",,,1"):
+        area_out = 2 * math.pi * ro * height
+        r_wall = math.log(ro / ri) / (2 * math.pi * k * height)
+    else:
+        area_out = height
+        r_wall = (ro - ri) / (k * height)
+    q = t_held / (r_wall + 1 / (h * area_out))
+    p = s.params
+    # planar: linear in x, exact; axisymmetric: ln r on 10 elements, within 0.2 %
+    assert p["Q_FILM"] == pytest.approx(q, rel=2e-3)
+    assert p["Q_HELD"] == pytest.approx(-q, rel=2e-3)  # MAPDL's sign: the held wall feeds it
+    assert p["T_S"] == pytest.approx(q / (h * area_out), rel=2e-3)
+
+
+def test_set_by_time_reads_substeps_of_every_load_step():
+    """A 1 × 1 plate (k = 1000: Biot ≈ 0) cooled toward 100 by films h = 1 on its 4 sides,
+    ρc = 1: T = 100 (1 − e^(−t/τ)), τ = ρc A/(h P) = 0.25 s.  Solved as two load steps
+    (to 1 s and 2 s, OUTRES,ALL), SET,,,,,TIME inside the first reads its substeps (MAPDL
+    keeps them in the results file), *GET ACTIVE SET TIME/LSTP name the set SET read."""
+    s = run("""/PREP7
+ET,1,PLANE55
+MP,KXX,1,1000
+MP,DENS,1,1
+MP,C,1,1
+N,1
+N,2,1
+N,3,1,1
+N,4,0,1
+E,1,2,3,4
+SF,ALL,CONV,1,100
+IC,ALL,TEMP,0
+FINISH
+/SOLU
+ANTYPE,TRANS
+KBC,1
+TIME,1
+DELTIM,0.001
+OUTRES,ALL,ALL
+SOLVE
+TIME,2
+SOLVE
+FINISH
+/POST1
+SET,,,,,0.5
+*GET,T_HALF,NODE,1,TEMP
+SET,,,,,1.5
+*GET,T_ONE_HALF,NODE,1,TEMP
+SET,FIRST
+*GET,T_ONE,NODE,1,TEMP
+*GET,TIME_FIRST,ACTIVE,0,SET,TIME
+SET,LAST
+*GET,STEP_LAST,ACTIVE,0,SET,LSTP
+""")
+    p = s.params
+    for name, t in (("T_HALF", 0.5), ("T_ONE", 1.0), ("T_ONE_HALF", 1.5)):
+        # backward Euler at Δt = τ/250 is within 0.1 % of the exponential
+        assert p[name] == pytest.approx(100 * (1 - math.exp(-t / 0.25)), rel=1e-3), name
+    assert (p["TIME_FIRST"], p["STEP_LAST"]) == (1.0, 2.0)

@@ -89,8 +89,16 @@ def star_get(s: SessionState, c: Call) -> None:
             raise ApdlError("VFQUERY has not been run")
         s.params[name] = s.radiation.average
         return
+    if entity == "ACTIVE":
+        if item != "SET" or sub not in ("TIME", "LSTP"):
+            raise ApdlError("ACTIVE supports *GET,Par,ACTIVE,0,SET,TIME|LSTP (the result set "
+                            "SET read)")
+        res = s.result()
+        s.params[name] = float(res.time if sub == "TIME" else res.load_step)
+        return
     if entity not in ("NODE", "ELEM"):
-        raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
+        raise ApdlError(f"field 2: entity must be NODE, ELEM, ACTIVE, FSUM, SSUM, VARI or RAD, "
+                        f"got {entity or '(empty)'!r}")
     if item == "COUNT":  # MAPDL's spelling: *GET,Par,NODE,0,COUNT
         item, sub = "NUM", "COUNT"
     if item == "NUM":

@@ -29,11 +29,14 @@ def thermal_history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
     thermal = [r for r in sol.results if r.analysis == "thermal"]
     if not thermal:
         raise ApdlError("there is no thermal result (SOLVE a thermal analysis first)")
+    last = thermal[-1]
+    if sol.history_times and sol.history_times[-1] == last.time and \
+            sol.history_times[0] <= thermal[0].time:
+        return np.array(sol.history_times), list(sol.history_temperatures)
     times, temps = [], []
     for r in thermal[:-1]:
         times.append(r.time)
         temps.append(r.temperature)
-    last = thermal[-1]
     if sol.substep_temperatures and sol.substep_times and sol.substep_times[-1] == last.time:
         times += list(sol.substep_times)
         temps += list(sol.substep_temperatures)
@@ -211,12 +214,21 @@ def fsum(s: SessionState, c: Call) -> None:
     """FSUM: the heat flow of the selected elements summed at the selected nodes
     (*GET,Par,FSUM,,ITEM,HEAT).  MAPDL sums the element nodal heat flows, counted positive
     into the model: a film that heats the model adds, a fixed temperature that takes heat
-    out adds; over all elements and nodes it is minus the total reaction heat."""
+    out adds; over all elements and nodes it is minus the total reaction heat.  Selected
+    SURF151 elements add nothing of their own: their films are in the solid's heat."""
     model, inputs = plane_solution(s)
     res = s.result()
     if res.analysis != "thermal":
         raise ApdlError("FSUM sums heat flows of a thermal result")
-    elements = np.nonzero(s.db.elements.selected)[0]
+    db = s.db
+    surface = np.array([db.element_types[int(t)].physics == "surface"
+                        for t in db.elements.type], bool)
+    chosen = db.elements.selected
+    if np.any(chosen & surface) and not np.any(chosen & ~surface):
+        raise ApdlError("FSUM of SURF151 elements alone: their film heat is summed by "
+                        "ETABLE,Lab,SMISC,2 and SSUM")
+    # a SURF151 film is counted with the solid face it lies on (its element heat holds it)
+    elements = np.nonzero(chosen & ~surface)[0]
     heat = -model.element_heat(inputs, res.temperature, elements) if elements.size else \
         np.zeros(model.mesh.n_dofs)
     dofs = model.mesh.node_dof[s.db.nodes.selected]
