@@ -14,3 +14,7 @@ def film_heat_sum(name: str) -> str:
     """/POST1 lines summing the convection heat rate of the SURF151 films (element type 2)
     into parameter `name` (SMISC 2 is a SURF151's film heat rate)."""
     return f"ESEL,S,TYPE,,2\nETABLE,{name}_E,SMISC,2\nSSUM\n*GET,{name},SSUM,,ITEM,{name}_E"
+
+
+# leave /PREP7, solve the load step, and read its results in /POST1
+SOLVE_THEN_POST = "FINISH\n/SOLU\nSOLVE\nFINISH\n/POST1"

@@ -13,6 +13,7 @@ import pytest
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
+from tests.apdl_decks import SOLVE_THEN_POST
 
 
 def run(text: str) -> Session:
@@ -46,11 +47,7 @@ D,ALL,TEMP,100
 NSEL,S,LOC,X,2
 D,ALL,TEMP,0
 NSEL,ALL
-FINISH
-/SOLU
-SOLVE
-FINISH
-/POST1
+{SOLVE_THEN_POST}
 *GET,T_MID,NODE,506,TEMP
 *GET,R_MID,NODE,506,LOC,X
 *GET,A_MID,NODE,506,LOC,Y
@@ -106,11 +103,7 @@ NSEL,S,LOC,X,2
 *GET,N_OUT,NODE,0,COUNT
 D,ALL,TEMP,0
 NSEL,ALL
-FINISH
-/SOLU
-SOLVE
-FINISH
-/POST1
+{SOLVE_THEN_POST}
 NSEL,S,LOC,X,1
 FSUM
 *GET,Q,FSUM,0,ITEM,HEAT

@@ -13,7 +13,7 @@ import pytest
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
-from tests.apdl_decks import film_heat_sum, held_faces
+from tests.apdl_decks import SOLVE_THEN_POST, film_heat_sum, held_faces
 
 RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
 K = 50.0  # W/mK
@@ -756,15 +756,8 @@ NSEL,S,LOC,X,1
 *GET,N_FACE,NODE,0,COUNT
 ALLSEL
 {join}
-NSEL,S,LOC,X,0
-D,ALL,TEMP,{t_hot}
-NSEL,S,LOC,X,2
-D,ALL,TEMP,0
-ALLSEL
-/SOLU
-SOLVE
-FINISH
-/POST1
+{held}
+{solve}
 T_FACE=TEMP(NODE(1,0.25,0))
 T_MID2=TEMP(NODE(1.5,0.25,0))
 T_MID1=TEMP(NODE(0.5,0.25,0))
@@ -779,7 +772,8 @@ def test_two_blocks_built_two_ways_and_joined_conduct_in_series(join):
     T_hot and 0: one flux through resistances 1/k1 + 1/k2, T_face = T_hot·(1/k2)/(1/k1 + 1/k2),
     linear within each block (exact for quadratic elements)."""
     k1, k2, t_hot = 1.0, 3.0, 100.0
-    s = run(TWO_BLOCKS.format(k1=k1, k2=k2, t_hot=t_hot, join=join))
+    s = run(TWO_BLOCKS.format(k1=k1, k2=k2, join=join, solve=SOLVE_THEN_POST,
+                              held=held_faces("X", (0, t_hot), (2, 0))))
     p = s.params
     assert (p["NE_MAPPED"], p["NE"]) == (8, 16)  # 4 × 2 mapped quads, then 4 × 2 by E/EGEN
     assert p["N_FACE"] == 10  # 3 corner + 2 mid-side nodes on each side of x = 1
@@ -814,15 +808,8 @@ E,101,102,112,111
 EGEN,2,1,-1
 CP,1,TEMP,3,101
 CPSGEN,2,10,1
-NSEL,S,LOC,X,0
-D,ALL,TEMP,{t_hot}
-NSEL,S,LOC,X,2
-D,ALL,TEMP,0
-ALLSEL
-/SOLU
-SOLVE
-FINISH
-/POST1
+{held_faces("X", (0, t_hot), (2, 0))}
+{SOLVE_THEN_POST}
 *GET,T3,NODE,3,TEMP
 *GET,T111,NODE,111,TEMP
 """)
