@@ -18,7 +18,7 @@ import numpy as np
 from apdl_like.errors import ApdlError
 from apdl_like.line_thermal import LINK_KINDS, ThermalLinks, link_constants
 from apdl_like.model import Database, element_corners, pair_keys, record_groups
-from apdl_like.plane_elastic import solve_elastic
+from apdl_like.plane_elastic import plane182_technology, solve_elastic
 from apdl_like.plane_thermal import (
     PlaneMesh,
     PlaneThermal,
@@ -532,12 +532,13 @@ def solve_plane_structural(s: SessionState) -> StepResult:
         for c, name in enumerate(("UX", "UY")):
             if label in (name, "ALL"):
                 couplings.append(c * n + scalar)
-    enhanced = np.array([db.element_types[int(t)].name == "PLANE182" and
-                         db.element_types[int(t)].keyopt.get(1, 0) in (2, 3)
-                         for t in db.elements.type], bool)
+    technology = {int(t): plane182_technology(et.keyopt.get(1, 0), f"element type {int(t)}")
+                  if et.name == "PLANE182" else ""
+                  for t in np.unique(db.elements.type) for et in [db.element_types[int(t)]]}
+    technology = np.array([technology[int(t)] for t in db.elements.type])
     disp, stress = solve_elastic(mesh, mode, E, nu, alpha, T - settings.tref,
                                  (np.concatenate(dofs), np.concatenate(values)), couplings,
-                                 enhanced)
+                                 technology)
     sol = s.solution
     sol.time = settings.time if settings.time is not None else sol.time + 1.0
     return StepResult.structural(len(sol.results) + 1, sol.time, T, disp, stress, mesh.nodal,

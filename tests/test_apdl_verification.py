@@ -366,8 +366,8 @@ def test_long_cylinder_thermal_stress_on_quads(keyopt1, rel):
     """Timoshenko (Strength of Materials II, p. 234; VM32): a long cylinder, a = 0.1875,
     b = 0.625 in, T = −1 at a, 0 at b (steady, ln r profile), free ends (UY coupled):
     σθ(a) = σz(a) = Eα/(2(1−ν) ln(b/a)) · T(a) · (1 − 2b²/(b²−a²) ln(b/a)) = 420.42 psi.
-    40 bilinear quads: enhanced strain (KEYOPT(1)=2) within 1.5 %, plain within 6 % (the
-    plain element's corner stress converges as O(h))."""
+    40 bilinear quads: enhanced strain (KEYOPT(1)=2) within 1.5 %, B-bar (KEYOPT(1)=0)
+    within 6 % (−4.4 %: the corner stress converges as O(h))."""
     a, b, E, alpha, nu = 0.1875, 0.625, 30e6, 1.435e-5, 0.3
     ln = math.log(b / a)
     exact = E * alpha / (2 * (1 - nu) * ln) * (-1.0) * (1 - 2 * b**2 / (b**2 - a**2) * ln)
@@ -378,6 +378,84 @@ def test_long_cylinder_thermal_stress_on_quads(keyopt1, rel):
     uniform = run(LONG_CYLINDER.format(t_in=5, keyopt1=keyopt1).replace(
         "D,41,TEMP,0,,141,100", "D,41,TEMP,5,,141,100"))
     assert abs(uniform.params["HOOP_IN"]) < 1e-6 * E * alpha * 5  # free expansion: no stress
+
+
+def thick_cylinder_deck(nr: int, nz: int, keyopt1: int, nu: float = 0.3,
+                        distort: float = 0.0) -> str:
+    """VM32's cylinder (a = 0.1875, b = 0.625 in, T = −1 at a, 0 at b) on nr × nz PLANE55
+    quads, then PLANE182 (KEYOPT(1) given) in generalised plane strain: UY held at z = 0
+    and coupled on the top row.  distort shifts the interior nodes radially by ± that
+    fraction of the local spacing, alternately (trapezoids)."""
+    r = np.linspace(0.1875, 0.625, nr + 1)
+    lines = ["/PREP7", "ET,1,PLANE55,,,1", "MP,KXX,1,3"]
+    for j in range(nz + 1):
+        for i in range(nr + 1):
+            x = float(r[i])
+            if 0 < i < nr and 0 < j < nz:
+                x += distort * float(r[i + 1] - r[i - 1]) / 2 * (1 if (i + j) % 2 else -1)
+            lines.append(f"N,{1000 * j + i + 1},{x!r},{0.1 * j / nz!r}")
+    lines += [f"E,{n},{n + 1},{n + 1001},{n + 1000}"
+              for j in range(nz) for i in range(nr) for n in [1000 * j + i + 1]]
+    lines += ["/SOLU", f"D,1,TEMP,-1,,{1000 * nz + 1},1000",
+              f"D,{nr + 1},TEMP,0,,{1000 * nz + nr + 1},1000", "SOLVE", "FINISH",
+              "/PREP7", "ETCHG,TTS", f"KEYOPT,1,1,{keyopt1}", "KEYOPT,1,3,1", "MP,EX,1,30E6",
+              "MP,ALPX,1,1.435E-5", f"MP,NUXY,1,{nu}",
+              f"CPNGEN,1,UY,{1000 * nz + 1},{1000 * nz + nr + 1}", "FINISH", "/SOLU",
+              f"D,1,UY,,,{nr + 1}", "LDREAD,TEMP", "SOLVE", "FINISH", "/POST1",
+              "*GET,U_IN,NODE,1,U,X", "*GET,HOOP_IN,NODE,1,S,Z", "*GET,AXIAL_IN,NODE,1,S,Y"]
+    return "\n".join(lines) + "\n"
+
+
+def thick_cylinder_exact(nu: float) -> tuple[float, float]:
+    """Timoshenko's bore stress σθ(a) = σz(a) (psi) and the bore's radial displacement
+    u(a) = a (σθ(1 − ν)/E + α T(a)) (in; σr(a) = 0) for `thick_cylinder_deck`."""
+    a, b, E, alpha, t_a = 0.1875, 0.625, 30e6, 1.435e-5, -1.0
+    ln = math.log(b / a)
+    stress = E * alpha * t_a / (2 * (1 - nu) * ln) * (1 - 2 * b**2 / (b**2 - a**2) * ln)
+    return stress, a * (stress * (1 - nu) / E + alpha * t_a)
+
+
+@pytest.mark.parametrize("keyopt1, worst_stress", [(2, 0.01), (0, 0.03)])
+def test_plane182_thick_cylinder_converges_at_the_element_rates(keyopt1, worst_stress):
+    """VM32's cylinder on 16, 32, 64 uniform PLANE182 quads (enhanced strain, B-bar):
+    the bore displacement converges as O(h²) and the nodal stresses extrapolated to the
+    bore corner as O(h) (halving h divides their error by about 4 and 2), toward the
+    closed form.  (Measured: enhanced strain +0.32/+0.08 % displacement, +1.36/+0.73 %
+    axial stress at 32/64 elements; B-bar +0.07/+0.02 %, −5.4/−2.8 %.)"""
+    stress, u_bore = thick_cylinder_exact(0.3)
+    err = {}
+    for nr in (16, 32, 64):
+        p = run(thick_cylinder_deck(nr, 1, keyopt1)).params
+        err[nr] = np.array([p["U_IN"] / u_bore, p["HOOP_IN"] / stress,
+                            p["AXIAL_IN"] / stress]) - 1.0
+    u_rate = err[32][0] / err[64][0]
+    s_rates = err[32][1:] / err[64][1:]
+    assert 3.5 < u_rate < 4.5, err
+    assert np.all((1.7 < s_rates) & (s_rates < 2.3)), err
+    assert np.all(np.abs(err[64][1:]) < worst_stress), err
+
+
+@pytest.mark.parametrize("keyopt1, bound", [(2, 0.1), (0, 0.05), (3, None)])
+def test_plane182_keyopt1_volumetric_locking_on_a_distorted_mesh(keyopt1, bound):
+    """ν = 0.4999 on a distorted 16 × 8 mesh of VM32's cylinder: the bore displacement
+    (independent of ν) is within 10 % with enhanced strain (KEYOPT(1) = 2: its fifth,
+    volumetric mode, the hoop strain ξη) and within 5 % with B-bar (0), and refining to
+    32 × 16 halves that and brings the bore stresses within 6 % (measured +2.7 %,
+    −4.2 %); with the four shear modes alone (3, "to prevent shear locking"
+    only, as MAPDL documents) the element locks: the bore moves several times too far
+    (measured 3.6×)."""
+    stress, u_bore = thick_cylinder_exact(0.4999)
+    ratio = run(thick_cylinder_deck(16, 8, keyopt1, 0.4999, 0.3)).params["U_IN"] / u_bore
+    if bound is None:
+        assert ratio > 2.0
+        return
+    assert abs(ratio - 1.0) < bound
+    finer = run(thick_cylinder_deck(32, 16, keyopt1, 0.4999, 0.3)).params
+    assert abs(finer["U_IN"] / u_bore - 1.0) < 0.5 * abs(ratio - 1.0)
+    # the bore stresses too (B-bar averages the thermal dilatation with the total one: a
+    # pointwise thermal one against the averaged total one made them ~100 times too big)
+    for name in ("HOOP_IN", "AXIAL_IN"):
+        assert finer[name] == pytest.approx(stress, rel=0.06), name
 
 
 def wall_end_C(t0: float, tb: float, h: float, length: float = 0.1, k: float = 20.0) -> float:
@@ -473,23 +551,28 @@ SET,2
         assert s.params[name] == pytest.approx(wall_end_C(t0, 20.0, 50.0), rel=1e-9)
 
 
-@pytest.mark.parametrize("mode", ["axisymmetric", "plane_strain"])
-def test_enhanced_quad_passes_the_patch_test_when_distorted(mode):
+@pytest.mark.parametrize("technology", ["bbar", "enhanced", "enhanced_shear"])
+@pytest.mark.parametrize("mode", ["axisymmetric", "plane_strain", "plane_stress"])
+def test_plane182_quad_passes_the_patch_test_when_distorted(mode, technology):
     """Patch test (Taylor, Simo & Zienkiewicz): a linear displacement field u = 1e-3 r,
-    v = 2e-3 z on a distorted PLANE182 enhanced-strain quad must give the exact uniform
-    stress σ = D ε, with ε = (1e-3, 2e-3, 1e-3 (hoop u/r; 0 in plane strain), 0).  The
-    incompatible modes must not pick up energy from it: in an axisymmetric ring they are
+    v = 2e-3 z on a distorted PLANE182 quad must give the exact uniform stress σ = D ε,
+    with ε = (1e-3, 2e-3, 1e-3 (hoop u/r; 0 in plane strain), 0), whatever KEYOPT(1) picks.
+    The enhanced strains must not pick up energy from it: in an axisymmetric ring they are
     scaled by the centre's r·detJ over the point's (an element scaled by detJ alone was
-    off by 30 % here)."""
-    from apdl_like.plane_elastic import elasticity_matrix, enhanced_quads
+    off by 30 % here); B-bar replaces the dilatation by its mean, which a uniform strain
+    leaves unchanged."""
+    from apdl_like.plane_elastic import elasticity_matrix, plane182_quads
 
     xy = np.array([[[1.0, 0.0], [2.2, 0.1], [2.0, 1.3], [1.1, 0.9]]])
     E, nu = 2e5, 0.3
     u_e = np.concatenate([1e-3 * xy[0, :, 0], 2e-3 * xy[0, :, 1]])[None]
-    _, _, recover = enhanced_quads(xy, mode, np.array([E]), np.array([nu]), np.zeros((1, 4)))
+    _, _, recover = plane182_quads(xy, mode, np.array([E]), np.array([nu]), np.zeros((1, 4)),
+                                   technology)
     hoop = 1e-3 if mode == "axisymmetric" else 0.0
     exact = elasticity_matrix(np.array(E), np.array(nu), mode) @ np.array(
         [1e-3, 2e-3, hoop, 0.0])
+    if mode == "plane_stress":
+        exact[2] = 0.0
     np.testing.assert_allclose(recover(u_e)[:, 0, :], np.repeat(exact[:, None], 4, axis=1),
                                atol=1e-9 * E)
 
