@@ -399,6 +399,16 @@ class SolutionSettings:
     tunif: float = 0.0
     toffst: float = 0.0  # TOFFST: the absolute temperature of the model's zero (radiation)
 
+    def substeps(self, span: float) -> int:
+        """The substeps of a load step of `span` (s): NSUBST's NSBSTP, or span / DTIME
+        rounded to the nearest integer (at least 1), as DELTIM's notes document: "the
+        program calculates the initial incremental time so that (EndingTime −
+        StartingTime)/DTIME is an integer" (0.4 over a span of 1: 3 substeps; 0.9: one).
+        With AUTOTS this fixes the first substep, span / substeps."""
+        if self.deltim is not None:
+            return max(1, int(np.floor(span / self.deltim + 0.5)))
+        return self.nsubst or 1
+
 
 @dataclass
 class Line:

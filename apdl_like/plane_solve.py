@@ -445,24 +445,20 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
 
 
 def _substeps(settings, span: float) -> tuple[float, bool, float, float]:  # noqa: ANN001
-    """(first substep, adaptive?, DTMIN, DTMAX) from DELTIM/NSUBST and AUTOTS."""
-    adaptive = bool(settings.autots)
+    """(first substep, adaptive?, DTMIN, DTMAX) from DELTIM/NSUBST and AUTOTS: the first
+    substep is span / `SolutionSettings.substeps` with or without AUTOTS; the bounds are
+    DELTIM's DTMIN, DTMAX or span / NSBMX, span / NSBMN, and where not given
+    `DEFAULT_DTMIN_FRACTION` of the first substep and `DEFAULT_DTMAX_FRACTION` of the span
+    (MAPDL's defaults depend "on the physics of the model")."""
+    dt = span / settings.substeps(span)
     if settings.deltim is not None:
-        dt = min(settings.deltim, span)
-        dt_min = settings.dtmin if settings.dtmin is not None else dt * DEFAULT_DTMIN_FRACTION
-        dt_max = settings.dtmax if settings.dtmax is not None else \
-            max(dt, span * DEFAULT_DTMAX_FRACTION)
+        dt_min, dt_max = settings.dtmin, settings.dtmax
     else:
-        n = settings.nsubst or 1
-        dt = span / n
-        dt_max = span / settings.nsub_min if settings.nsub_min else \
-            max(dt, span * DEFAULT_DTMAX_FRACTION)
-        dt_min = span / settings.nsub_max if settings.nsub_max else \
-            dt * DEFAULT_DTMIN_FRACTION
-    if not adaptive:
-        n = max(1, int(np.ceil(span / dt - 1e-9)))
-        dt = span / n
-    return dt, adaptive, dt_min, dt_max
+        dt_min = span / settings.nsub_max if settings.nsub_max else None
+        dt_max = span / settings.nsub_min if settings.nsub_min else None
+    dt_min = dt * DEFAULT_DTMIN_FRACTION if dt_min is None else min(dt_min, dt)
+    dt_max = max(dt, span * DEFAULT_DTMAX_FRACTION if dt_max is None else dt_max)
+    return dt, bool(settings.autots), dt_min, dt_max
 
 
 def _temperature_scale(T0: np.ndarray, inputs: ThermalInputs) -> float:

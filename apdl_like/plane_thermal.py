@@ -21,9 +21,11 @@ in at most 200 iterations (PICARD_ITERATIONS), else the SOLVE stops with a locat
 Steady and every transient substep iterate alike (MAPDL's NEQIT/CNVTOL are not read).
 
 Transient load steps use twin.fem's θ-method (`twin.fem.stepper.theta_step`, `march_to`;
-TINTP sets θ, 1 backward Euler by default).  With AUTOTS the step size follows a
-step-doubling estimate of the local error (at most `STEP_TOLERANCE` × the temperature scale
-of the problem), between DTMIN and DTMAX.
+TINTP sets θ, 1 backward Euler by default).  With AUTOTS the first substep is DELTIM's
+DTIME (or the span / NSBSTP), as MAPDL takes it; each next size is predicted from a
+step-doubling estimate of the last step's local error (against `STEP_TOLERANCE` × the
+temperature scale of the problem), growing at most 3× a step, between DTMIN and DTMAX; a
+step is bisected only when its Picard iteration does not converge.
 """
 
 from __future__ import annotations
@@ -399,10 +401,8 @@ class PlaneThermal:
 
         capacity = None if inputs_new.enthalpy is None else \
             (lambda T1: self.secant_capacity(inputs_new, T, T1))
-        try:
-            return theta_step(T, dt, theta, start, end_at, solve, nonlinear, capacity)
-        except SteppingError as exc:
-            raise ApdlError(f"the nonlinear thermal step {exc}") from None
+        # a SteppingError (Picard not converging) goes to `march`, which bisects the step
+        return theta_step(T, dt, theta, start, end_at, solve, nonlinear, capacity)
 
     def element_heat(self, inputs: ThermalInputs, T: np.ndarray,
                      elements: int | np.ndarray) -> np.ndarray:
@@ -535,7 +535,8 @@ def march(model: PlaneThermal, inputs_at: Callable[[float], ThermalInputs], T0: 
           adaptive: bool, dt_min: float, dt_max: float,
           scale: float) -> tuple[list[float], list[np.ndarray]]:
     """Substeps from t0 to t1: fixed `dt` (the last one shortened to land on t1) or, with
-    `adaptive`, sizes from a step-doubling error estimate within [dt_min, dt_max]."""
+    `adaptive`, a first substep of `dt` and then sizes predicted from a step-doubling error
+    estimate within [dt_min, dt_max] (`twin.fem.stepper.march_to`)."""
     inputs_at = functools.lru_cache(maxsize=4)(inputs_at)  # a half step's end starts the next
 
     def step(T: np.ndarray, t: float, t_next: float, h: float) -> np.ndarray:
@@ -545,4 +546,4 @@ def march(model: PlaneThermal, inputs_at: Callable[[float], ThermalInputs], T0: 
     try:
         return march_to(step, T0, t0, t1, dt, control)
     except SteppingError as exc:
-        raise ApdlError(str(exc)) from None
+        raise ApdlError(f"the transient thermal load step: {exc}") from None

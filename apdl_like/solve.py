@@ -272,10 +272,7 @@ def solve_thermal(session: SessionState) -> StepResult:
         steps_T, steps_t = [T], [end]
     else:
         span = sol.span_to(s.time)
-        if s.deltim is not None:
-            n = max(1, int(np.ceil(span / s.deltim - 1e-9)))
-        else:
-            n = s.nsubst or 1
+        n = s.substeps(span)
         dt = span / n
         T = sol.temperature
         stepper = None

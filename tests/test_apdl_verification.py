@@ -183,6 +183,42 @@ def test_transient_uniform_heating_ramped():
     assert s.params["T_A"] == pytest.approx(expected, rel=1e-10)
 
 
+@pytest.mark.parametrize("autots, deltim, first, count", [
+    ("OFF", 0.4, 1 / 3, 3),  # DELTIM's own example: 1/0.4 = 2.5 rounds to 3 substeps
+    ("OFF", 0.9, 1.0, 1),  # 1/0.9 rounds to one substep
+    ("ON", 0.4, 1 / 3, None),  # with AUTOTS: the starting substep, the same rounding
+])
+def test_deltim_substeps_divide_the_load_step_as_documented(autots, deltim, first, count):
+    """DELTIM: "the program calculates the initial incremental time so that (EndingTime −
+    StartingTime)/DTIME is an integer", rounding to the nearest; with AUTOTS, DTIME is the
+    starting time substep.  Uniform heating of an insulated body is exact for any step."""
+    s = run(f"""
+/PREP7
+ET,1,PLANE55
+MP,KXX,1,45
+MP,DENS,1,7800
+MP,C,1,460
+RECTNG,0,0.02,0,0.02
+ESIZE,0.01
+AMESH,ALL
+/SOLU
+ANTYPE,TRANS
+TUNIF,20
+BFE,ALL,HGEN,,5E6
+KBC,1
+AUTOTS,{autots}
+TIME,1
+DELTIM,{deltim}
+SOLVE
+*GET,T_A,NODE,1,TEMP
+""")
+    times = s.state.solution.substep_times
+    assert times[0] == pytest.approx(first, rel=1e-12) and times[-1] == 1.0
+    if count is not None:
+        assert len(times) == count
+    assert s.params["T_A"] == pytest.approx(20.0 + 5e6 / (7800 * 460), rel=1e-10)
+
+
 def test_transient_conduction_series_solution():
     """Slab 0..L (a cylinder insulated on r), T(0, t) = T1 for t > 0, insulated at z = L:
     T(L, t) = T1 + (T0 − T1) Σ 4(−1)^n/((2n+1)π) exp(−((2n+1)π/2L)² α t)."""

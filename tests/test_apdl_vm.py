@@ -27,6 +27,8 @@ TOLERANCE = 0.02
 ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4, "vm99": 5, "vm227": 3,
         # thermal links and masses (LINK31/33/34, MASS71) and PLANE77 without mid-side nodes
         "vm92": 3, "vm93": 1, "vm94": 2, "vm106": 1, "vm107": 1, "vm109": 3, "vm112": 1,
+        # a slab under a stepped gas temperature, Crank-Nicolson with AUTOTS from NSUBST,80
+        "vm110": 7,
         "vm114": 6, "vm115": 6, "vm116": 1,
         # an arc line (L in CSYS 1), BFA, ETABLE/SSUM of SURF151 heat rates
         "vm58": 3}
@@ -67,13 +69,25 @@ def test_vm111_sphere_center_matches_the_exact_series_solution(tmp_path):
     assert computed == pytest.approx(exact, rel=0.005)
 
 
-def _slab_series(biot: float, fourier: float, x: np.ndarray, terms: int = 60) -> np.ndarray:
-    """θ/θ_i of a slab, insulated at x = 0 and cooled through Bi at x = 1 (x = position /
-    thickness): Σ Cn exp(−λn² Fo) cos(λn x), λn tan λn = Bi, Cn = 4 sin λn/(2λn + sin 2λn)."""
+def _slab_modes(biot: float, terms: int = 60) -> tuple[np.ndarray, np.ndarray]:
+    """(λn, Cn) of a slab insulated at x = 0 and cooled through Bi at x = 1 (x = position /
+    thickness): λn tan λn = Bi, Cn = 4 sin λn/(2λn + sin 2λn)."""
     lam = np.array([brentq(lambda v: v * np.tan(v) - biot, k * np.pi + 1e-12,
                            k * np.pi + np.pi / 2 - 1e-12) for k in range(terms)])
-    c = 4 * np.sin(lam) / (2 * lam + np.sin(2 * lam))
+    return lam, 4 * np.sin(lam) / (2 * lam + np.sin(2 * lam))
+
+
+def _slab_series(biot: float, fourier: float, x: np.ndarray, terms: int = 60) -> np.ndarray:
+    """θ/θ_i of that slab: Σ Cn exp(−λn² Fo) cos(λn x)."""
+    lam, c = _slab_modes(biot, terms)
     return (c * np.exp(-lam**2 * fourier) * np.cos(np.outer(x, lam))).sum(axis=1)
+
+
+def _slab_heat_taken(biot: float, fourier: float, terms: int = 60) -> float:
+    """Q/Q0 of that slab, the heat it has taken over its capacity × initial difference:
+    1 − Σ Cn sin λn/λn exp(−λn² Fo)."""
+    lam, c = _slab_modes(biot, terms)
+    return float(1.0 - (c * np.sin(lam) / lam * np.exp(-lam**2 * fourier)).sum())
 
 
 def test_vm113_orthotropic_bar_matches_the_exact_product_solution(tmp_path):
@@ -99,6 +113,31 @@ def test_vm113_orthotropic_bar_matches_the_exact_product_solution(tmp_path):
         if name == "TN13":
             assert exact == pytest.approx(285.17, abs=0.01)
             assert params[name] == pytest.approx(exact, rel=0.005)
+
+
+def test_vm110_slab_matches_the_exact_series_solution(tmp_path):
+    """VM110's targets are chart readings (Kreith's Gröber charts).  The exact series of the
+    slab (L = 1 ft insulated at x = 0, gas at 1600 °F through h = 5 at x = L, from 100 °F)
+    gives the temperatures at t = 14.5 h and the heat the wall has taken,
+    Q(t) = ρcL(T∞ − Ti)·(Q/Q0).  The deck integrates the film's heat rate over its stored
+    substeps (POST26 INT1), which start at the first substep: AUTOTS takes NSUBST's
+    14.5/80 h as that first substep, as MAPDL documents, so the integral is
+    Q(14.5) − Q(14.5/80)."""
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(DECKS / "vm110.dat"),
+                           "--out", str(out)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    rows = results_table(out / "vm110.vrt")
+    k, rho_c, h, t_in, t_gas, t_end = 0.54, 144 * 0.20, 5.0, 100.0, 1600.0, 14.5
+    biot, alpha = h * 1.0 / k, k / rho_c
+    x_ft = np.array([0.0, 0.2, 0.4, 0.6, 0.8, 1.0])  # nodes 1, 3, .., 11
+    exact = t_gas + (t_in - t_gas) * _slab_series(biot, alpha * t_end, x_ft)
+    for (label, _, computed), expected in zip(rows[:6], exact, strict=True):
+        assert computed == pytest.approx(expected, rel=0.005), label
+    heat = rho_c * (t_gas - t_in) * (_slab_heat_taken(biot, alpha * t_end)
+                                     - _slab_heat_taken(biot, alpha * t_end / 80))
+    (label, _, computed) = rows[6]
+    assert -computed == pytest.approx(heat, rel=0.01), label
 
 
 def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_percent(

@@ -77,6 +77,48 @@ def test_march_to_adaptive_meets_its_tolerance():
     assert max(np.diff([0.0, *times])) > 1.0  # the step grew where the error allowed
 
 
+def test_march_to_adaptive_takes_the_first_substep_given_and_grows_at_most_threefold():
+    """MAPDL's AUTOTS: DELTIM's DTIME is the starting substep, taken even when its error
+    estimate exceeds the tolerance (a linear step converges, so nothing bisects it); the
+    next size is predicted smaller from that error, and later ones grow at most
+    OPNCONTROL's thermal OPENUPFACTOR (3) a step.  The end value still meets the
+    exponential to the tolerance per step plus the first step's own error."""
+
+    def step(T, t, t_next, h):
+        return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
+
+    control = StepControl(dt_min=1e-3, dt_max=100.0, tolerance=1e-3)
+    times, temps = stepper.march_to(step, np.array([80.0]), 0.0, 400.0, 40.0, control)
+    sizes = np.diff([0.0, *times])
+    assert sizes[0] == 40.0 and sizes[1] < 0.5 * sizes[0]
+    assert np.all(sizes[1:-1] <= stepper.OPEN_UP_FACTOR * sizes[:-2] * (1 + 1e-12))
+    assert sizes[-2] > 2.0 * sizes[1]  # grew again as the error allowed
+    # one backward-Euler step of 40 s (two of 20 s kept) from 80 °C: its error, decayed
+    first = T_INF_C + 60.0 / (1 + 20.0 / 200.0) ** 2
+    first_error = (first - (T_INF_C + 60.0 * math.exp(-40.0 / 200.0))) * math.exp(-360 / 200)
+    exact = T_INF_C + 60.0 * math.exp(-2.0)
+    assert temps[-1][0] - exact > first_error  # the first step was not redone smaller
+    assert temps[-1][0] - exact - first_error < 1e-3 * len(times)
+
+
+def test_march_to_bisects_a_step_that_fails_and_gives_up_at_dt_min():
+    """Bisection answers a step that does not converge: the step is redone at half the
+    size until it passes, and the error goes out once the size is DTMIN."""
+
+    def step(T, t, t_next, h):
+        if h > 0.3:
+            raise SteppingError("did not converge")
+        return T + h
+
+    control = StepControl(dt_min=0.1, dt_max=1.0, tolerance=1.0)
+    times, temps = stepper.march_to(step, np.array([0.0]), 0.0, 1.0, 1.0, control)
+    assert times[0] == pytest.approx(0.25) and times[-1] == 1.0
+    assert temps[-1][0] == pytest.approx(1.0)
+    with pytest.raises(SteppingError, match="converge"):
+        stepper.march_to(step, np.array([0.0]), 0.0, 1.0, 1.0,
+                         StepControl(dt_min=0.5, dt_max=1.0, tolerance=1.0))
+
+
 def test_march_to_refuses_too_many_substeps():
     n = stepper.MAX_SUBSTEPS
     with pytest.raises(SteppingError, match=f"more than {n} substeps"):

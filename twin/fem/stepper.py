@@ -151,14 +151,23 @@ def theta_step(
     return picard(update, T, iterate)
 
 
+OPEN_UP_FACTOR = 3.0
+"""The most a substep may grow over the previous one under `StepControl`: MAPDL's
+OPNCONTROL,OPENUPFACTOR default for thermal analyses."""
+
+
 @dataclass(frozen=True)
 class StepControl:
-    """Adaptive step size: a step is accepted when one step of h and two of h/2 differ by
-    at most `tolerance` (°C); h stays within [dt_min, dt_max] (s)."""
+    """Automatic time stepping as MAPDL's AUTOTS documents it: time step *prediction*
+    (each next size from the last step) and *bisection* (a failed step redone with half
+    the size).  The prediction here is the step-doubling estimate of the last step's local
+    error against `tolerance` (°C); a step fails when its iteration does not converge.
+    Sizes stay within [dt_min, dt_max] (s) and grow at most `growth` times a step."""
 
     dt_min: float
     dt_max: float
     tolerance: float
+    growth: float = OPEN_UP_FACTOR
 
 
 def march_to(
@@ -170,10 +179,12 @@ def march_to(
     control: StepControl | None = None,
 ) -> tuple[list[float], list[np.ndarray]]:
     """Steps from time t0 to t1 (s): `step(T, t, t_next, h)` advances T by h = t_next − t.
-    Without `control` every step is `dt` (the last one shortened to land on t1); with it the
-    first step tries `dt` and the next sizes follow the step-doubling error estimate (the
-    two half steps are kept).  Returns the end time and temperature of every step; the last
-    time is t1 exactly."""
+    Without `control` every step is `dt` (the last one shortened to land on t1).  With it
+    the first substep is `dt` (DELTIM's DTIME is "the starting time substep"); each step is
+    taken as one step of h and two of h/2 (the two halves are kept), and their difference,
+    the local error estimate, predicts the next h.  A step is redone with h/2 only when
+    `step` raises `SteppingError` (not converging), down to dt_min.  Returns the end time
+    and temperature of every step; the last time is t1 exactly."""
     times: list[float] = []
     temps: list[np.ndarray] = []
     t, T = t0, T0
@@ -188,20 +199,23 @@ def march_to(
             times.append(t)
             temps.append(T)
             continue
-        full = step(T, t, t + h, h)
-        half = step(T, t, t + 0.5 * h, 0.5 * h)
-        half = step(half, t + 0.5 * h, t + h, 0.5 * h)
-        error = float(np.max(np.abs(full - half)))
-        tol = control.tolerance
-        if error > tol and h > control.dt_min * (1 + 1e-9):
-            h = max(control.dt_min, h * max(0.2, 0.9 * np.sqrt(tol / error)))
+        try:
+            full = step(T, t, t + h, h)
+            half = step(T, t, t + 0.5 * h, 0.5 * h)
+            half = step(half, t + 0.5 * h, t + h, 0.5 * h)
+        except SteppingError:
+            if h <= control.dt_min * (1 + 1e-9):
+                raise
+            h = max(control.dt_min, 0.5 * h)  # bisection
             continue
+        error = float(np.max(np.abs(full - half)))
         t += h
         T = half  # the more accurate of the two
         times.append(t)
         temps.append(T)
-        grow = 2.0 if error == 0.0 else min(2.0, 0.9 * np.sqrt(tol / error))
-        h = min(control.dt_max, max(control.dt_min, h * max(grow, 0.5)))
+        # local error ∝ h² (θ = 1) or h³ (θ = ½): the square root is the cautious guess
+        factor = control.growth if error == 0.0 else 0.9 * np.sqrt(control.tolerance / error)
+        h = min(control.dt_max, max(control.dt_min, h * min(control.growth, factor)))
     if times:
         times[-1] = t1
     return times, temps
