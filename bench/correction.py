@@ -1,5 +1,10 @@
 """Cost of the correction: training the four networks and one bpnn/ratio window.
 
+`bpnn_replay_cpu_ms_per_window`: CPU time per window of a whole bpnn replay through the
+window decks (loop, correction, deck solve) on the bundled speed-step run with its first
+30 s cut off, so its two steps (600 s and 1200 s in the file) fall inside windows 9 and
+19: with the re-run of those windows (`twin.correction.rerun`, the default) and without.
+
 Targets (issue 6): training ≤ 60 s for the paper's data volume (20 runs of 30 min, samples
 every 60 s plus every 20 s over the first 10 min: 1000 samples), inference ≤ 1 ms per
 window.  The samples come from the lumped test plant (twin/correction/toy_plant.py), so
@@ -41,6 +46,44 @@ def _samples(n_runs: int = 20):
                                anchored_inputs=samples.inputs)
 
 
+def replay_cpu_ms_per_window(repeats: int = 3) -> dict:
+    """CPU ms per window of a bpnn replay (deck solver) with and without the re-run, and
+    how many windows were re-run (module doc)."""
+    from pathlib import Path
+
+    from twin.correction.methods import BpnnCorrection
+    from twin.correction.modelfile import load_model
+    from twin.loop.replay import deck_window_solver, replay_method
+    from twin.runs.run import read_table, run_from_table
+    from twin.spindle.model import SpindleModel
+
+    root = Path(__file__).resolve().parent.parent
+    table = read_table(root / "examples" / "runs" / "spindle_steps_faults_30min.csv")
+    keep = table.columns["time_s"] >= 30.0
+    table = dataclasses.replace(
+        table, rows=table.rows[keep],
+        columns={k: (v[keep] - 30.0 if k == "time_s" else v[keep])
+                 for k, v in table.columns.items()})
+    run = run_from_table(table)
+    spindle = SpindleModel.load()
+    network = load_model(root / "examples" / "correction_model.safetensors")
+    out = {}
+    for rerun in (True, False):
+        solver = deck_window_solver(spindle)
+        best = float("inf")
+        for _ in range(repeats):
+            start = time.process_time()
+            r = replay_method(run, spindle, BpnnCorrection(network, rerun_missed_speed=rerun),
+                              solver=solver, keep_fields=False)
+            best = min(best, time.process_time() - start)
+        key = "with_rerun" if rerun else "without_rerun"
+        out[key] = 1e3 * best / len(r.windows)
+        if rerun:
+            out["rerun_windows"] = sum(w.rerun_deck is not None for w in r.windows)
+            out["windows"] = len(r.windows)
+    return out
+
+
 def run() -> dict:
     from twin.correction import BoundaryValues, WindowFeatures, make_corrector
     from twin.correction.network import DEFAULT, PAPER
@@ -75,6 +118,7 @@ def run() -> dict:
         "bpnn_window_ms": timings["bpnn"],
         "ratio_window_ms": timings["ratio"],
         "inference_target_ms": 1.0,
+        "bpnn_replay_cpu_ms_per_window": replay_cpu_ms_per_window(),
     }
 
 

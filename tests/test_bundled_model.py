@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "ac29236a586fc72d308de488b7a59762bb22c68a9a538f4de68d854b6ff43b2d"
+BUNDLED_MODEL_SHA256 = "4a783cc564ee5de7c07e3cb6e104815320b34c0f62492cf92c7d252af06ec776"
 
 
 def _make_model():

@@ -1,10 +1,30 @@
-"""Re-running a window with a missed speed change (twin.correction.rerun)."""
+"""Re-running a window with a missed speed change (twin.correction.rerun) in the loop: the
+`bpnn` starts the next window from the re-run's field, reads its inputs off the re-run, and
+the decks (window decks and the re-run deck) reproduce both the reported trajectory and
+the carried state."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from twin.contract import STEPS_PER_WINDOW
+from twin.correction.methods import BpnnCorrection, RatioCorrection
+from twin.correction.modelfile import load_model
 from twin.correction.rerun import rerun_window, speed_stretches
+from twin.loop.replay import (
+    deck_window_solver,
+    direct_window_solver,
+    method_replay_from_json,
+    method_replay_to_json,
+    replay_method,
+)
+from twin.runs import read_run
+
+from .test_estimation import write_speed_step_run
+
+BUNDLED_MODEL = Path(__file__).resolve().parent.parent / "examples" / "correction_model.safetensors"
 
 
 def test_stretches_of_equal_speed_are_solved_one_after_another():
@@ -20,3 +40,68 @@ def test_stretches_of_equal_speed_are_solved_one_after_another():
     assert calls == [(6000.0, 4, 60.0), (12000.0, 6, 76.0), (3000.0, 5, 100.0)]
     assert fields.shape == (15, 2)
     np.testing.assert_allclose(fields[:, 0], np.cumsum(1e-3 * speeds))
+
+
+def test_bpnn_starts_the_next_window_from_the_rerun(tmp_path, spindle_model, monkeypatch):
+    """Speed 6000 → 12000 rpm at 76 s → 3000 rpm at 100 s, inside window 1 (loads fixed at
+    60 s), on the nominal model itself.  With the re-run window 2 starts from the right
+    field; without it the twin carries the missed heat into the following windows."""
+    model = spindle_model
+    run = read_run(write_speed_step_run(tmp_path / "step.csv", model))
+    network = load_model(BUNDLED_MODEL)
+
+    def error_after_the_change(rerun: bool) -> float:
+        replay = replay_method(run, model, BpnnCorrection(network, rerun_missed_speed=rerun),
+                               solver=direct_window_solver(model), keep_fields=False)
+        rows = (replay.time_s > 120.0) & (replay.time_s <= 240.0)
+        return np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[rows].max()
+
+    with_rerun, without = error_after_the_change(True), error_after_the_change(False)
+    assert with_rerun < 0.3 * without
+    assert without > 0.5
+
+
+def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
+        tmp_path, spindle_model):
+    """Window 0's deck from the uniform start, window 1's deck from its end (the reported
+    window 1), the re-run deck of window 1 from the same field, and window 2's deck from
+    the re-run's end: the reported window 2, step by step.  Run in a fresh session, from
+    the deck texts alone."""
+    from apdl_like.session import Session
+
+    model = spindle_model
+    run = read_run(write_speed_step_run(tmp_path / "step.csv", model))
+    replay = replay_method(run, model, BpnnCorrection(load_model(BUNDLED_MODEL)),
+                           solver=deck_window_solver(model), keep_fields=False)
+    w = replay.windows
+    assert w[1].rerun_deck is not None  # the speed changed inside window 1
+    assert all(x.rerun_deck is None for x in w if x.window != 1)
+    assert w[1].rerun_deck.count("SOLVE") == 3  # 6000, 12000 and 3000 rpm stretches
+    # a replay done in another process brings its re-run decks back
+    assert method_replay_from_json(method_replay_to_json(replay)).windows[1].rerun_deck == \
+        w[1].rerun_deck
+    # the paper's ratio law keeps the forecast
+    ratio = replay_method(run, model, RatioCorrection(), solver=direct_window_solver(model),
+                          keep_fields=False)
+    assert all(x.rerun_deck is None for x in ratio.windows)
+
+    session = Session.from_mesh(model.mesh, model.materials, order=model.order,
+                                T_ref_C=model.elastic.T_ref)
+
+    def sensors(fields):
+        return (model.sensor_matrix @ np.asarray(fields).T).T
+
+    def reported(k):
+        return replay.T_twin_C[k * STEPS_PER_WINDOW:(k + 1) * STEPS_PER_WINDOW]
+
+    T = np.full(model.n_dofs, replay.T_initial_C)
+    window0 = session.advance(T, 0.0, w[0].deck)
+    np.testing.assert_allclose(sensors(window0), reported(0), atol=1e-9)
+    window1 = session.advance(window0[-1], 60.0, w[1].deck)
+    np.testing.assert_allclose(sensors(window1), reported(1), atol=1e-9)
+    rerun_end = session.advance(window0[-1], 60.0, w[1].rerun_deck)[-1]
+    # the re-run ends elsewhere than the forecast (it saw the step) ...
+    assert np.abs(sensors([rerun_end]) - sensors([window1[-1]])).max() > 0.5
+    # ... and window 2 starts from it
+    window2 = session.advance(rerun_end, 120.0, w[2].deck)
+    np.testing.assert_allclose(sensors(window2), reported(2), atol=1e-9)

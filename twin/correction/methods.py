@@ -169,7 +169,9 @@ class BpnnCorrection:
     Inference is plain numpy on the loaded weights (no torch needed at replay time).  An
     anchored model (the default) corrects the ratio-law value, `ratio_anchor`, by the
     factor exp(output); where its inputs are not finite (window 0, a dead sensor) the
-    value is the anchor.  A paper-configuration model predicts the value itself; non-finite
+    value is the anchor.  The twin's state and simulated key points it reads come from
+    the re-run of a window with a missed speed change (`rerun_missed_speed`).  A
+    paper-configuration model predicts the value itself; non-finite
     inputs fall back to the previous window's correction factor on the current nominal
     value.  The output is kept within the guards' band around the nominal value.  A
     stopped bearing has no heat: its heat network is not asked.
@@ -182,6 +184,10 @@ class BpnnCorrection:
     name: str = "bpnn"
     anchor_factors: np.ndarray = field(default_factory=lambda: np.ones(4), repr=False)
     """The last anchor as factors on its nominal values (held through a stop)."""
+    rerun_missed_speed: bool = True
+    """Ask the loop to re-run a window whose recorded speed changed after its loads were
+    fixed, and to start the next window (and read its inputs) from that re-run
+    (`twin.loop.replay`, `twin.correction.rerun`)."""
 
     def correct(self, features: WindowFeatures) -> Correction:
         nominal = np.asarray(features.nominal, dtype=float)

@@ -9,7 +9,8 @@ read its errors off the re-run instead of the forecast that missed the input.
 
 One implementation serves every method that does it: the `estimator`
 (`twin.estimation.method`, with its analysed factors) and the loop's state correction for
-`bpnn` and the training fit (`twin.loop.replay`, through the window decks).  Each passes
+`bpnn` (`twin.loop.replay`, through the window decks; the training fit may ask for it too,
+`twin.loop.windowfit.WindowFit.rerun_missed_speed`).  Each passes
 its own `advance(speed_rpm, T, n_steps, start_s)`, the solver of one constant-speed
 stretch; this module finds the change, the speed of every solver step and the stretches.
 

@@ -14,6 +14,22 @@ The temperature state carries over from window to window.  A stop (speed 0) is a
 ordinary window: no bearing or motor heat, the twin cools; each value's correction factor
 is held through the stop and resumes at the restart (`WindowFeatures.previous_factors`).
 
+Re-run of a missed speed change (methods with `rerun_missed_speed`: `bpnn`; the paper's
+`ratio` and `open_loop` keep the forecast, the `estimator` re-runs inside its own
+analysis).  When the recorded speed changed inside window k−1, after its loads were
+fixed, that window is re-run from its start field with the recorded speed
+(`twin.correction.rerun`: one stretch per speed, the window's own loads at its own speed,
+the nominal loads of the other speeds, at the window start's temperatures, times the
+window's correction factors) before window k's correction; all of it was measured before
+60k s.  Window k then starts from the re-run's end field, and the method reads its
+simulated key points over window k−1 from the re-run (`WindowFeatures.simulated_C`), not
+from the forecast that missed the input.  The reported trajectory of window k−1 stays its
+forecast (what was known when it started).  Every stretch is solved through a deck like any
+window; together they are `WindowRecord.rerun_deck` (`decks/window_kkk_rerun.inp`): run in
+the session from window k−1's start field (the state its own deck started from) they give
+the field window k's deck starts from, so the decks reproduce both the reported trajectory
+and the carried state.
+
 The run starts from a uniform field at the mean of the first measured T1..T5 (a spindle
 at rest has equalised), which is also the zero of the drift: the recorded drift is taken
 as measured from the start.
@@ -21,6 +37,7 @@ as measured from the start.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -35,6 +52,7 @@ from twin.correction.features import (
     WindowFeatures,
     correction_factors,
 )
+from twin.correction.rerun import recorded_step_speeds, rerun_window, speed_change_s
 from twin.correction.result import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
@@ -60,6 +78,10 @@ class WindowRecord:
     correction: Correction
     nominal: BoundaryValues
     deck: str | None = None
+    rerun_deck: str | None = None
+    """The window re-run with its recorded speed (module doc), if the speed changed inside
+    it and the method re-runs: run from the window's start field, it ends on the field the
+    next window starts from."""
 
 
 @dataclass
@@ -80,15 +102,17 @@ class MethodReplay:
     with uncertainty (the estimator); None otherwise."""
 
 
-WindowSolver = Callable[[BoundaryConditions, Correction, np.ndarray, float, int], tuple]
-"""(conditions, correction, T_start, start_s, window) → (T per step (15, n), deck text)."""
+WindowSolver = Callable[..., tuple]
+"""(conditions, correction, T_start, start_s, window, n_steps=15) → (T per step (n_steps,
+n), deck text or None)."""
 
 
 def direct_window_solver(model: SpindleModel) -> WindowSolver:
     """Solve a window straight on twin.fem (no deck); the reference for the deck path."""
 
     def solve(
-        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int
+        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int,
+        n_steps: int = STEPS_PER_WINDOW,
     ) -> tuple[np.ndarray, str | None]:
         loads = bc.to_thermal_loads(
             H_front=corr.H_front_W_m3,
@@ -97,7 +121,7 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
             R_rear=corr.R_rear_m2K_W,
         )
         stepper = model.thermal.transient(loads, STEP_S)
-        return np.array(list(stepper.march(T, STEPS_PER_WINDOW))), None
+        return np.array(list(stepper.march(T, n_steps))), None
 
     return solve
 
@@ -123,7 +147,8 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
         )
 
     def solve(
-        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int
+        bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int,
+        n_steps: int = STEPS_PER_WINDOW,
     ) -> tuple[np.ndarray, str]:
         loads = bc.to_thermal_loads(
             H_front=corr.H_front_W_m3,
@@ -135,7 +160,7 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
             window=window,
             start_s=start_s,
             dt_s=STEP_S,
-            n_steps=STEPS_PER_WINDOW,
+            n_steps=n_steps,
             heat_generation=loads.sources,
             convection=loads.convection,
             contact_resistance=loads.contact_resistance,
@@ -208,14 +233,13 @@ def replay_method(
     band: np.ndarray | None = None
     factors = np.ones(4)  # each value's last correction factor; a stop holds it
 
-    for k in range(windows):
-        start = float(starts[k])
-        speed = float(state.speed_rpm[k])
-        ambient = float(state.ambient_C[k])
-        coolant = None if state.coolant_C is None else float(state.coolant_C[k])
+    reruns = bool(getattr(corrector, "rerun_missed_speed", False))
+    last: _WindowRun | None = None  # what window k−1 ran with, for its re-run
+
+    def conditions(speed: float, ambient: float, coolant: float | None,
+                   T_now: np.ndarray) -> BoundaryConditions:
         # the nominal model is open loop: it sees its own bearing temperatures only
-        T_now = sim_T[k * STEPS_PER_WINDOW]
-        bc = nominal_conditions(
+        return nominal_conditions(
             model,
             speed,
             ambient,
@@ -224,6 +248,13 @@ def replay_method(
             T_sleeves_C=(float(T_now[1]), float(T_now[3])),
             film_ambient_C=FILM_AMBIENT_STEP_K * round(ambient / FILM_AMBIENT_STEP_K),
         )
+
+    for k in range(windows):
+        start = float(starts[k])
+        speed = float(state.speed_rpm[k])
+        ambient = float(state.ambient_C[k])
+        coolant = None if state.coolant_C is None else float(state.coolant_C[k])
+        bc = conditions(speed, ambient, coolant, sim_T[k * STEPS_PER_WINDOW])
         nominal = BoundaryValues(bc.H_front, bc.H_rear, bc.R_front, bc.R_rear)
         upto = run.time_s <= start
         n_sim = k * STEPS_PER_WINDOW + 1
@@ -244,6 +275,19 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
         )
+        if reruns and last is not None and speed_change_s(features, last.bc.speed_rpm) is not None:
+            rerun, records[-1].rerun_deck = _rerun(model, solver, last, features, factors,
+                                                   conditions)
+            # the twin's state is the re-run's: it starts the window, its key points over
+            # the window just ended are what the method compares with the measurement
+            T = rerun[-1]
+            seen = sim_T[:n_sim].copy()
+            seen[-STEPS_PER_WINDOW:] = (model.sensor_matrix @ rerun.T).T
+            bc = conditions(speed, ambient, coolant, seen[-1])
+            nominal = BoundaryValues(bc.H_front, bc.H_rear, bc.R_front, bc.R_rear)
+            features = dataclasses.replace(
+                features, simulated_C=seen, nominal=nominal, previous=previous or nominal,
+                twin_state=TwinState(T, bc))
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
             T = np.asarray(corr.state_C, dtype=float)
@@ -256,6 +300,7 @@ def replay_method(
             if band is None:
                 band = np.full((n_steps, 6), np.nan)
             band[k * STEPS_PER_WINDOW : (k + 1) * STEPS_PER_WINDOW] = corr.band_sd
+        last = _WindowRun(T, start, k, bc, corr, thermal_factors)
         steps, deck = solver(bc, corr, T, start, k)
         T = steps[-1]
         sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
@@ -285,6 +330,50 @@ def replay_method(
     )
 
 
+@dataclass(frozen=True)
+class _WindowRun:
+    """What one window ran with: its start field and time, conditions (model-form factors
+    applied), correction and model-form factors."""
+
+    T_start: np.ndarray
+    start_s: float
+    window: int
+    bc: BoundaryConditions
+    correction: Correction
+    thermal_factors: dict
+
+
+def _rerun(model: SpindleModel, solver: WindowSolver, last: _WindowRun,
+           features: WindowFeatures, factors: np.ndarray,
+           conditions: Callable[..., BoundaryConditions]) -> tuple[np.ndarray, str | None]:
+    """Window k−1 (`last`) re-run with the speed recorded in it (module doc): the fields
+    after each step (15, n) and the decks of its stretches as one text (None without decks).
+    `features` are window k's (the recorded speed up to its start), `factors` each value's
+    correction factor of window k−1 (held through a stop); a stretch at another speed gets
+    the nominal conditions there, at the window start's temperatures, times those factors."""
+    bc0 = last.bc
+    T_start_C = model.sensor_matrix @ last.T_start
+    decks: list[str] = []
+
+    def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
+        bc, corr = bc0, last.correction
+        if abs(speed - bc0.speed_rpm) > 0.5:
+            bc = conditions(speed, bc0.ambient_C, bc0.coolant_C, T_start_C)
+            if last.thermal_factors:
+                bc = bc.scaled(last.thermal_factors)
+            corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front,
+                                                    bc.R_rear])))
+        steps, deck = solver(bc, corr, T, start_s, last.window, n_steps=n)
+        if deck is not None:
+            decks.append(deck)
+        return steps
+
+    fields = rerun_window(last.T_start, last.start_s,
+                          recorded_step_speeds(features, STEPS_PER_WINDOW, STEP_S), STEP_S,
+                          advance)
+    return fields, ("".join(decks) if decks else None)
+
+
 def _array(a: np.ndarray | None) -> dict | None:
     """An array as JSON: float64 values as their exact repr (JSON's floats round-trip)."""
     if a is None:
@@ -305,6 +394,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
         return {
             "window": w.window, "start_s": w.start_s, "speed_rpm": w.speed_rpm,
             "ambient_C": w.ambient_C, "nominal": list(w.nominal), "deck": w.deck,
+            "rerun_deck": w.rerun_deck,
             "correction": {
                 "values": list(c.values), "C_H": list(c.C_H), "C_C": list(c.C_C),
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
@@ -331,7 +421,8 @@ def method_replay_from_json(text: str) -> MethodReplay:
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
             state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]))
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
-                            correction, BoundaryValues(*w["nominal"]), w["deck"])
+                            correction, BoundaryValues(*w["nominal"]), w["deck"],
+                            w["rerun_deck"])
 
     return MethodReplay(
         method=d["method"], time_s=_from_array(d["time_s"]), T_twin_C=_from_array(d["T_twin_C"]),

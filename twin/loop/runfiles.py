@@ -185,6 +185,8 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
         for w in r.windows:
             if w.deck is not None:
                 write_text(deck_dir / f"window_{w.window:03d}.inp", w.deck)
+            if w.rerun_deck is not None:
+                write_text(deck_dir / f"window_{w.window:03d}_rerun.inp", w.rerun_deck)
     return accuracy, token
 
 
