@@ -219,6 +219,57 @@ SOLVE
     assert s.params["T_A"] == pytest.approx(20.0 + 5e6 / (7800 * 460), rel=1e-10)
 
 
+def _sphere_center_cooling(n_radial: int) -> float:
+    """VM111's sphere (R = 1/6 ft, k = 1/3, ρc = 66.67, h = 2 to 25 °F from 65 °F, 6 h) as a
+    2° PLANE55 wedge of n_radial elements (VM111 itself: 15° and 3), AUTOTS from DTIME =
+    0.01 h; the centre temperature, °F."""
+    s = run(f"""
+/PREP7
+ANTYPE,TRANS
+ET,1,PLANE55,,,1
+MP,KXX,1,(1/3)
+MP,DENS,1,62
+MP,C,1,1.0752677
+CSYS,1
+N,1
+N,2,(1/6/{n_radial}),-1
+N,{n_radial + 1},(1/6),-1
+FILL
+NGEN,2,100,1,{n_radial + 1},1,,2
+E,2,102,1,1
+E,3,103,102,2
+EGEN,{n_radial - 1},1,2
+CP,1,TEMP,2,102
+CPSGEN,{n_radial},1,1
+AUTOTS,ON
+DELTIM,.01
+TIME,6
+TUNIF,65
+KBC,1
+NSEL,S,LOC,X,(1/6)
+SF,ALL,CONV,2,25
+NSEL,ALL
+/SOLU
+SOLVE
+*GET,T_C,NODE,1,TEMP
+""")
+    return s.params["T_C"]
+
+
+def test_transient_sphere_cooling_converges_to_the_series_solution():
+    """A sphere cooled by a film, Bi = hR/k = 1: λn = (2n − 1)π/2 and the centre follows
+    T∞ + (Ti − T∞) Σ 2 sin λn/λn exp(−λn² Fo), 28.545 °F at Fo = αt/R² = 1.08.  With AUTOTS
+    the deck's value approaches it as the radial mesh is refined (the wedge's straight outer
+    face and backward Euler's lag keep it slightly above)."""
+    fourier = (1 / 3) / (62 * 1.0752677) * 6.0 / (1 / 6) ** 2
+    lam = (2 * np.arange(1, 40) - 1) * math.pi / 2
+    exact = 25.0 + 40.0 * float(np.sum(2 * np.sin(lam) / lam * np.exp(-lam**2 * fourier)))
+    assert exact == pytest.approx(28.545, abs=1e-3)
+    coarse, fine = _sphere_center_cooling(12), _sphere_center_cooling(24)
+    assert exact < fine < coarse
+    assert fine == pytest.approx(exact, rel=0.0015)
+
+
 def test_transient_conduction_series_solution():
     """Slab 0..L (a cylinder insulated on r), T(0, t) = T1 for t > 0, insulated at z = L:
     T(L, t) = T1 + (T0 − T1) Σ 4(−1)^n/((2n+1)π) exp(−((2n+1)π/2L)² α t)."""
