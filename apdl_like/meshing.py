@@ -214,19 +214,44 @@ def side_fractions(n: int, space: float) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(lengths) / lengths.sum()])
 
 
-def _side(s: SessionState, a: int, b: int, size: float) -> np.ndarray:
-    """Fractions along the area side from keypoint a to b: its line's LESIZE (divisions,
-    spacing in the line's own direction) or ESIZE."""
-    db = s.db
-    for line in db.lines.values():
+def _line_of(s: SessionState, a: int, b: int) -> Line | None:
+    """The line joining keypoints a and b, if there is one."""
+    for line in s.db.lines.values():
         if {line.k1, line.k2} == {a, b}:
-            length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
-            n = line.ndiv or (db.esize_divisions or _divisions(length, size))
-            f = side_fractions(n, line.space)
-            return f if line.k1 == a else 1.0 - f[::-1]
+            return line
+    return None
+
+
+def _side_divisions(s: SessionState, a: int, b: int, size: float) -> tuple[int, bool]:
+    """(divisions, hard?) of the area side a -> b: a line's own NDIV (LESIZE, L) is hard,
+    ESIZE's or the element size's is soft (the mapped mesher may change it)."""
+    db = s.db
+    line = _line_of(s, a, b)
+    if line is not None and line.ndiv:
+        return line.ndiv, True
     length = float(np.hypot(*np.subtract(db.keypoints[b], db.keypoints[a])))
-    n = db.esize_divisions or _divisions(length, size)
-    return side_fractions(n, 1.0)
+    return db.esize_divisions or _divisions(length, size), False
+
+
+def _side(s: SessionState, a: int, b: int, n: int) -> np.ndarray:
+    """Fractions along the area side from keypoint a to b for n divisions, spaced by its
+    line's LESIZE ratio (given in the line's own direction)."""
+    line = _line_of(s, a, b)
+    f = side_fractions(n, line.space if line is not None else 1.0)
+    return f if line is None or line.k1 == a else 1.0 - f[::-1]
+
+
+def _matched(s: SessionState, one: tuple[int, int], other: tuple[int, int],
+             size: float) -> tuple[int, Line | None] | None:
+    """Divisions of two opposite sides for a mapped mesh (None if they cannot match) and
+    the line whose soft divisions change to match: as in MAPDL, a side with soft divisions
+    takes the hard divisions of the opposite side."""
+    (n1, hard1), (n2, hard2) = _side_divisions(s, *one, size), _side_divisions(s, *other, size)
+    if n1 == n2:
+        return n1, None
+    if hard1 == hard2:
+        return None
+    return (n1 if hard1 else n2), _line_of(s, *(other if hard1 else one))
 
 
 def _divisions(length: float, size: float) -> int:
@@ -244,10 +269,15 @@ def mapped_grid(s: SessionState, area: int, size: float) -> np.ndarray | None:
     if len(kps) != 4:
         return None
     k0, k1, k2, k3 = kps
-    bottom, top = _side(s, k0, k1, size), _side(s, k3, k2, size)
-    left, right = _side(s, k0, k3, size), _side(s, k1, k2, size)
-    if bottom.size != top.size or left.size != right.size:
+    along = _matched(s, (k0, k1), (k3, k2), size)
+    across = _matched(s, (k0, k3), (k1, k2), size)
+    if along is None or across is None:
         return None
+    for n, soft in (along, across):
+        if soft is not None:
+            soft.ndiv = n  # the line keeps them: an area meshed later matches this one
+    bottom, top = _side(s, k0, k1, along[0]), _side(s, k3, k2, along[0])
+    left, right = _side(s, k0, k3, across[0]), _side(s, k1, k2, across[0])
     check_new_elements(s, (bottom.size - 1) * (left.size - 1), size)
     p0, p1, p2, p3 = (np.array(db.keypoints[k], float) for k in kps)
     u = 0.5 * (bottom + top)[None, :, None]

@@ -1089,3 +1089,47 @@ SET,LAST
         # backward Euler at Δt = τ/250 is within 0.1 % of the exponential
         assert p[name] == pytest.approx(100 * (1 - math.exp(-t / 0.25)), rel=1e-3), name
     assert (p["TIME_FIRST"], p["STEP_LAST"]) == (1.0, 2.0)
+
+
+def test_mapped_mesh_gives_a_soft_side_the_hard_divisions_opposite():
+    """Two unit squares stacked, each with its own keypoints at y = 1 (as VM163 builds its
+    caisson): LESIZE 4 on both bottoms, ESIZE,,3 elsewhere.  As MAPDL does, the lower
+    square's top (soft: ESIZE) takes its bottom's 4 divisions, so both map 4 × 3 and
+    NUMMRG joins their nodes at y = 1 one to one; held at 100 and 0 the model is the 1-D
+    wall: 50 at the interface, heat k ΔT w / L."""
+    s = run(f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,1
+K,1,0,0
+K,2,1,0
+K,3,1,1
+K,4,0,1
+K,5,0,1
+K,6,1,1
+K,7,1,2
+K,8,0,2
+L,1,2
+L,5,6
+LESIZE,ALL,,,4
+A,1,2,3,4
+A,5,6,7,8
+ESIZE,,3
+AMESH,ALL
+*GET,N_ELEM,ELEM,0,COUNT
+NUMMRG,NODE
+NSEL,S,LOC,Y,1
+*GET,N_JOINT,NODE,0,COUNT
+ALLSEL
+{held_faces("Y", (0, 100), (2, 0))}
+{SOLVE_THEN_POST}
+NSEL,S,LOC,Y,0
+FSUM
+*GET,Q,FSUM,0,ITEM,HEAT
+ALLSEL
+T_JOINT=TEMP(NODE(0.25,1,0))
+""")
+    p = s.params
+    assert p["N_ELEM"] == 24  # 4 × 3 mapped quads in each square
+    assert p["N_JOINT"] == 5  # the squares share the 5 nodes of y = 1 (MAPDL: after NUMMRG)
+    assert p["T_JOINT"] == pytest.approx(50.0, rel=1e-12)
+    assert p["Q"] == pytest.approx(-50.0, rel=1e-12)

@@ -31,7 +31,9 @@ ROWS = {"vm102": 8, "vm105": 8, "vm28": 4, "vm98": 12, "vm113": 4, "vm99": 5, "v
         "vm110": 7,
         "vm114": 6, "vm115": 6, "vm116": 1,
         # an arc line (L in CSYS 1), BFA, ETABLE/SSUM of SURF151 heat rates
-        "vm58": 3}
+        "vm58": 3,
+        # mapped AMESH: a side with ESIZE's soft divisions takes the opposite side's LESIZE
+        "vm163": 1}
 
 
 def results_table(path: Path) -> list[tuple[str, float, float]]:
