@@ -466,6 +466,28 @@ class PlaneThermal:
                 r = r - load.assemble(fb, g=flux, axisymmetric=ax)
         return r
 
+    def centroid_gradient(self, inputs: ThermalInputs, T: np.ndarray,
+                          n_elements: int) -> tuple[np.ndarray, np.ndarray]:
+        """Per element of the deck's table (n_elements rows; NaN outside the plane mesh) the
+        temperature gradient ∇T (°C/m) and the heat flux −(KXX ∂T/∂x, KYY ∂T/∂y) (W/m², k at
+        the centroid's temperature) at the element centroid: MAPDL's TG and TF items."""
+        grad = np.full((n_elements, 2), np.nan)
+        flux = np.full((n_elements, 2), np.nan)
+        for k, part in enumerate(self.mesh.parts):
+            tri = isinstance(part.basis.mesh, MeshTri1)
+            centroid = np.full((2, 1), 1.0 / 3.0 if tri else 0.5)  # reference cells: [0,1]²
+            b = Basis(part.basis.mesh, part.basis.elem, quadrature=(centroid, np.ones(1)))
+            u = b.interpolate(T[part.local_dofs])
+            g = u.grad[:, :, 0].T  # (cells, 2)
+            grad[part.elements] = g
+            for m, cells in self.groups[k].items():
+                Tc = u.value[cells]  # (cells, 1): the properties take quadrature-point arrays
+                kx = np.broadcast_to(inputs.kxx[m](Tc), Tc.shape)[:, 0]
+                ky = np.broadcast_to(inputs.kyy[m](Tc), Tc.shape)[:, 0]
+                flux[part.elements[cells]] = -np.column_stack([kx * g[cells, 0],
+                                                               ky * g[cells, 1]])
+        return grad, flux
+
     def film_heat(self, inputs: ThermalInputs, T: np.ndarray, keys: np.ndarray) -> np.ndarray:
         """Per exterior face (node-pair key) the heat its film takes out of the model,
         ∫ h (T − T_bulk) dA (W; consistent integral, 2πr in an axisymmetric model); 0 on a

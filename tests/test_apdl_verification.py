@@ -1133,3 +1133,54 @@ T_JOINT=TEMP(NODE(0.25,1,0))
     assert p["N_JOINT"] == 5  # the squares share the 5 nodes of y = 1 (MAPDL: after NUMMRG)
     assert p["T_JOINT"] == pytest.approx(50.0, rel=1e-12)
     assert p["Q"] == pytest.approx(-50.0, rel=1e-12)
+
+
+def test_etable_thermal_gradient_and_flux_at_element_centroids():
+    """ETABLE TG and TF on two walls whose closed forms are known at every point.
+    Orthotropic (KXX = 2, KYY = 5) triangles held 100/20 across y = 0..1: ∇T = (0, −80),
+    flux (0, KYY·80) in every element.  k = 10 + 0.05 T (MP C1) quads held 100/20 across
+    x = 0..2: the flux is the same everywhere, q = (U(100) − U(20))/L with the Kirchhoff
+    transform U(T) = 10 T + 0.025 T²."""
+
+    def wall(rectangle: str, axis: str, length: float) -> str:
+        """The rectangle meshed at 0.25, held at 100 and 20 across `axis`, solved."""
+        return (f"RECTNG,{rectangle}\nESIZE,0.25\nAMESH,1\n"
+                f"{held_faces(axis, (0, 100), (length, 20))}\n{SOLVE_THEN_POST}")
+
+    s = run(f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,2
+MP,KYY,1,5
+MSHAPE,1
+{wall("0,1,0,1", "Y", 1)}
+ETABLE,GY,TG,Y
+ETABLE,GS,TG,SUM
+ETABLE,FX,TF,X
+ETABLE,FY,TF,Y
+*GET,N_ELEM,ELEM,0,COUNT
+SSUM
+*GET,SUM_GY,SSUM,,ITEM,GY
+*GET,SUM_GS,SSUM,,ITEM,GS
+*GET,SUM_FX,SSUM,,ITEM,FX
+*GET,SUM_FY,SSUM,,ITEM,FY
+*GET,FY_1,ELEM,1,ETAB,FY
+""")
+    p = s.params
+    n = p["N_ELEM"]
+    assert p["FY_1"] == pytest.approx(-5 * -80.0, rel=1e-9)
+    assert p["SUM_GY"] == pytest.approx(-80.0 * n, rel=1e-9)
+    assert p["SUM_GS"] == pytest.approx(80.0 * n, rel=1e-9)
+    assert p["SUM_FY"] == pytest.approx(400.0 * n, rel=1e-9)
+    assert abs(p["SUM_FX"]) <= 1e-9 * 400.0 * n
+    s = run(f"""/PREP7
+ET,1,PLANE77
+MP,KXX,1,10,0.05
+{wall("0,2,0,0.5", "X", 2)}
+ETABLE,FX,TF,X
+*GET,F_FIRST,ELEM,1,ETAB,FX
+*GET,F_LAST,ELEM,16,ETAB,FX
+""")
+    q = ((10 * 100 + 0.025 * 100**2) - (10 * 20 + 0.025 * 20**2)) / 2
+    # quadratic quads of 0.25 across T(x) = (−10 + √(100 + 0.1 U(x)))/0.05: within 0.1 %
+    assert s.params["F_FIRST"] == pytest.approx(q, rel=1e-3)
+    assert s.params["F_LAST"] == pytest.approx(q, rel=1e-3)

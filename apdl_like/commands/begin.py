@@ -110,8 +110,16 @@ def star_get(s: SessionState, c: Call) -> None:
             value = float(ids.max() if sub == "MAX" else ids.min()) if ids.size else 0.0
         else:
             raise ApdlError(f"field 5: NUM takes MAX, MIN or COUNT, got {sub or '(empty)'!r}")
+    elif entity == "ELEM" and item == "ETAB":  # *GET,Par,ELEM,n,ETAB,Lab
+        column = s.element_table.get(sub)
+        if column is None:
+            raise ApdlError(f"field 5: no element table column {sub or '(empty)'!r} (ETABLE)")
+        i = int(db.elements.index(c.int(3, what="element number"))[0])
+        if i < 0:
+            raise ApdlError(f"element {c.raw(3)} does not exist")
+        value = float(column[i])
     elif entity == "ELEM":
-        raise ApdlError(f"field 4: ELEM supports NUM only, got {item or '(empty)'!r}")
+        raise ApdlError(f"field 4: ELEM supports NUM and ETAB, got {item or '(empty)'!r}")
     else:
         n = c.int(3, what="node number")
         if item == "TEMP":

@@ -8,6 +8,8 @@ elements selected when it runs.  The items are the thermal ones decks use:
     SMISC,2/3  of LINK32/33        the node temperatures TI, TJ
     SMISC,2    of SURF151          heat rate its convection takes out of the solid,
                                    ∫ h (T − T_bulk) dA, W
+    TG,X|Y|SUM of PLANE35/55/77    thermal gradient at the centroid, °C/m
+    TF,X|Y|SUM of PLANE35/55/77    heat flux −(KXX ∂T/∂x, KYY ∂T/∂y) at the centroid, W/m²
 
 An element without the item gets 0, as in MAPDL's table.
 """
@@ -54,6 +56,20 @@ def _smisc(s: SessionState, comp: int) -> np.ndarray:
     return out
 
 
+def _centroid_item(s: SessionState, item: str, comp: str) -> np.ndarray:
+    """TG (∇T, °C/m) or TF (heat flux, W/m²) at the element centroids: component X, Y or
+    SUM (the vector's length); NaN for elements without it (links, surface elements)."""
+    if comp not in ("X", "Y", "SUM"):
+        raise ApdlError(f"field 3: {item} takes X, Y or SUM, got {comp or '(empty)'!r}")
+    model, inputs = plane_solution(s)
+    res = s.result()
+    if res.analysis != "thermal":
+        raise ApdlError(f"ETABLE,,{item} reads a thermal result")
+    grad, flux = model.centroid_gradient(inputs, res.temperature, len(s.db.elements.ids))
+    vec = grad if item == "TG" else flux
+    return np.hypot(vec[:, 0], vec[:, 1]) if comp == "SUM" else vec[:, "XY".index(comp)]
+
+
 @command("ETABLE", POST, 4)
 def etable(s: SessionState, c: Call) -> None:
     """ETABLE,Lab,Item,Comp (ETABLE,ERAS deletes every column)."""
@@ -64,8 +80,13 @@ def etable(s: SessionState, c: Call) -> None:
     if not lab:
         raise ApdlError("field 1 (Lab) is required")
     item = c.label(2)
+    if item in ("TG", "TF"):
+        selected = s.db.elements.selected
+        s.element_table[lab] = np.where(selected, np.nan_to_num(_centroid_item(s, item,
+                                                                               c.label(3))), 0.0)
+        return
     if item != "SMISC":
-        raise ApdlError(f"field 2: ETABLE supports SMISC, got {item or '(empty)'!r}")
+        raise ApdlError(f"field 2: ETABLE supports SMISC, TG and TF, got {item or '(empty)'!r}")
     comp = c.int(3, what="Comp")
     if comp not in (1, 2, 3):
         raise ApdlError("field 3: SMISC supports 1 (a link's HEAT RATE), 2 and 3 (a bar's "
