@@ -79,10 +79,14 @@ def area_outline(s: SessionState, area: int) -> np.ndarray:
     return np.vstack(out)
 
 
-def _triangulate(polygons: list[np.ndarray], size: float,
-                 arcs: list[list[Line | None]] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles of the polygons (sides i -> i+1; arcs[k][i]: the circular arc that is
-    side i of polygon k, None for a straight side)."""
+def _triangulate(boundaries: list[tuple[np.ndarray, np.ndarray]],
+                 size: float) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of the areas whose boundaries are given as closed point lists (n, 2) with
+    their keypoint flags (n,): every boundary point becomes a node and no boundary segment
+    is divided further (the lines' divisions, as MAPDL's free mesher keeps them, so a
+    neighbouring area's line mesh matches node for node); inside, the size grows from the
+    boundary spacing up to `size`.  Keypoints come first in the node order (MAPDL numbers
+    an area's keypoint nodes before its line and interior nodes)."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -93,27 +97,26 @@ def _triangulate(polygons: list[np.ndarray], size: float,
         gmsh.model.add("amesh")
         occ = gmsh.model.occ
         surfaces = []
-        centres: dict[tuple[float, float], int] = {}
-        for k, poly in enumerate(polygons):
-            pts = [occ.addPoint(x, y, 0.0) for x, y in poly]
-            lines = []
-            for i in range(len(pts)):
-                j = (i + 1) % len(pts)
-                arc = arcs[k][i] if arcs is not None else None
-                if arc is not None:
-                    if arc.centre not in centres:
-                        centres[arc.centre] = occ.addPoint(*arc.centre, 0.0)
-                    lines.append(occ.addCircleArc(pts[i], centres[arc.centre], pts[j]))
-                else:
-                    lines.append(occ.addLine(pts[i], pts[j]))
+        tags = [np.zeros(len(poly), int) for poly, _ in boundaries]
+        for first in (True, False):
+            for (poly, corner), tag in zip(boundaries, tags, strict=True):
+                seg = np.hypot(*(np.roll(poly, -1, axis=0) - poly).T)
+                local = 0.5 * (seg + np.roll(seg, 1))  # a point's size: its two segments
+                for i in np.nonzero(corner == first)[0]:
+                    tag[i] = occ.addPoint(poly[i, 0], poly[i, 1], 0.0, float(local[i]))
+        for tag in tags:
+            lines = [occ.addLine(int(tag[i]), int(tag[(i + 1) % tag.size]))
+                     for i in range(tag.size)]
             surfaces.append((2, occ.addPlaneSurface([occ.addCurveLoop(lines)])))
         if len(surfaces) > 1:
             occ.fragment(surfaces[:1], surfaces[1:])
         occ.synchronize()
+        for _, curve in gmsh.model.getEntities(1):
+            gmsh.model.mesh.setTransfiniteCurve(curve, 2)  # a boundary segment stays whole
         gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", size / 4.0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: regular triangles
         gmsh.model.mesh.generate(2)
         tags, coords, _ = gmsh.model.mesh.getNodes()
@@ -139,9 +142,6 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
     if et is None:
         raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
     polygons = [np.array([db.keypoints[k] for k in db.areas[a]], float) for a in area_numbers]
-    arcs = [[_arc_between(s, k, kk)
-             for k, kk in zip(db.areas[a], [*db.areas[a][1:], db.areas[a][0]], strict=True)]
-            for a in area_numbers]
     outlines = [area_outline(s, a) for a in area_numbers]
     allpts = np.vstack(polygons)
     extent = float(np.ptp(allpts, axis=0).max())
@@ -155,7 +155,9 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
     if total <= 0.0:
         raise ApdlError("an area has zero size (check the keypoint order)")
     check_new_elements(s, 2.5 * total / size**2, size)
-    xy, tri = _triangulate(polygons, size, arcs)
+    boundaries = [_divided_boundary(s, a, size) for a in area_numbers]
+    longest = max(float(np.hypot(*(np.roll(b, -1, axis=0) - b).T).max()) for b, _ in boundaries)
+    xy, tri = _triangulate(boundaries, max(size, longest))
     if tri.size == 0:
         raise ApdlError("gmsh produced no triangles")
     used = np.unique(tri)
@@ -195,6 +197,26 @@ def mesh_areas(s: SessionState, area_numbers: list[int]) -> None:
         inside = _inside(poly, centroids)
         db.area_elements[num] = first + np.nonzero(inside)[0]
     s.say(f"AMESH: {len(tri)} elements, {fresh} new nodes (size {size:g})")
+
+
+def _divided_boundary(s: SessionState, area: int, size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The area's boundary as the nodes its lines get, and which of them are keypoints: per
+    side its divisions (LESIZE, L, ESIZE's NDIV, else the element size), spaced by its
+    ratio, on its arc when it is one.  Lines without divisions of their own keep the ones
+    they are meshed with."""
+    db = s.db
+    kps = db.areas[area]
+    out = []
+    for a, b in zip(kps, [*kps[1:], kps[0]], strict=True):
+        n, hard = _side_divisions(s, a, b, size)
+        line = _line_of(s, a, b)
+        if line is not None and not hard:
+            line.ndiv = n  # meshed now: an area meshed later must match it
+        p1, p2 = np.array(db.keypoints[a], float), np.array(db.keypoints[b], float)
+        out.append(line_points(_arc_between(s, a, b) or Line(a, b), p1, p2,
+                               _side(s, a, b, n))[:-1])
+    corner = np.concatenate([np.arange(len(side)) == 0 for side in out])
+    return np.vstack(out), corner
 
 
 def _inside(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:

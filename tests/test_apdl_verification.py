@@ -1184,3 +1184,39 @@ ETABLE,FX,TF,X
     # quadratic quads of 0.25 across T(x) = (−10 + √(100 + 0.1 U(x)))/0.05: within 0.1 %
     assert s.params["F_FIRST"] == pytest.approx(q, rel=1e-3)
     assert s.params["F_LAST"] == pytest.approx(q, rel=1e-3)
+
+
+def test_free_and_mapped_areas_share_the_nodes_of_their_common_line():
+    """A square mapped (4 sides, LESIZE 7) beside a pentagon meshed free: MAPDL meshes
+    their common line once, so both use its 8 nodes.  Held at 100 and 0 across the two the
+    field is linear (T = 50 on the joint, heat k ΔT h / L = 50), which a mesh cracked along
+    the joint (each area's own nodes there) cannot represent."""
+    s = run(f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,1
+K,1,0,0
+K,2,1,0
+K,3,1,1
+K,4,0,1
+K,5,1.5,0
+K,6,2,0
+K,7,2,1
+A,1,2,3,4
+A,2,5,6,7,3
+LESIZE,ALL,,,7
+AMESH,ALL
+NSEL,S,LOC,X,1
+*GET,N_JOINT,NODE,0,COUNT
+ALLSEL
+{held_faces("X", (0, 100), (2, 0))}
+{SOLVE_THEN_POST}
+NSEL,S,LOC,X,0
+FSUM
+*GET,Q,FSUM,0,ITEM,HEAT
+ALLSEL
+T_JOINT=TEMP(NODE(1,0.43,0))
+""")
+    p = s.params
+    assert p["N_JOINT"] == 8
+    assert p["T_JOINT"] == pytest.approx(50.0, rel=1e-9)
+    assert p["Q"] == pytest.approx(-50.0, rel=1e-9)
