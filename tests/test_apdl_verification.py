@@ -1091,19 +1091,33 @@ SET,LAST
     assert (p["TIME_FIRST"], p["STEP_LAST"]) == (1.0, 2.0)
 
 
+# PLANE55 with k = 1 and the keypoints 1-4 of the unit square, counter-clockwise from 0,0
+UNIT_SQUARE_KEYPOINTS = "/PREP7\nET,1,PLANE55\nMP,KXX,1,1\nK,1,0,0\nK,2,1,0\nK,3,1,1\nK,4,0,1"
+
+
+def joint_then_solve(axis: str, joint_point: str) -> str:
+    """Deck lines for two parts joined at `axis` = 1 and held at 100 (axis = 0) and 0
+    (axis = 2): N_JOINT nodes on the joint, the heat Q at the held-hot nodes (FSUM) and
+    T_JOINT at the joint node nearest `joint_point` ("x,y")."""
+    return f"""NSEL,S,LOC,{axis},1
+*GET,N_JOINT,NODE,0,COUNT
+ALLSEL
+{held_faces(axis, (0, 100), (2, 0))}
+{SOLVE_THEN_POST}
+NSEL,S,LOC,{axis},0
+FSUM
+*GET,Q,FSUM,0,ITEM,HEAT
+ALLSEL
+T_JOINT=TEMP(NODE({joint_point},0))"""
+
+
 def test_mapped_mesh_gives_a_soft_side_the_hard_divisions_opposite():
     """Two unit squares stacked, each with its own keypoints at y = 1 (as VM163 builds its
     caisson): LESIZE 4 on both bottoms, ESIZE,,3 elsewhere.  As MAPDL does, the lower
     square's top (soft: ESIZE) takes its bottom's 4 divisions, so both map 4 × 3 and
     NUMMRG joins their nodes at y = 1 one to one; held at 100 and 0 the model is the 1-D
     wall: 50 at the interface, heat k ΔT w / L."""
-    s = run(f"""/PREP7
-ET,1,PLANE55
-MP,KXX,1,1
-K,1,0,0
-K,2,1,0
-K,3,1,1
-K,4,0,1
+    s = run(f"""{UNIT_SQUARE_KEYPOINTS}
 K,5,0,1
 K,6,1,1
 K,7,1,2
@@ -1117,16 +1131,7 @@ ESIZE,,3
 AMESH,ALL
 *GET,N_ELEM,ELEM,0,COUNT
 NUMMRG,NODE
-NSEL,S,LOC,Y,1
-*GET,N_JOINT,NODE,0,COUNT
-ALLSEL
-{held_faces("Y", (0, 100), (2, 0))}
-{SOLVE_THEN_POST}
-NSEL,S,LOC,Y,0
-FSUM
-*GET,Q,FSUM,0,ITEM,HEAT
-ALLSEL
-T_JOINT=TEMP(NODE(0.25,1,0))
+{joint_then_solve("Y", "0.25,1")}
 """)
     p = s.params
     assert p["N_ELEM"] == 24  # 4 × 3 mapped quads in each square
@@ -1191,13 +1196,7 @@ def test_free_and_mapped_areas_share_the_nodes_of_their_common_line():
     their common line once, so both use its 8 nodes.  Held at 100 and 0 across the two the
     field is linear (T = 50 on the joint, heat k ΔT h / L = 50), which a mesh cracked along
     the joint (each area's own nodes there) cannot represent."""
-    s = run(f"""/PREP7
-ET,1,PLANE55
-MP,KXX,1,1
-K,1,0,0
-K,2,1,0
-K,3,1,1
-K,4,0,1
+    s = run(f"""{UNIT_SQUARE_KEYPOINTS}
 K,5,1.5,0
 K,6,2,0
 K,7,2,1
@@ -1205,16 +1204,7 @@ A,1,2,3,4
 A,2,5,6,7,3
 LESIZE,ALL,,,7
 AMESH,ALL
-NSEL,S,LOC,X,1
-*GET,N_JOINT,NODE,0,COUNT
-ALLSEL
-{held_faces("X", (0, 100), (2, 0))}
-{SOLVE_THEN_POST}
-NSEL,S,LOC,X,0
-FSUM
-*GET,Q,FSUM,0,ITEM,HEAT
-ALLSEL
-T_JOINT=TEMP(NODE(1,0.43,0))
+{joint_then_solve("X", "1,0.43")}
 """)
     p = s.params
     assert p["N_JOINT"] == 8
