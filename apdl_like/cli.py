@@ -4,7 +4,10 @@
     apdl-like export-cdb --out FILE    the default spindle mesh as an ANSYS archive
 
 Bad input (an `ApdlError`, or any `twin.errors.InputError`) prints one line and exits 2;
-anything else is an internal error, exit 1; neither prints a traceback.
+anything else is an internal error, exit 1; neither prints a traceback.  A deck that stops
+at a bad line still leaves what ran before it in DIR (the files it wrote, the load steps it
+solved, params.json as they stood, log.txt ending with the error), as MAPDL keeps its
+output files when a batch run stops.
 """
 
 from __future__ import annotations
@@ -47,8 +50,14 @@ def run(
         raise ApdlError("deck not found", file=str(deck))
     check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
     session = Session(base_dir=deck.parent, strict=strict)
+    stopped: InputError | None = None
     try:
         session.run_file(deck)
+    except InputError as exc:
+        # a bad line stops the run, not what came before it: the files the deck wrote, the
+        # load steps it solved and the log (ending with the error) are kept, then exit 2
+        stopped = exc
+        session.state.listing.log.append(f"*** ERROR *** {exc}")
     finally:
         if not quiet:
             for warning in session.state.listing.warnings:
@@ -56,6 +65,8 @@ def run(
     for name in session.state.listing.files:  # the files the deck wrote, same checks
         check_out_file(out / name, inputs=[deck])
     written = write_outputs(session.state, out)
+    if stopped is not None:
+        raise stopped
     if not quiet:
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
                    f"{len(written)} files to {out}")

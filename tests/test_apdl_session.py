@@ -249,7 +249,25 @@ def test_cli_bad_deck_exits_2_without_traceback(tmp_path, text, where):
                            str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
     assert where in done.stderr and "Traceback" not in done.stderr
-    assert not (tmp_path / "o" / "params.json").exists()
+    # the log says where the run stopped
+    assert where in (tmp_path / "o" / "log.txt").read_text().splitlines()[-1]
+
+
+def test_cli_bad_line_keeps_what_ran_before_it(tmp_path):
+    """Statement by statement: a results table written and a load step solved before a bad
+    line are kept in --out; the run still exits 2 naming the line."""
+    deck = tmp_path / "d.inp"
+    deck.write_text("/PREP7\nET,1,PLANE55\nMP,KXX,1,2\nN,1,0,0\nN,2,1,0\nN,3,1,1\n"
+                    "N,4,0,1\nE,1,2,3,4\nD,1,TEMP,10\nD,4,TEMP,10\nD,2,TEMP,30\n"
+                    "D,3,TEMP,30\n/SOLU\nSOLVE\n/POST1\n*GET,TMID,NODE,2,TEMP\n"
+                    "/OUT,table,txt\n*VWRITE,TMID\n(F8.2)\n/OUT\nMP,KXX,1,-1\n")
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
+                           str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "d.inp:21: MP" in done.stderr
+    out = tmp_path / "o"
+    assert float((out / "table.txt").read_text().split()[0]) == 30.0
+    assert (out / "result_001.vtu").is_file()
+    assert json.loads((out / "params.json").read_text())["TMID"] == 30.0
 
 
 def test_cli_warns_on_unknown_commands_and_strict_makes_them_errors(tmp_path):
