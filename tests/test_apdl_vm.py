@@ -162,3 +162,139 @@ def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_p
         assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), label
     for label, target, computed in rows[3:]:
         assert computed == pytest.approx(target, rel=0.03), label
+
+
+def _run_published(deck_text: str, tmp_path: Path) -> Path:
+    """Run a (possibly edited) deck with apdl-like; its --out folder."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    deck, out = tmp_path / "deck.dat", tmp_path / "out"
+    deck.write_text(deck_text)
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
+                           str(out)], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+VM100_ELEMENTS = "E,4,1,2,5\nE,3,6,5,2\nEGEN,2,3,1,2,1\n"
+
+
+def test_vm100_targets_are_kreiths_finite_differences_which_triangles_reproduce(tmp_path):
+    """VM100's targets are Kreith's finite-difference temperatures on the 0.5 ft grid (the
+    five-point stencil, half cells with their film on the faces).  Linear triangles on a
+    square grid with a diagonal film matrix are exactly that scheme: with each of the
+    deck's squares split into two triangles, every node lands on its target to within
+    0.07 °F (node 12: 11.76 against a printed 11.7).  The deck as published meshes the
+    squares with PLANE55's bilinear quads, which couple a node to its diagonal neighbour
+    too (2 × 2 Gauss points on a unit square: 2/3 on the diagonal, −1/6 along an edge,
+    −1/3 across).  At node 11, between the two right triangles 11-7-8 and 12-15-11 and
+    the square 8-9-12-11, that gives T11 = 0.4 T8 + 0.4 T12 + 0.2 T9 instead of the
+    finite differences' (T8 + T12)/2: 27.6 °F against the 29.6 target (−6.9 %), and 17.3,
+    12.5, 5.0 °F at nodes 9, 12, 15 (targets 18.3, 11.7, 4.7).  That is the element, not
+    a defect: the deck cannot meet its 2 % on those four nodes."""
+    published = (DECKS / "vm100.dat").read_text()
+    assert VM100_ELEMENTS in published
+    split = ("E,4,1,2,2\nE,4,2,5,5\nE,3,6,5,5\nE,3,5,2,2\nE,7,4,5,5\nE,7,5,8,8\n"
+             "E,6,9,8,8\nE,6,8,5,5\n")
+    nodes = (1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 15)  # the table's rows, unrounded
+    post = "\n/POST1\n" + "".join(f"*GET,T{n},NODE,{n},TEMP\n" for n in nodes)
+    out = _run_published(published.replace(VM100_ELEMENTS, split).replace(
+        "E,9,12,11,8\n", "E,9,12,11,11\nE,9,11,8,8\n") + post, tmp_path / "split")
+    p = json.loads((out / "params.json").read_text())
+    rows = results_table(out / "vm100.vrt")
+    for n, (label, target, _) in zip(nodes, rows, strict=False):
+        assert p[f"T{n}"] == pytest.approx(target, abs=0.07), label
+    out = _run_published(published + post, tmp_path / "quads")
+    p = json.loads((out / "params.json").read_text())
+    assert p["TN11"] == pytest.approx(0.4 * p["T8"] + 0.4 * p["TN12"] + 0.2 * p["T9"],
+                                      rel=1e-9)
+    assert p["TN11"] < 0.5 * (p["T8"] + p["TN12"]) - 1.0
+    rows = results_table(out / "vm100.vrt")
+    for label, target, computed in rows[:8] + rows[12:]:  # nodes 1..8 and the heat
+        assert computed == pytest.approx(target, rel=TOLERANCE), label
+
+
+def _neumann_freezing(x_m: np.ndarray, t_s: float, alpha: float, stefan: float,
+                      t_wall: float, t_melt: float) -> np.ndarray:
+    """Neumann's one-phase solidification of liquid at its melting point (a semi-infinite
+    body, the face held at t_wall from t = 0): T = t_wall + (t_melt − t_wall)
+    erf(x/2√(αt)) / erf λ in the solid, λ e^{λ²} erf λ = Ste/√π, Ste = ρc ΔT / ρL."""
+    from scipy.special import erf
+
+    lam = brentq(lambda v: v * np.exp(v * v) * erf(v) - stefan / math.sqrt(math.pi),
+                 1e-9, 5.0)
+    front = 2.0 * lam * math.sqrt(alpha * t_s)
+    assert np.all(x_m < front)
+    return t_wall + (t_melt - t_wall) * erf(x_m / (2 * math.sqrt(alpha * t_s))) / erf(lam)
+
+
+VM104_TABLE = ("MPTEMP,1,-10,-1,0,10\n"
+               "MPDATA,ENTH,1,1,0,37.8E6,79.8E6,121.8E6  ! ENTHALPY\n")
+
+
+def test_vm104_targets_are_neumanns_solution_with_a_42_mj_latent_heat(tmp_path):
+    """VM104 (water freezing from 0 °C, face at −5 °C, ρc = 4.2 MJ/m³K, k = 0.6 W/mK):
+    its targets −3.64 and −2.32 °C (x = 2 and 4 mm, t = 500 s) are Neumann's sharp-front
+    solution with ρL = 42 MJ/m³ (Ste = 0.5): −3.6412 and −2.3199.  The deck's enthalpy
+    table, though, rises 42 MJ/m³ over −1..0 °C, of which 4.2 are the sensible heat of
+    that degree: its latent heat is 37.8 MJ/m³, spread over a mushy degree, and the
+    exact solution of that table is −3.709 / −2.454 °C (a 1-D enthalpy finite-difference
+    reference converged to 1e-4 °C on 50..200 cells), 1.9 % / 5.8 % from the targets;
+    apdl-like runs the published deck to −3.715 / −2.467.  Given the table Neumann's
+    problem intends (42 MJ/m³ latent over a 0.1 °C mushy zone), the same 15 PLANE55 with
+    5 s steps meet Neumann's solution, and so the targets, to within 0.5 %."""
+    published = (DECKS / "vm104.dat").read_text()
+    assert VM104_TABLE in published
+    sharp = "MPTEMP,1,-10,-0.1,0,10\nMPDATA,ENTH,1,1,0,41.58E6,84E6,126E6\n"
+    deck = (published.replace(VM104_TABLE, sharp).replace("AUTOTS,ON", "AUTOTS,OFF")
+            .replace("DELTIM,3,3,10", "DELTIM,5").replace("TIME,900", "TIME,500"))
+    rows = results_table(_run_published(deck, tmp_path) / "vm104.vrt")
+    exact = _neumann_freezing(np.array([0.002, 0.004]), 500.0, 0.6 / 4.2e6,
+                              4.2e6 * 5.0 / 42e6, -5.0, 0.0)
+    for (label, target, computed), expected in zip(rows, exact, strict=True):
+        assert round(expected, 2) == target, label
+        assert computed == pytest.approx(expected, rel=0.005), label
+
+
+def _enthalpy_slab(temps: np.ndarray, enthalpy: np.ndarray, k: float, length: float,
+                   t_wall: float, t_init: float, t_end: float, x_m: np.ndarray,
+                   cells: int = 100) -> np.ndarray:
+    """An independent reference: explicit 1-D enthalpy finite differences (nodes at i·dx,
+    the face held at t_wall, the far end insulated, half cells at both ends), T = H⁻¹(H)
+    from the piecewise-linear table, steps at 0.4 of the stability limit of the smallest
+    capacity."""
+    dx = length / cells
+    volume = np.full(cells + 1, dx)
+    volume[[0, -1]] = dx / 2
+    T = np.full(cells + 1, float(t_init))
+    T[0] = t_wall
+    H = np.interp(T, temps, enthalpy)
+    dt_max = 0.4 * np.diff(enthalpy).min() / np.diff(temps).max() * dx * dx / k
+    t = 0.0
+    while t < t_end - 1e-9:
+        dt = min(dt_max, t_end - t)
+        flux = k * np.diff(T) / dx
+        # node i >= 1 gains flux[i] from its right (none at the insulated end), loses
+        # flux[i - 1] to its left
+        H[1:] += dt * (np.concatenate([flux[1:], [0.0]]) - flux) / volume[1:]
+        T[1:] = np.interp(H[1:], enthalpy, temps)
+        t += dt
+    return np.interp(x_m, np.linspace(0.0, length, cells + 1), T)
+
+
+@pytest.mark.slow
+def test_vm104_as_published_meets_the_exact_solution_of_its_own_enthalpy_table(tmp_path):
+    """The published VM104 (15 PLANE55, AUTOTS from 3 s) against the converged solution of
+    its own ENTH table (37.8 MJ/m³ latent over −1..0 °C): within 1 % at x = 2 and 4 mm,
+    t = 500 s, while that solution is 1.9 % and 5.8 % colder than the targets (Neumann's
+    with 42 MJ/m³)."""
+    temps = np.array([-10.0, -1.0, 0.0, 10.0])
+    enthalpy = np.array([0.0, 37.8e6, 79.8e6, 121.8e6])
+    x = np.array([0.002, 0.004])
+    reference = _enthalpy_slab(temps, enthalpy, 0.6, 0.01, -5.0, 0.0, 500.0, x)
+    assert reference == pytest.approx(
+        _enthalpy_slab(temps, enthalpy, 0.6, 0.01, -5.0, 0.0, 500.0, x, cells=200), abs=1e-3)
+    rows = results_table(_run_published((DECKS / "vm104.dat").read_text(), tmp_path)
+                         / "vm104.vrt")
+    for (label, target, computed), expected in zip(rows, reference, strict=True):
+        assert computed == pytest.approx(expected, rel=0.01), label
+        assert abs(expected / target - 1.0) > 0.018, label
