@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "4a783cc564ee5de7c07e3cb6e104815320b34c0f62492cf92c7d252af06ec776"
+BUNDLED_MODEL_SHA256 = "f7b80109fe5aebcef1c57aab578fe41081bbad9e72abb4f702d1d5e5460bf879"
 
 
 def _make_model():
@@ -38,6 +38,10 @@ def test_bundled_model_learnt_from_the_training_suite_only():
     expected = [f"suite{plan.SUITE_SEED}_{i:03d}" for i in range(1, plan.RUNS + 1)]
     assert meta["training_runs"] == expected
     assert set(meta["held_out_runs"]) < set(expected)
+    # the closed-loop check also replayed the gate suite, which no network learnt from
+    assert plan.GATE_SEED not in (plan.SUITE_SEED, *plan.EVALUATION_SEEDS)
+    assert meta["gate_runs"] == [f"suite{plan.GATE_SEED}_{i:03d}.csv"
+                                 for i in range(1, plan.GATE_RUNS + 1)]
     # the paper's topology: 6-10-1 heat, 6-12-1 resistance
     assert meta["hidden_sizes"] == {"heat_front": 10, "heat_rear": 10,
                                     "resistance_front": 12, "resistance_rear": 12}

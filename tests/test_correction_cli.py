@@ -67,10 +67,13 @@ def _invoke(args):
 def test_train_writes_model_and_report(runs, tmp_path):
     out = tmp_path / "model" / "m.safetensors"
     before = [p.read_bytes() for p in runs]
+    gate = tmp_path / "gate_6000.csv"  # a run only the closed-loop check replays
+    gate.write_bytes(runs[0].read_bytes())
     result = _invoke(["train", *map(str, runs), "--out", str(out), "--epochs", "60",
-                      "--seed", "3", "--quiet"])
+                      "--seed", "3", "--gate-runs", str(gate), "--quiet"])
     assert result.exit_code == 0, result.output
     model = load_model(out)
+    assert model.metadata["gate_runs"] == ["gate_6000.csv"]
     assert model.config_name == "anchored"
     assert model.metadata["training_runs"] == ["run_11000", "run_6000", "run_8000"]
     # the closed-loop check replayed the held-out run with every group of networks

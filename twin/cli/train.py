@@ -28,6 +28,11 @@ def train(
         "twin, with two passes driven off the fit) or 'ratio' (the paper's Eq. 2/5/6 on "
         "fitted curves of a ratio-corrected simulation).",
     ),
+    gate_runs: list[Path] = typer.Option(
+        None, "--gate-runs",
+        help="A recorded run that the closed-loop check of the default networks replays "
+        "besides the held-out runs; never trained on (repeat the option for more).",
+    ),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Train the 6-10-1 heat and 6-12-1 contact-resistance networks of both bearings.
@@ -47,7 +52,8 @@ def train(
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
 
-    check_out_file(out, inputs=runs, also=report_paths(out))
+    gate_runs = list(gate_runs or [])
+    check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
     spindle = SpindleModel.load()  # the networks train on that spindle
     simulator = training_simulator(targets, spindle=spindle)
     sets, recorded = [], {}
@@ -79,9 +85,12 @@ def train(
         if not quiet:
             typer.echo("checking the networks in closed loop on the held-out runs …", err=True)
         held_out = [recorded[name] for name in model.metadata["held_out_runs"]]
+        held_out += [read_run(p, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
+                     for p in gate_runs]
         model, gate = gate_networks(model, held_out, spindle)
         model.metadata.update(networks_kept=gate["kept"], held_out_temperature_accuracy_pct=(
-            gate.get("held_out_temperature_accuracy_pct", {})))
+            gate.get("held_out_temperature_accuracy_pct", {})),
+            gate_runs=[p.name for p in gate_runs])
         if not quiet:
             typer.echo(f"networks kept: {', '.join(gate['kept']) or 'none (the anchor)'}",
                        err=True)
