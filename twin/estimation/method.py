@@ -74,23 +74,23 @@ Deck, analysed state and members
 Drift (default where recorded)
     The recorded axial nose drift (three 20 s bins per window, valid samples only) joins the
     update, its error σ² = drift_model_sd_um² + (drift_rel_sd·drift)² + noise²/samples;
-    the members' drift is e^φα·w·(T − T₀) with the expansion factor φα, and the loop scales each window's
-    displacements by the estimated e^φα.  Window k's drift is then a 0–60 s forecast from
-    the drift measured up to 60k s (causal).  A run without a drift column, or whose drift
-    the quality check rejects, is filtered on T1..T5 alone with no switch needed;
-    `EstimatorConfig(assimilate_drift=False)` always filters on T1..T5 alone (the twin then
-    predicts the drift from temperatures, as on a machine without probes).  `make bench`
-    and the README report both.
+    the members' drift is e^φα·w·(T − T₀) with the expansion factor φα, and the loop
+    scales each window's displacements by the estimated e^φα.  Window k's drift is then a
+    0–60 s forecast from the drift measured up to 60k s (causal).  A run without a drift
+    column, or whose drift the quality check rejects, is filtered on T1..T5 alone with no
+    switch needed; `EstimatorConfig(assimilate_drift=False)` always filters on T1..T5
+    alone (the twin then predicts the drift from temperatures, as on a machine without
+    probes).  `make bench` and the README report both.
     Why drift_model_sd_um is small (0.05 µm): what the structural model gets wrong scales
     with the drift — the expansion factor (estimated) and drift_rel_sd carry it — so the
     absolute part is only what is left of a 20-sample bin mean, of the order of the probe
     noise over √20 (0.05–0.3 µm → 0.01–0.07 µm).  With 0.2 µm the gain on the drift was
     too low: offsets of 0.1–0.4 µm between twin and truth survived 5–10 windows after a
-    start or a speed step (suite 77 run 12), a quarter of the deformation error of such a
-    run.  Measured (`tools/estimator_ceiling.py`; deformation median / worst, every other
-    criterion unchanged): suite 909 97.94 / 94.57 → 98.14 / 94.64 %, 77 98.06 / 94.45 →
-    98.10 / 94.50 %, 2024 98.13 / 95.61 → 98.18 / 96.10 %; 0.02 µm gained at most 0.02
-    more, and the drift's relative error 0.005 instead of 0.01 0.01–0.05.
+    start or a speed step (suite 77 run 12).  Measured (`tools/estimator_ceiling.py`;
+    deformation median / worst; temperature within 0.01 points, no criterion count
+    lower): suite 909 97.94 / 94.57 → 98.14 / 94.64 %, 77 98.06 / 94.45 → 98.10 / 94.50 %,
+    2024 98.13 / 95.61 → 98.18 / 96.10 %, the bundled runs' mean 98.95 → 99.02 %.  0.02 µm,
+    or drift_rel_sd halved as well, gained at most 0.05 points more (not kept).
 
 Band
     Per solver step, ±1.645 σ around the mean: σ² = member variance of the sensor value +
