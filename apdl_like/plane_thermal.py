@@ -156,11 +156,16 @@ def _part(xy: np.ndarray, node_ids: np.ndarray, node_dof: np.ndarray, corners: n
     vertex_of[vertex_node] = np.arange(vertex_node.size)
     p = xy[vertex_node].T
     t = vertex_of[corners].T.copy()
-    # counter-clockwise cells: the signed area of the corner polygon
-    x, y = p[0][t], p[1][t]
+    # counter-clockwise cells: the signed area of the corner polygon, in coordinates scaled
+    # to the model's extent (so that 1e300-sized models neither overflow nor lose the sign)
+    extent = max(float(np.ptp(p, axis=1).max()), 1e-300)
+    if extent > 1e150:  # areas and Jacobians (lengths squared) would overflow in float64
+        raise ApdlError(f"node coordinates out of range: the model spans {extent:.3g} "
+                        "(areas overflow)")
+    x = (p[0][t] - p[0].min()) / extent
+    y = (p[1][t] - p[1].min()) / extent
     area2 = (x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y).sum(axis=0)
-    scale = max(float(np.ptp(p, axis=1).max()), 1e-300) ** 2
-    if np.any(np.abs(area2) <= 1e-12 * scale):
+    if np.any(np.abs(area2) <= 1e-12):
         bad = int(node_ids[corners[int(np.argmin(np.abs(area2))), 0]])
         raise ApdlError(f"an element at node {bad} has zero area (check its node order and "
                         "coordinates)")
