@@ -6,6 +6,7 @@ Limits keep any deck finite: loop iterations per run, statements per run, /INPUT
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -293,7 +294,13 @@ def _dispatch(session: SessionState, st: Statement) -> None:
     while given > spec.max_fields and not str(st.fields[given - 1]).strip():
         given -= 1  # trailing blank fields are no input (FSUM,,,)
     if given > spec.max_fields:
-        raise st.error(f"takes at most {spec.max_fields} fields, got {given}")
+        # values past the fields apdl_like reads (MAPDL has undocumented ones: VM228 sets
+        # HEMIOPT's 19th) are unsupported input: a warning, as for an unknown command
+        message = f"takes at most {spec.max_fields} fields, got {given}"
+        if session.strict:
+            raise st.error(message + " (--strict)")
+        session.warn(st.error(f"{message}; fields {spec.max_fields + 1}..{given} ignored"))
+        st = replace(st, fields=st.fields[:spec.max_fields])
     try:
         spec.handler(session, Call(st, session))
     except ApdlError as exc:
