@@ -15,6 +15,7 @@ from scipy.optimize import brentq
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
+from tests.apdl_decks import SOLVE_THEN_POST
 
 
 def run(text: str) -> Session:
@@ -82,11 +83,7 @@ TYPE,1
 E,4,5
 D,1,TEMP,{t1}
 D,5,TEMP,{t2}
-FINISH
-/SOLU
-SOLVE
-FINISH
-/POST1
+{SOLVE_THEN_POST}
 *GET,T2,NODE,2,TEMP
 *GET,T4,NODE,4,TEMP
 ESEL,S,ELEM,,2,3
@@ -134,11 +131,7 @@ D,{n + 2},TEMP,{t_inf}
 ESEL,S,TYPE,,1
 BFE,ALL,HGEN,,{qdot}
 ESEL,ALL
-FINISH
-/SOLU
-SOLVE
-FINISH
-/POST1
+{SOLVE_THEN_POST}
 *GET,TC,NODE,1,TEMP
 """)
     assert s.params["TC"] == pytest.approx(t_inf + qdot * length / h
@@ -192,11 +185,7 @@ E,2,3
 TOFFST,{off}
 D,1,TEMP,{tg}
 D,3,TEMP,{tw}
-FINISH
-/SOLU
-SOLVE
-FINISH
-/POST1
+{SOLVE_THEN_POST}
 *GET,TB,NODE,2,TEMP
 """)
     bead = brentq(lambda t: h * (tg - t) - sigma * emis * ((t + off) ** 4 - (tw + off) ** 4),
