@@ -142,16 +142,24 @@ def test_vm110_slab_matches_the_exact_series_solution(tmp_path):
     assert -computed == pytest.approx(heat, rel=0.01), label
 
 
-def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_percent(
-        tmp_path):
+# MAPDL's own VM32 results table (Verification Manual, Release 2024 R2, VM32 "Results
+# Comparison", the same deck): the inner axial and hoop stress ratios to Timoshenko's
+# 420.42 psi, as printed (F15.3).  Read in a third-party summary of the manual's VM31-VM60
+# pages; the outer rows' ratios were not in it.
+VM32_MAPDL_RATIOS = {"A_STS psi X=.187": 1.029, "T_STS psi X=.187": 1.014}
+
+
+def test_vm32_runs_as_published_and_reproduces_mapdls_published_stress_ratios(tmp_path):
     """VM32 (long cylinder): the thermal rows meet the 2 % target; the thermal-stress rows
     come within 3 % of Timoshenko's 420.42 / −194.58 psi (worst: the inner axial stress,
-    432.6, +2.9 %), not 2 %.  The 7 axisymmetric PLANE182 quads run MAPDL's documented
-    KEYOPT(1) = 2 element (Simo & Rifai's enhanced strains: four against shear locking, a
-    fifth hoop mode ξη against volumetric locking; the fifth is odd in z and stays zero
-    in this problem, symmetric in each element), with the nodal stresses extrapolated from
-    the 2 × 2 points (ERESX default).  Their corner stress converges as O(h): the coarse
-    published mesh decides it (tests/test_apdl_verification.py checks the rates)."""
+    432.6, +2.9 %), not 2 %, and the inner rows are MAPDL's own published ratios to the
+    three decimals it prints (1.029 and 1.014): MAPDL misses 2 % on this deck too.  The 7
+    axisymmetric PLANE182 quads run MAPDL's documented KEYOPT(1) = 2 element (Simo &
+    Rifai's enhanced strains: four against shear locking, a fifth hoop mode ξη against
+    volumetric locking; any mode in ξη is odd in z and stays zero in this problem,
+    symmetric in each element), with the nodal stresses extrapolated from the 2 × 2 points
+    (ERESX default).  Their corner stress converges as O(h): the coarse published mesh
+    decides it (tests/test_apdl_verification.py checks the rates)."""
     out = tmp_path / "out"
     done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(DECKS / "vm32.dat"),
                            "--out", str(out)], capture_output=True, text=True, timeout=600)
@@ -162,6 +170,9 @@ def test_vm32_runs_as_published_thermal_rows_within_2_and_stress_rows_within_3_p
         assert computed == pytest.approx(target, rel=TOLERANCE, abs=1e-9), label
     for label, target, computed in rows[3:]:
         assert computed == pytest.approx(target, rel=0.03), label
+    ratios = {label: computed / target for label, target, computed in rows[3:]}
+    for label, published in VM32_MAPDL_RATIOS.items():
+        assert abs(ratios[label] - published) <= 0.0005, (label, ratios[label])
 
 
 def _run_published(deck_text: str, tmp_path: Path) -> Path:
