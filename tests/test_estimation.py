@@ -17,7 +17,7 @@ from twin.estimation import method as estimation_method
 from twin.estimation.analysis import etkf_update
 from twin.estimation.ensemble import Ensemble, cap_spread, standardized
 from twin.estimation.forecast import forecast_window
-from twin.estimation.method import EnsembleEstimator, EstimatorConfig, thermocouple_reading
+from twin.estimation.method import EnsembleEstimator, EstimatorConfig
 from twin.estimation.parameters import (
     DEFAULT_PARAMETERS,
     DRIFT_ONLY,
@@ -30,6 +30,7 @@ from twin.loop.replay import deck_window_solver, direct_window_solver, replay_me
 from twin.loop.runfiles import band_of
 from twin.runs import read_run
 from twin.spindle.conditions import nominal_conditions
+from twin.spindle.thermocouple import thermocouple_reading
 
 from .test_replay import make_recorded_run
 
@@ -141,6 +142,15 @@ def test_thermocouple_reading_is_the_exact_ramp_response():
     np.testing.assert_allclose(reading, 0.1 * (t - 10.0 * (1 - np.exp(-t / 10.0))), atol=1e-9)
 
 
+def test_thermocouple_reading_from_an_unsettled_start_decays_to_the_metal():
+    t = np.arange(0.0, 60.0, 4.0)
+    metal = np.full((t.size, 2), 30.0)
+    reading = thermocouple_reading(t, metal, 12.0, start_C=np.array([25.0, 31.0]))
+    expected = 30.0 + np.outer(np.exp(-t / 12.0), [-5.0, 1.0])
+    np.testing.assert_allclose(reading, expected, atol=1e-9)
+    np.testing.assert_array_equal(thermocouple_reading(t, metal, 0.0, np.zeros(2)), metal)
+
+
 # ------------------------------------------------------------------ the method
 @pytest.fixture(scope="module")
 def synthetic(tmp_path_factory, spindle_model):
@@ -238,10 +248,15 @@ def test_a_stuck_sensor_is_left_out_of_the_update(tmp_path, spindle_model):
     np.testing.assert_array_equal(ra.T_twin_C, rb.T_twin_C)
 
 
-def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, spindle_model):
+@pytest.mark.parametrize("readings", [True, False], ids=["readings", "metal"])
+def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, spindle_model,
+                                                                     readings):
+    """The deck run from the analysed field gives the forecast's metal at T1..T5; reported
+    are that metal through the stated thermocouple lag from the stated readings at the
+    window start (report_readings), or the metal itself."""
     model = spindle_model
     run = make_run(tmp_path / "deck.csv", model, minutes=4)
-    est = EnsembleEstimator(model)
+    est = EnsembleEstimator(model, EstimatorConfig(report_readings=readings))
     forecasts = []
     original = est.correct
 
@@ -258,8 +273,20 @@ def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, s
         line = w.deck.split("CMSEL,S,ROTOR\n", 1)[1].splitlines()[0]
         rotor_hgen = float(line.split("!")[0].split(",")[-1])
         assert rotor_hgen == pytest.approx(rotor_nominal * w.correction.factors["motor"])
-    for k, fc in enumerate(forecasts):
+    metal = np.vstack(forecasts)
+    for k, (fc, w) in enumerate(zip(forecasts, replay.windows, strict=True)):
+        c = w.correction
+        assert c.sensor_lag_s == 10.0
+        if readings:
+            window = np.vstack([model.sensor_matrix @ c.state_C, fc])
+            fc = thermocouple_reading(4.0 * np.arange(16), window, c.sensor_lag_s,
+                                      c.readings_start_C)[1:]
+        else:
+            assert c.readings_start_C is None
         np.testing.assert_allclose(replay.T_twin_C[15 * k: 15 * (k + 1)], fc, atol=1e-4)
+    # a heating run: the readings trail the metal (by up to rate × 10 s)
+    lagging = np.abs(replay.T_twin_C - metal).max()
+    assert lagging > 0.05 if readings else lagging < 1e-4
 
 
 def test_replay_cli_writes_the_band_and_the_estimated_factors(tmp_path, spindle_model):
@@ -441,17 +468,16 @@ def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
                                       "ambient_C": np.full(t.size, 24.0),
                                       **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
     run = read_run(tmp_path / "stop.csv")
-    est, replay, windows = estimate(run, model)
+    est, replay, windows = estimate(run, model, sensor_lag_s=0.0)  # the data have no lag
     stopped = [c for k, (c, _) in enumerate(windows) if speeds[k] == 0.0]
     assert stopped and all(c.H_front_W_m3 == 0.0 and c.H_rear_W_m3 == 0.0 for c in stopped)
     assert all(np.all(np.isfinite(c.band_sd)) for c, _ in windows)
     # the twin follows the cool-down and the restart
     measured = run.at(replay.time_s).T_C
     error = np.abs(replay.T_twin_C - measured)
-    # the restart window forecasts a step in the bearing heat with the assumed 10 s sensor
-    # lag (the data have none): about 1 K at T1 in its first steps
+    # the restart window: about 1 K at T1 in its first steps, as the heat steps up
     restart = (replay.time_s > 540.0) & (replay.time_s <= 600.0)
-    assert error[(replay.time_s > 120) & ~restart].max() < 1.0
+    assert error[(replay.time_s > 120) & ~restart].max() < 0.3
     assert error[restart].max() < 1.1
     at = {t: i for i, t in enumerate(replay.time_s)}
     assert replay.T_twin_C[at[540.0], 0] < replay.T_twin_C[at[300.0], 0] - 2.0  # cooled

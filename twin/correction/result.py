@@ -41,6 +41,12 @@ class Correction:
     band_sd: np.ndarray | None = field(default=None, repr=False, compare=False)
     """(steps, 6) forecast spread (1 σ) at each solver step of the window: T1..T5 in °C
     (measurement noise included) and the axial nose drift in µm; None: no uncertainty."""
+    readings_start_C: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """(5,) what T1..T5's thermocouples read at the window start, °C: the loop then reports
+    T1..T5 as the readings of the window's metal temperatures at their points through the
+    first-order lag `sensor_lag_s` (`twin.spindle.thermocouple`).  None: the metal."""
+    sensor_lag_s: float = 0.0
+    """The thermocouples' time constant, s (a method that estimates it; 0: not estimated)."""
 
     @property
     def values(self) -> BoundaryValues:
@@ -56,7 +62,7 @@ class Correction:
         cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
     ) -> Correction:
         """These values with C_H, C_C on `previous` (1 where that was 0: a stop);
-        `extra`: factors, state_C, band_sd."""
+        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s."""
         v = [float(x) for x in values]
         c = [float(x) for x in correction_factors(v, previous)]
         return cls(*v, C_H=(c[0], c[1]), C_C=(c[2], c[3]), **extra)

@@ -57,6 +57,7 @@ from twin.correction.result import Correction, Corrector
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
+from twin.spindle.thermocouple import thermocouple_reading
 
 FILM_AMBIENT_STEP_K = 0.5
 """The film coefficients see the ambient on this grid (the sink temperature stays exact).
@@ -224,6 +225,7 @@ def replay_method(
     state = run.before(starts)
     sim_T = np.empty((n_steps + 1, 5))
     sim_T[0] = model.sensor_matrix @ T
+    reported_T = np.empty((n_steps, 5))  # T1..T5 as reported: the metal or the readings
     sim_time = np.r_[0.0, time_s]
     drift = np.empty((n_steps, 2))
     records: list[WindowRecord] = []
@@ -302,9 +304,11 @@ def replay_method(
             band[k * STEPS_PER_WINDOW : (k + 1) * STEPS_PER_WINDOW] = corr.band_sd
         last = _WindowRun(T, start, k, bc, corr, thermal_factors)
         steps, deck = solver(bc, corr, T, start, k)
+        start_T = model.sensor_matrix @ T
         T = steps[-1]
         sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
         sim_T[sl.start + 1 : sl.stop + 1] = (model.sensor_matrix @ steps.T).T
+        reported_T[sl] = _reported(np.vstack([start_T, sim_T[sl.start + 1 : sl.stop + 1]]), corr)
         drift[sl] = 1e6 * expansion * ((steps - T0) @ model.probe_vectors.T)
         records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck))
         if field_step is not None and sl.start < field_step <= sl.stop:
@@ -319,7 +323,7 @@ def replay_method(
     return MethodReplay(
         method=corrector.name,
         time_s=time_s,
-        T_twin_C=sim_T[1:],
+        T_twin_C=reported_T,
         drift_z_um=drift[:, 0],
         drift_r_um=drift[:, 1],
         windows=records,
@@ -328,6 +332,16 @@ def replay_method(
         wall_s=time.perf_counter() - t_wall,
         band_sd=band,
     )
+
+
+def _reported(metal_C: np.ndarray, corr: Correction) -> np.ndarray:
+    """T1..T5 over a window as reported (metal_C: the window start and its steps): the
+    metal at the sensor points, or, for a method that gives the thermocouples' readings at
+    the window start, their readings through the method's lag."""
+    if corr.readings_start_C is None or corr.sensor_lag_s <= 0:
+        return metal_C[1:]
+    time_s = STEP_S * np.arange(len(metal_C))
+    return thermocouple_reading(time_s, metal_C, corr.sensor_lag_s, corr.readings_start_C)[1:]
 
 
 @dataclass(frozen=True)
