@@ -177,12 +177,12 @@ class EstimatorConfig:
     sensor_sd_C: float = 0.05
     """Thermocouple noise per sample, °C."""
     sensor_lag_s: float = 10.0
-    """Prior thermocouple time constant, s (sheathed thermocouples: about 4–20 s)."""
+    """Assumed thermocouple time constant, s (sheathed thermocouples: about 4–20 s)."""
     lag_sd_s: float = 6.0
     """Its uncertainty, s: a rate of change r adds lag_sd_s·r to the observation error."""
     report_readings: bool = True
     """Report T1..T5 as what the thermocouples read (the metal at their points through
-    the identified lag); False: the metal temperature at their points."""
+    the lag sensor_lag_s); False: the metal temperature at their points."""
     bins_per_window: int = 3
     """Observation bins per 60 s window; each bin's mean is one observation per sensor."""
     initial_field_sd_C: float = 0.2
