@@ -105,7 +105,18 @@ class Call:
         try:
             return compile_expression(text)(self.state.params, self.state.model_functions)
         except ApdlError as exc:
-            raise ApdlError(f"field {i}{f' ({what})' if what else ''}: {exc.reason}") from None
+            reason = exc.reason
+            if self.table(i) is not None:
+                reason = (f"a table ({text.strip()}) is not accepted here (tabular values: "
+                          "D,,TEMP, SF/SFE CONV and HFLUX, BF/BFE HGEN)")
+            raise ApdlError(f"field {i}{f' ({what})' if what else ''}: {reason}") from None
+
+    def table(self, i: int) -> str | None:
+        """The table field `i` names as `%NAME%` (a tabular load value), else None."""
+        text = self.raw(i).strip()
+        if len(text) > 2 and text[0] == "%" and text[-1] == "%":
+            return text[1:-1].strip().upper()
+        return None
 
     def int(self, i: int, default: int | None = None, what: str = "") -> int:
         value = self.num(i, None if default is None else float(default), what)

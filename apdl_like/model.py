@@ -150,14 +150,15 @@ class NodeTable(_NumberedTable):
         "d_uy": np.nan,
         "bf_temp": np.nan,
         "ic_temp": np.nan,
+        "d_temp_table": -1,  # D,,TEMP,%table%: its slot in Database.load_tables (-1: none)
     }
+    DTYPES = {"selected": bool, "d_temp_table": np.int64}  # the others: float
 
     def __init__(self) -> None:
         self.ids = np.zeros(0, dtype=np.int64)
         self.xy = np.zeros((0, 2))
         self.arrays: dict[str, np.ndarray] = {
-            "selected": np.zeros(0, bool),
-            **{k: np.zeros(0) for k in self.ARRAYS if k != "selected"},
+            k: np.zeros(0, self.DTYPES.get(k, float)) for k in self.ARRAYS
         }
         self.pending: dict[int, tuple[float, float]] = {}
         self.version = 0
@@ -168,7 +169,7 @@ class NodeTable(_NumberedTable):
         self.ids = np.asarray(ids, np.int64)[order]
         self.xy = np.asarray(xy, float)[order]
         self.arrays = {
-            k: np.full(len(self.ids), v, dtype=bool if k == "selected" else float)
+            k: np.full(len(self.ids), v, dtype=self.DTYPES.get(k, float))
             for k, v in self.ARRAYS.items()
         }
         self.pending.clear()
@@ -198,7 +199,9 @@ class NodeTable(_NumberedTable):
 class ElementTable(_NumberedTable):
     """Elements by number: type, material, real set, node numbers (0 = none), selection, HGEN."""
 
-    ARRAYS = {"selected": True, "hgen": np.nan, "hgen_record": -1}
+    # hgen_table: BF/BFE,,HGEN,%table%, its slot in Database.load_tables (-1: none)
+    ARRAYS = {"selected": True, "hgen": np.nan, "hgen_record": -1, "hgen_table": -1}
+    DTYPES = {"selected": bool, "hgen": float, "hgen_record": np.int64, "hgen_table": np.int64}
 
     def __init__(self) -> None:
         self.ids = np.zeros(0, dtype=np.int64)
@@ -206,11 +209,7 @@ class ElementTable(_NumberedTable):
         self.mat = np.zeros(0, dtype=np.int64)
         self.real = np.zeros(0, dtype=np.int64)
         self.nodes = np.zeros((0, MAX_ELEMENT_NODES), dtype=np.int64)
-        self.arrays: dict[str, np.ndarray] = {
-            "selected": np.zeros(0, bool),
-            "hgen": np.zeros(0),
-            "hgen_record": np.zeros(0, np.int64),
-        }
+        self.arrays: dict[str, np.ndarray] = {k: np.zeros(0, self.DTYPES[k]) for k in self.ARRAYS}
         self.pending: dict[int, tuple[int, int, int, tuple[int, ...]]] = {}
         self.version = 0
 
@@ -230,9 +229,8 @@ class ElementTable(_NumberedTable):
         padded = np.zeros((len(ids), MAX_ELEMENT_NODES), np.int64)
         padded[:, : nodes.shape[1]] = nodes
         self.nodes = padded[order]
-        dtypes = {"selected": bool, "hgen": float, "hgen_record": np.int64}
         self.arrays = {
-            k: np.full(len(self.ids), v, dtype=dtypes[k]) for k, v in self.ARRAYS.items()
+            k: np.full(len(self.ids), v, dtype=self.DTYPES[k]) for k, v in self.ARRAYS.items()
         }
         self.pending.clear()
         self.version += 1
@@ -331,6 +329,10 @@ class FaceLoads:
     # RDSF: a radiating surface, its emissivity and enclosure number (NaN: none)
     rdsf_emis: np.ndarray = field(default_factory=lambda: np.zeros(0))
     rdsf_encl: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # SF/SFE,%table%: the value's slot in Database.load_tables (-1: none)
+    conv_h_table: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    conv_bulk_table: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    hflux_table: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     FILLS = {
         "conv_h": np.nan,
@@ -340,6 +342,9 @@ class FaceLoads:
         "hflux_record": -1,
         "rdsf_emis": np.nan,
         "rdsf_encl": np.nan,
+        "conv_h_table": -1,
+        "conv_bulk_table": -1,
+        "hflux_table": -1,
     }
 
     def rekey(self, new_keys: np.ndarray) -> None:
@@ -465,6 +470,8 @@ class Database:
     # contact interface (of an AxiMesh session) -> its real-constant set (TCC at 14)
     contact_real_sets: dict[str, int] = field(default_factory=dict)
     load_records: int = 0  # a counter: every load command gets its own record id
+    # the tables loads name (`%NAME%`), by slot; only grows, so saved load steps stay valid
+    load_tables: list[str] = field(default_factory=list)
 
     @property
     def active_system(self) -> CoordinateSystem:

@@ -83,8 +83,10 @@ def store(params: dict[str, Value], name: str, subs: list[float],
             array[index] = v
 
 
-def dimension(params: dict[str, Value], name: str, kind: str, shape: tuple[int, int, int]) -> None:
-    """*DIM: a new array of zeros (ARRAY, TABLE) or blanks (CHAR, STRING)."""
+def dimension(params: dict[str, Value], name: str, kind: str, shape: tuple[int, int, int],
+              variables: tuple[str, str, str] = ("", "", "")) -> None:
+    """*DIM: a new array of zeros (ARRAY, TABLE) or blanks (CHAR, STRING); `variables` are a
+    TABLE's primary variables (Var1..Var3)."""
     if any(n < 1 for n in shape) or shape[0] * shape[1] * shape[2] > MAX_ARRAY_SIZE:
         raise ApdlError(f"array dimensions {shape} out of range (1.., at most "
                         f"{MAX_ARRAY_SIZE} elements)")
@@ -93,7 +95,7 @@ def dimension(params: dict[str, Value], name: str, kind: str, shape: tuple[int, 
     elif kind in ("CHAR", "STRING"):
         params[name] = np.full(shape, "", dtype=object)
     elif kind == "TABLE":
-        params[name] = new_table(shape)
+        params[name] = new_table(shape, variables)
     else:
         raise ApdlError(f"field 2: array type must be ARRAY, TABLE, CHAR or STRING, got "
                         f"{kind!r}")

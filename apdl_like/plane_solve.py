@@ -28,6 +28,7 @@ from apdl_like.plane_thermal import (
     march,
 )
 from apdl_like.state import StepResult
+from apdl_like.tabular_loads import TabularLoads, tabular_loads
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -318,8 +319,38 @@ class _LoadState:
                    f.hflux.copy(), db.nodes.arrays["d_temp"].copy())
 
 
+def _tabular(s: SessionState, faces: FaceTable) -> TabularLoads | None:
+    """The loads that come from tables (`%NAME%`), looked up at nodes, face middles and
+    element centroids."""
+    db = s.db
+    if not db.load_tables:
+        return None
+    xy = db.nodes.xy
+    f = db.faces
+
+    def face_middles(idx: np.ndarray) -> np.ndarray:
+        return 0.5 * (xy[faces.face_nodes[0, idx]] + xy[faces.face_nodes[1, idx]])
+
+    def centroids(idx: np.ndarray) -> np.ndarray:
+        corners = corners_and_midside(db)[0][idx]
+        distinct = np.ones(corners.shape, bool)
+        distinct[:, 1:] = corners[:, 1:] != corners[:, :-1]  # K = L of a triangle: once
+        return (xy[corners] * distinct[..., None]).sum(axis=1) / distinct.sum(axis=1)[:, None]
+
+    def nodes(idx: np.ndarray) -> np.ndarray:
+        return xy[idx]
+
+    return tabular_loads(db, s.params, {
+        "hgen": (db.elements.arrays["hgen_table"], centroids),
+        "conv_h": (f.conv_h_table, face_middles), "conv_bulk": (f.conv_bulk_table, face_middles),
+        "hflux": (f.hflux_table, face_middles), "d_temp": (db.nodes.arrays["d_temp_table"], nodes)})
+
+
 def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
-            now: _LoadState, before: _LoadState | None, fraction: float) -> ThermalInputs:
+            now: _LoadState, before: _LoadState | None, fraction: float,
+            varying: bool = False) -> ThermalInputs:
+    """The solver's inputs from the loads `now`, ramped from `before` by `fraction`;
+    `varying`: the values of one load record may differ from face to face (tables)."""
     tunif = db.settings.tunif
 
     def ramp(new: np.ndarray, old: np.ndarray | None, start: float) -> np.ndarray:
@@ -334,7 +365,7 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
     h = ramp(now.conv_h, None if before is None else before.conv_h, 0.0)
     tb = ramp(now.conv_bulk, None if before is None else before.conv_bulk, tunif)
     rec = db.faces.conv_record
-    for idx in record_groups(rec, h if before is not None else None):
+    for idx in record_groups(rec, h if before is not None or varying else None):
         hv, tv = float(h[idx[0]]), float(tb[idx[0]])
         if np.isnan(hv) or np.isnan(tv):
             raise ApdlError("a face has CONV with only one of film coefficient and bulk "
@@ -408,10 +439,13 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
         sol.previous_loads = None
         sol.history_times, sol.history_temperatures = [], []
     now = _LoadState.of(db)
+    tables = _tabular(s, faces)
+    varying = tables is not None
     T0 = sol.temperature
     if not transient:
-        inputs = _inputs(db, mesh, faces, props, now, None, 1.0)
         end = settings.time if settings.time is not None else sol.time + 1.0
+        inputs = _inputs(db, mesh, faces, props, now if tables is None else tables.at(now, end),
+                         None, 1.0, varying)
         T = model.steady(inputs, T0, nonlinear)
         times, temps = [end], [T]
     else:
@@ -423,9 +457,16 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
                                 np.full_like(now.conv_bulk, np.nan),
                                 np.full_like(now.hflux, np.nan), np.full_like(now.d_temp, np.nan))
         start = sol.time
-        steady_inputs = _inputs(db, mesh, faces, props, now, None, 1.0)
+        steady_inputs = _inputs(db, mesh, faces, props,
+                                now if tables is None else tables.at(now, settings.time),
+                                None, 1.0, varying)
 
         def inputs_at(t: float) -> ThermalInputs:
+            if tables is not None:
+                # tabular entries take the table's value at t, unramped (in `before` too)
+                return _inputs(db, mesh, faces, props, tables.at(now, t),
+                               None if before is None else tables.at(before, t),
+                               (t - start) / span if ramped else 1.0, True)
             if not ramped:
                 return steady_inputs
             return _inputs(db, mesh, faces, props, now, before, (t - start) / span)
@@ -438,7 +479,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
     sol.substep_times, sol.substep_temperatures = times, temps
     sol.history_times += times
     sol.history_temperatures += temps
-    sol.previous_loads = now
+    sol.previous_loads = now if tables is None else tables.cleared(now)
     s.fem.plane_inputs = steady_inputs if transient else inputs
     return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature,
                       nodal_temperature=mesh.nodal(sol.temperature))

@@ -23,11 +23,19 @@ from apdl_like.fem_bridge import FemModel, build_model
 from apdl_like.model import record_groups
 from apdl_like.plane_solve import deck_faces, solve_plane_structural, solve_plane_thermal
 from apdl_like.state import TCC_LOCATION, StepResult
+from apdl_like.tabular_loads import in_use
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
 _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants positive values
+
+
+def refuse_tabular(session: SessionState, done: str) -> None:
+    """Tabular loads are solved on a deck's own mesh only (`apdl_like.plane_solve`)."""
+    if in_use(session.db):
+        raise ApdlError(f"tabular loads (%table%) are {done} on a deck's own mesh only, not on "
+                        "the spindle session's: give values")
 
 
 def fem_model(session: SessionState) -> FemModel:
@@ -249,6 +257,7 @@ def solve_thermal(session: SessionState) -> StepResult:
                         "their view factors only: /AUX12, VFQUERY)")
     if not session.fem.external_mesh:
         return solve_plane_thermal(session)
+    refuse_tabular(session, "solved")
     fem = fem_model(session)
     _check_axisymmetric(session, "thermal")
     problem = thermal_problem(session, fem)

@@ -13,7 +13,13 @@ import pytest
 
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
-from tests.apdl_decks import SOLVE_THEN_POST, film_heat_sum, held_faces
+from tests.apdl_decks import (
+    SOLVE_THEN_POST,
+    STEEL_SQUARE,
+    column_of_quads,
+    film_heat_sum,
+    held_faces,
+)
 
 RI, RO, H = 0.02, 0.05, 0.01  # hollow cylinder, m
 K = 50.0  # W/mK
@@ -193,14 +199,7 @@ def test_deltim_substeps_divide_the_load_step_as_documented(autots, deltim, firs
     StartingTime)/DTIME is an integer", rounding to the nearest; with AUTOTS, DTIME is the
     starting time substep.  Uniform heating of an insulated body is exact for any step."""
     s = run(f"""
-/PREP7
-ET,1,PLANE55
-MP,KXX,1,45
-MP,DENS,1,7800
-MP,C,1,460
-RECTNG,0,0.02,0,0.02
-ESIZE,0.01
-AMESH,ALL
+{STEEL_SQUARE}
 /SOLU
 ANTYPE,TRANS
 TUNIF,20
@@ -281,14 +280,7 @@ ET,1,PLANE55,,,1
 MP,KXX,1,{k}
 MP,DENS,1,{rho}
 MP,C,1,{c}
-NZE = 40
-*DO,I,0,NZE
-  N,I+1,0.01,{L}*I/NZE
-  N,I+101,0.02,{L}*I/NZE
-*ENDDO
-*DO,I,1,NZE
-  E,I,I+100,I+101,I+1
-*ENDDO
+{column_of_quads(L, 0.01, 0.02)}
 /SOLU
 ANTYPE,TRANS
 TUNIF,0

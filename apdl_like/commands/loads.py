@@ -2,7 +2,8 @@
 
 Every load command is a *record*: the entities it touches remember its id, so a later
 command on a subset overrides only that subset, and the solver can turn each record back
-into one region or boundary of the FEM mesh (see `apdl_like.fem_bridge`).
+into one region or boundary of the FEM mesh (see `apdl_like.fem_bridge`).  D,,TEMP, SF/SFE
+(CONV, HFLUX) and BF/BFE (HGEN) also take a table, `%NAME%` (`apdl_like.tabular_loads`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
 from apdl_like.model import pair_keys
 from apdl_like.solve import face_table
+from apdl_like.tabular_loads import mark, table_slot
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -82,18 +84,32 @@ _D_LABELS = {"TEMP": ("d_temp",), "UX": ("d_ux",), "UY": ("d_uy",), "ALL": ("d_u
 @command("D", LOADS, 11)
 def d(s: SessionState, c: Call) -> None:
     labels = [_dof_label(c, i) for i in (2, 7, 8, 9, 10, 11) if i == 2 or c.given(i)]
-    value = c.num(3, 0.0, what="VALUE")
+    value, slot = _dof_value(s, c, 3, labels, "VALUE")
     if c.given(4) and c.num(4) != 0.0:
         raise ApdlError("field 4 (VALUE2, imaginary part) is not supported")
-    _fix_dofs(s, node_targets(s, c, 1, end_field=5), labels, value)
+    _fix_dofs(s, node_targets(s, c, 1, end_field=5), labels, value, slot)
     s.note_load(c)
 
 
-def _fix_dofs(s: SessionState, idx: np.ndarray, labels: list[str], value: float) -> None:
+def _dof_value(s: SessionState, c: Call, i: int, labels: list[str],
+               what: str) -> tuple[float, int | None]:
+    """(value, None) of field i, or (placeholder, slot) when it names a table (TEMP only)."""
+    slot = table_slot(s, c, i)
+    if slot is None:
+        return c.num(i, 0.0, what=what), None
+    if any(lab != "TEMP" for lab in labels):
+        raise ApdlError(f"field {i} ({what}): a table is supported for TEMP only")
+    return 0.0, slot
+
+
+def _fix_dofs(s: SessionState, idx: np.ndarray, labels: list[str], value: float,
+              slot: int | None = None) -> None:
     arrays = s.db.nodes.arrays
     for lab in labels:
         for key in _D_LABELS[lab]:
             arrays[key][idx] = value
+    if "TEMP" in labels:
+        mark(s.db, arrays["d_temp_table"], idx, slot)
 
 
 def _dof_label(c: Call, i: int) -> str:
@@ -152,17 +168,18 @@ def dk(s: SessionState, c: Call) -> None:
         idx.append(int(np.argmin(dist)))
     if not idx:
         raise ApdlError("field 1: ALL, but no keypoint is selected (KSEL)")
-    _fix_dofs(s, np.array(idx), [_dof_label(c, 2)], c.num(3, 0.0, what="VALUE"))
+    labels = [_dof_label(c, 2)]
+    _fix_dofs(s, np.array(idx), labels, *_dof_value(s, c, 3, labels, "VALUE"))
     s.note_load(c)
 
 
 @command("DL", LOADS, 6)
 def dl(s: SessionState, c: Call) -> None:
     """DL,LINE,AREA,Lab,Value1: a DOF constraint on every node of a line."""
-    lab = _dof_label(c, 3)
+    labels = [_dof_label(c, 3)]
     if c.given(5):
         raise ApdlError("field 5 (Value2) is not supported")
-    _fix_dofs(s, _nodes_on_lines(s, c, 1), [lab], c.num(4, 0.0, what="Value1"))
+    _fix_dofs(s, _nodes_on_lines(s, c, 1), labels, *_dof_value(s, c, 4, labels, "Value1"))
     s.note_load(c)
 
 
@@ -176,6 +193,8 @@ def ddele(s: SessionState, c: Call) -> None:
     idx = node_targets(s, c, 1, end_field=3)
     for key in keys:
         s.db.nodes.arrays[key][idx] = np.nan
+    if "d_temp" in keys:
+        mark(s.db, s.db.nodes.arrays["d_temp_table"], idx, None)
 
 
 def _faces_on_nodes(s: SessionState, idx: np.ndarray) -> np.ndarray:
@@ -186,16 +205,22 @@ def _faces_on_nodes(s: SessionState, idx: np.ndarray) -> np.ndarray:
 
 
 def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | None,
-                   v2: float | None) -> None:
-    f = s.db.faces
-    rec = s.db.next_record()
+                   v2: float | None, slot1: int | None = None,
+                   slot2: int | None = None) -> None:
+    """Lab's values v1 (h or flux), v2 (bulk temperature) on the faces; a slot: the value
+    comes from that table (v1, v2 are placeholders then)."""
+    db = s.db
+    f = db.faces
+    rec = db.next_record()
     if lab == "CONV":
         if v1 is not None:
             if v1 < 0.0:
                 raise ApdlError(f"film coefficient must be ≥ 0, got {v1!r}")
             f.conv_h[faces] = v1
+            mark(db, f.conv_h_table, faces, slot1)
         if v2 is not None:
             f.conv_bulk[faces] = v2
+            mark(db, f.conv_bulk_table, faces, slot2)
         f.conv_record[faces] = rec
     elif lab == "RDSF":
         if v1 is None or not 0.0 < v1 <= 1.0:
@@ -205,6 +230,7 @@ def _set_face_load(s: SessionState, faces: np.ndarray, lab: str, v1: float | Non
     else:
         f.hflux[faces] = v1
         f.hflux_record[faces] = rec
+        mark(db, f.hflux_table, faces, slot1)
 
 
 @command("SF", LOADS, 4)
@@ -220,13 +246,16 @@ def _load_faces_on(s: SessionState, c: Call, nodes: np.ndarray, bulk_field: int,
     if lab not in ("CONV", "HFLUX", "RDSF"):
         raise ApdlError(f"field 2: surface load must be CONV, HFLUX or RDSF, got "
                         f"{lab or '(empty)'!r}")
-    v1 = c.num(3, what="VALUE")
-    v2 = c.num(bulk_field, what="bulk temperature") if lab == "CONV" else \
+    slot1 = table_slot(s, c, 3) if lab != "RDSF" else None
+    slot2 = table_slot(s, c, bulk_field) if lab == "CONV" else None
+    v1 = 0.0 if slot1 is not None else c.num(3, what="VALUE")
+    v2 = 0.0 if slot2 is not None else \
+        c.num(bulk_field, what="bulk temperature") if lab == "CONV" else \
         c.num(bulk_field, 1.0, what="enclosure number") if lab == "RDSF" else None
     faces = _faces_on_nodes(s, nodes)
     if faces.size == 0:
         raise ApdlError(f"no exterior element face has all its nodes on {where}")
-    _set_face_load(s, faces, lab, v1, v2)
+    _set_face_load(s, faces, lab, v1, v2, slot1, slot2)
     if lab != "RDSF":  # radiation surfaces also serve /AUX12 view factors without a SOLVE
         s.note_load(c)
 
@@ -250,8 +279,11 @@ def sfdele(s: SessionState, c: Call) -> None:
     f = s.db.faces
     if lab in ("CONV", "ALL"):
         f.conv_h[faces], f.conv_bulk[faces], f.conv_record[faces] = np.nan, np.nan, -1
+        mark(s.db, f.conv_h_table, faces, None)
+        mark(s.db, f.conv_bulk_table, faces, None)
     if lab in ("HFLUX", "ALL"):
         f.hflux[faces], f.hflux_record[faces] = np.nan, -1
+        mark(s.db, f.hflux_table, faces, None)
     if lab in ("RDSF", "ALL"):
         f.rdsf_emis[faces], f.rdsf_encl[faces] = np.nan, np.nan
 
@@ -295,25 +327,39 @@ def sfe(s: SessionState, c: Call) -> None:
     if lab not in ("CONV", "HFLUX"):
         raise ApdlError(f"field 3: surface load must be CONV or HFLUX, got {lab or '(empty)'!r}")
     kval = c.int(4, 0, what="KVAL")
-    value = c.num(5, what="VAL1")
-    for i in (6, 7, 8):
-        if c.given(i) and c.num(i) != value:
-            raise ApdlError("values varying along a face (VAL2..VAL4) are not supported")
+    value, slot = _uniform_value(s, c, 5, (6, 7, 8),
+                                 "values varying along a face (VAL2..VAL4) are not supported")
     faces = _element_faces(s, element_targets(s, c, 1), lkey)
     if lab == "CONV":
         if kval not in (0, 1, 2):
             raise ApdlError(f"field 4 (KVAL) must be 0/1 (film coefficient) or 2 (bulk "
                             f"temperature), got {kval}")
-        _set_face_load(s, faces, lab, value if kval < 2 else None, value if kval == 2 else None)
+        _set_face_load(s, faces, lab, value if kval < 2 else None, value if kval == 2 else None,
+                       slot if kval < 2 else None, slot if kval == 2 else None)
     else:
-        _set_face_load(s, faces, lab, value, None)
+        _set_face_load(s, faces, lab, value, None, slot)
     s.note_load(c)
 
 
-def _set_hgen(s: SessionState, elems: np.ndarray, value: float | None) -> None:
+def _uniform_value(s: SessionState, c: Call, first: int, others: tuple[int, ...],
+                   refusal: str) -> tuple[float, int | None]:
+    """(VAL1, None), or (placeholder, slot) when VAL1 names a table; VAL2.. blank or equal
+    (else ApdlError(refusal))."""
+    slot = table_slot(s, c, first)
+    value = 0.0 if slot is not None else c.num(first, what="VAL1")
+    for i in others:
+        if c.given(i) and (c.table(i) != c.table(first) if slot is not None else
+                           c.num(i) != value):
+            raise ApdlError(refusal)
+    return value, slot
+
+
+def _set_hgen(s: SessionState, elems: np.ndarray, value: float | None,
+              slot: int | None = None) -> None:
     arrays = s.db.elements.arrays
     arrays["hgen"][elems] = np.nan if value is None else value
     arrays["hgen_record"][elems] = -1 if value is None else s.db.next_record()
+    mark(s.db, arrays["hgen_table"], elems, slot)
 
 
 @command("BF", LOADS, 6)
@@ -329,7 +375,9 @@ def bf(s: SessionState, c: Call) -> None:
         if comp is None or comp.entity != "ELEM":
             raise ApdlError("HGEN by BF needs an element component; use BFE,ALL,HGEN,,value "
                             "for selected elements")
-        _set_hgen(s, element_targets(s, c, 1), c.num(3, what="VAL1"))
+        slot = table_slot(s, c, 3)
+        _set_hgen(s, element_targets(s, c, 1), 0.0 if slot is not None else
+                  c.num(3, what="VAL1"), slot)
     else:
         raise ApdlError(f"field 2: body load must be TEMP or HGEN, got {lab or '(empty)'!r}")
     s.note_load(c)
@@ -343,11 +391,9 @@ def bfe(s: SessionState, c: Call) -> None:
     stloc = c.int(3, 1, what="STLOC")
     if stloc != 1:
         raise ApdlError("field 3 (STLOC): only a uniform value from location 1 is supported")
-    value = c.num(4, what="VAL1")
-    for i in (5, 6, 7):
-        if c.given(i) and c.num(i) != value:
-            raise ApdlError("HGEN varying inside an element (VAL2..VAL4) is not supported")
-    _set_hgen(s, element_targets(s, c, 1), value)
+    value, slot = _uniform_value(s, c, 4, (5, 6, 7), "HGEN varying inside an element "
+                                 "(VAL2..VAL4) is not supported")
+    _set_hgen(s, element_targets(s, c, 1), value, slot)
     s.note_load(c)
 
 
@@ -398,12 +444,13 @@ def bfa(s: SessionState, c: Call) -> None:
     """BFA,AREA|ALL,HGEN,VAL1: heat generation on the elements of meshed areas (ALL: the
     selected ones), as MAPDL transfers an area body load to its elements."""
     db = s.db
-    value = c.num(3, what="VAL1")
+    slot = table_slot(s, c, 3)
+    value = 0.0 if slot is not None else c.num(3, what="VAL1")
     db.elements.flush()
     for num in _solid_entities(c, "BFA", db.areas, db.unselected_areas, "AREA", "area"):
         if num not in db.area_elements:
             raise ApdlError(f"area {num} is not meshed: AMESH it before BFA")
-        _set_hgen(s, db.elements.index(db.area_elements[num]), value)
+        _set_hgen(s, db.elements.index(db.area_elements[num]), value, slot)
     s.note_load(c)
 
 

@@ -61,7 +61,8 @@ def star_dim(s: SessionState, c: Call) -> None:
     shape = (c.int(3, 1, what="IMAX"), c.int(4, 1, what="JMAX"), c.int(5, 1, what="KMAX"))
     if kind == "STRING":
         shape = (shape[1], 1, 1)  # *DIM,Par,STRING,length,rows: rows of one string
-    dimension(s.params, name, kind, shape)
+    variables = (c.label(6), c.label(7), c.label(8))  # a TABLE's primary variables
+    dimension(s.params, name, kind, shape, variables)
 
 
 @command("*VFILL", ANY, 20)
