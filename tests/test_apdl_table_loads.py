@@ -18,6 +18,7 @@ from scipy.optimize import brentq
 from apdl_like.errors import ApdlError
 from apdl_like.session import Session
 from tests.apdl_decks import STEEL_SQUARE, column_of_quads
+from twin.fem import AxiMesh, Material
 
 K, RHO, C, L = 1.0, 1000.0, 1000.0, 0.01  # W/mK, kg/m³, J/kgK, m: α = 1e-6 m²/s
 ALPHA = K / (RHO * C)
@@ -288,3 +289,21 @@ def test_an_undefined_table_is_exit_2_from_the_command_line(tmp_path):
     line = SLAB.count("\n") + 2
     assert f"deck.inp:{line}: D: field 3: %TBOUND% names no parameter" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_the_spindle_session_refuses_tabular_loads():
+    """A twin session (an AxiMesh solved on twin.fem) takes values only: a table there is a
+    located error at SOLVE, and a window deck with one is refused when read."""
+    r, z = np.linspace(0.0, 0.02, 3), np.linspace(0.0, 0.04, 5)
+    mesh = AxiMesh.structured(r, z, regions={"body": lambda r, z: r >= 0.0},
+                              boundaries={"outer": lambda r, z: np.isclose(r, 0.02)})
+    deck = ("/SOLU\nANTYPE,TRANS\n*DIM,TB,TABLE,2,1,1,TIME\nTB(1,0) = 0,1\nTB(1,1) = 20,30\n"
+            "NSEL,S,LOC,X,0.02\nD,ALL,TEMP,%TB%\nALLSEL\nKBC,1\nTIME,1\nDELTIM,0.5\nSOLVE\n")
+    steel = Material(k=45.0, rho=7800.0, c=460.0)
+    session = Session.from_mesh(mesh, {"body": steel})
+    with pytest.raises(ApdlError, match=r"deck.inp:12: SOLVE: tabular loads \(%table%\) are "
+                                        "solved on a deck's own mesh only"):
+        session.run_text(deck, "deck.inp")
+    with pytest.raises(ApdlError, match=r"tabular loads \(%table%\) are read on a deck's own"):
+        Session.from_mesh(mesh, {"body": steel}).read_window_deck(
+            "WINDOW = 0\nT_START = 0\n" + deck)
