@@ -52,7 +52,7 @@ from skfem import (
 
 from apdl_like.errors import ApdlError
 from apdl_like.line_thermal import ThermalLinks
-from apdl_like.model import pair_keys
+from apdl_like.model import PAIR_BASE, pair_keys
 from twin.fem.stepper import (
     StepControl,
     SteppingError,
@@ -205,6 +205,19 @@ def _part(xy: np.ndarray, node_ids: np.ndarray, node_dof: np.ndarray, corners: n
         raise ApdlError("internal numbering error of the element dofs")  # pragma: no cover
     placeholder = sp.csr_matrix((0, 0))
     return Part(basis, placeholder, local, elements, facet_keys), n_global
+
+
+def _refuse_zero_length(part: Part, facets: np.ndarray) -> None:
+    """A face load needs faces of some length: two distinct nodes at one point (an element
+    edge I-J of zero length) have no facet map to integrate it on."""
+    mesh = part.basis.mesh
+    ends = mesh.p[:, mesh.facets[:, facets]]  # (2 coordinates, 2 ends, n)
+    length = np.hypot(*(ends[:, 1] - ends[:, 0]))
+    extent = max(float(np.ptp(mesh.p, axis=1).max()), 1e-300)
+    if np.any(length <= 1e-12 * extent):
+        key = int(part.facet_keys[facets[int(np.argmin(length))]])
+        raise ApdlError(f"a face load on the edge of nodes {key // int(PAIR_BASE)} and "
+                        f"{key % int(PAIR_BASE)}, which lie at one point (zero length)")
 
 
 # ----------------------------------------------------------------- the forms
@@ -366,6 +379,7 @@ class PlaneThermal:
         if cache_key not in self._facet_bases:
             part = self.mesh.parts[k]
             facets = np.nonzero(np.isin(part.facet_keys, keys))[0]
+            _refuse_zero_length(part, facets)
             self._facet_bases[cache_key] = FacetBasis(part.basis.mesh, part.basis.elem,
                                                       facets=facets) if facets.size else None
         return self._facet_bases[cache_key]

@@ -241,6 +241,15 @@ def test_fuzz_mutated_valid_deck(mutations):
     _only_apdl_errors("\n".join(lines))
 
 
+def test_a_face_load_on_an_edge_of_zero_length_is_a_located_error():
+    """Found by the mutation fuzz: nodes 1..5 at one point make edges of zero length, and the
+    flux on them had no facet map (scikit-fem's 'Zero Jacobian determinant', exit 1)."""
+    deck = VALID_DECK.replace("N,I+1,0.01+0.01*I,0", "N,I+1,0.01+0.0*I,0", 1)
+    with pytest.raises(ApdlError, match=r"fuzz.inp:17: SOLVE: a face load on the edge of nodes "
+                                        r"\d+ and \d+, which lie at one point"):
+        Session().run_text(deck, "fuzz.inp")
+
+
 def test_the_fuzzed_deck_itself_is_valid():
     s = run(VALID_DECK)
     # q ri / k ln(ro / ri) + T_o, the log profile of a hollow cylinder (4 elements: ~1 %)
