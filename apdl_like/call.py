@@ -108,7 +108,7 @@ class Call:
             reason = exc.reason
             if self.table(i) is not None:
                 reason = (f"a table ({text.strip()}) is not accepted here (tabular values: "
-                          "D,,TEMP, SF/SFE CONV and HFLUX, BF/BFE HGEN)")
+                          "D,,TEMP, F,,HEAT, SF/SFE CONV and HFLUX, BF/BFE HGEN)")
             raise ApdlError(f"field {i}{f' ({what})' if what else ''}: {reason}") from None
 
     def table(self, i: int) -> str | None:

@@ -89,10 +89,10 @@ class LoadSet:
 
 def record_solve(session: SessionState) -> dict:
     """What a SOLVE would solve, by mesh names (SOLVE with `record_only` set)."""
-    from apdl_like.solve import fem_model, refuse_tabular
+    from apdl_like.solve import fem_model, refuse_deck_mesh_loads
     from apdl_like.state import TCC_LOCATION
 
-    refuse_tabular(session, "read")
+    refuse_deck_mesh_loads(session, "read")
     fem = fem_model(session)
     db = session.db
     el = db.elements.arrays

@@ -151,8 +151,10 @@ class NodeTable(_NumberedTable):
         "bf_temp": np.nan,
         "ic_temp": np.nan,
         "d_temp_table": -1,  # D,,TEMP,%table%: its slot in Database.load_tables (-1: none)
+        "f_heat": np.nan,  # F,,HEAT: heat flow into the node, W (axisymmetric: 360°)
+        "f_heat_table": -1,
     }
-    DTYPES = {"selected": bool, "d_temp_table": np.int64}  # the others: float
+    DTYPES = {"selected": bool, "d_temp_table": np.int64, "f_heat_table": np.int64}
 
     def __init__(self) -> None:
         self.ids = np.zeros(0, dtype=np.int64)

@@ -10,7 +10,7 @@ are keyed by their corner node numbers (`FaceTable`), so loads survive a rebuilt
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -311,12 +311,18 @@ class _LoadState:
     conv_bulk: np.ndarray
     hflux: np.ndarray
     d_temp: np.ndarray  # per node (NaN: free)
+    f_heat: np.ndarray  # per node, W (NaN: none)
 
     @classmethod
     def of(cls, db: Database) -> _LoadState:
         f = db.faces
+        nodes = db.nodes.arrays
         return cls(db.elements.arrays["hgen"].copy(), f.conv_h.copy(), f.conv_bulk.copy(),
-                   f.hflux.copy(), db.nodes.arrays["d_temp"].copy())
+                   f.hflux.copy(), nodes["d_temp"].copy(), nodes["f_heat"].copy())
+
+    def none(self) -> _LoadState:
+        """No load anywhere (NaN): where the ramps of a first load step start."""
+        return _LoadState(*(np.full_like(a, np.nan) for a in astuple(self)))
 
 
 def _tabular(s: SessionState, faces: FaceTable) -> TabularLoads | None:
@@ -343,7 +349,8 @@ def _tabular(s: SessionState, faces: FaceTable) -> TabularLoads | None:
     return tabular_loads(db, s.params, {
         "hgen": (db.elements.arrays["hgen_table"], centroids),
         "conv_h": (f.conv_h_table, face_middles), "conv_bulk": (f.conv_bulk_table, face_middles),
-        "hflux": (f.hflux_table, face_middles), "d_temp": (db.nodes.arrays["d_temp_table"], nodes)})
+        "hflux": (f.hflux_table, face_middles), "d_temp": (db.nodes.arrays["d_temp_table"], nodes),
+        "f_heat": (db.nodes.arrays["f_heat_table"], nodes)})
 
 
 def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
@@ -381,9 +388,12 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
     d = ramp(now.d_temp, None if before is None else before.d_temp, tunif)
     nodes_fixed = np.nonzero(~np.isnan(now.d_temp) & (mesh.node_dof >= 0))[0]
     fixed = (mesh.node_dof[nodes_fixed], d[nodes_fixed])
+    heat = ramp(now.f_heat, None if before is None else before.f_heat, 0.0)
+    heated = np.nonzero(~np.isnan(heat) & (heat != 0.0) & (mesh.node_dof >= 0))[0]
+    nodal_heat = (mesh.node_dof[heated], heat[heated]) if heated.size else None
     enthalpy = props["enthalpy"] if any(h is not None for h in props["enthalpy"]) else None
     return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed,
-                         enthalpy, props["hf"], props["specific_heat"])
+                         enthalpy, props["hf"], props["specific_heat"], nodal_heat)
 
 
 def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
@@ -453,9 +463,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
         ramped = settings.kbc == 0
         before = sol.previous_loads if ramped else None
         if ramped and before is None:
-            before = _LoadState(np.full_like(now.hgen, np.nan), np.full_like(now.conv_h, np.nan),
-                                np.full_like(now.conv_bulk, np.nan),
-                                np.full_like(now.hflux, np.nan), np.full_like(now.d_temp, np.nan))
+            before = now.none()
         start = sol.time
         steady_inputs = _inputs(db, mesh, faces, props,
                                 now if tables is None else tables.at(now, settings.time),

@@ -252,6 +252,7 @@ class ThermalInputs:
     films            (face keys, h W/m²K, T_bulk °C) groups; keys: packed corner node numbers
     fluxes           (face keys, q W/m²) groups
     fixed            (dofs, values °C)
+    nodal_heat       (dofs, heat flows W) of F,,HEAT, or None
     hf, specific_heat  per material MP,HF and MP,C callables (or None), for the links
     enthalpy         per material H(T) J/m³ (MPDATA,ENTH) or None: a transient step's
                      capacity is then the secant (H(T1) − H(T0)) / (T1 − T0), so a step
@@ -268,6 +269,7 @@ class ThermalInputs:
     enthalpy: list[Property | None] | None = None
     hf: list[Property | None] | None = None
     specific_heat: list[Property | None] | None = None
+    nodal_heat: tuple[np.ndarray, np.ndarray] | None = None
 
 
 class PlaneThermal:
@@ -362,6 +364,8 @@ class PlaneThermal:
                 fb = self._facet_basis(k, keys)
                 if fb is not None:
                     f = f + S @ load.assemble(fb, g=flux, axisymmetric=ax)
+        if inputs.nodal_heat is not None:
+            f = f + np.bincount(inputs.nodal_heat[0], inputs.nodal_heat[1], minlength=n)
         if self.mesh.lumped:
             C = row_sum_lumped(C).tocsr()
         if self.links is not None:

@@ -31,11 +31,16 @@ if TYPE_CHECKING:
 _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants positive values
 
 
-def refuse_tabular(session: SessionState, done: str) -> None:
-    """Tabular loads are solved on a deck's own mesh only (`apdl_like.plane_solve`)."""
-    if in_use(session.db):
+def refuse_deck_mesh_loads(session: SessionState, done: str) -> None:
+    """Tabular loads and F,,HEAT are solved on a deck's own mesh only
+    (`apdl_like.plane_solve`), not on twin.fem's spindle."""
+    db = session.db
+    if in_use(db):
         raise ApdlError(f"tabular loads (%table%) are {done} on a deck's own mesh only, not on "
                         "the spindle session's: give values")
+    if np.any(~np.isnan(db.nodes.arrays["f_heat"])):
+        raise ApdlError(f"nodal heat flows (F,,HEAT) are {done} on a deck's own mesh only, not "
+                        "on the spindle session's")
 
 
 def fem_model(session: SessionState) -> FemModel:
@@ -257,7 +262,7 @@ def solve_thermal(session: SessionState) -> StepResult:
                         "their view factors only: /AUX12, VFQUERY)")
     if not session.fem.external_mesh:
         return solve_plane_thermal(session)
-    refuse_tabular(session, "solved")
+    refuse_deck_mesh_loads(session, "solved")
     fem = fem_model(session)
     _check_axisymmetric(session, "thermal")
     problem = thermal_problem(session, fem)

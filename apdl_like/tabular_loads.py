@@ -1,13 +1,13 @@
 """Tabular loads: a load value given as `%NAME%`, a TABLE parameter looked up at the time
 and place the load acts (MAPDL's tabular boundary conditions).
 
-A load command (D,,TEMP; SF/SFE CONV film coefficient and bulk temperature, HFLUX; BF/BFE
-HGEN) that names a table stores the table's slot (its position in `Database.load_tables`)
+A load command (D,,TEMP; F,,HEAT; SF/SFE CONV film coefficient and bulk temperature, HFLUX;
+BF/BFE HGEN) that names a table stores the table's slot (its position in `Database.load_tables`)
 beside a placeholder value.  SOLVE looks the table up, with the table's linear interpolation
 and end values (`apdl_like.table_array`), at
 
 - time: each substep's time in a transient load step, the load step's TIME in a steady one;
-- place: the node of a D, the middle of an element face for SF/SFE (a face carries one value
+- place: the node of a D or F, the middle of an element face for SF/SFE (a face carries one value
   here), the centroid of an element for BF/BFE.
 
 Primary variables (*DIM's Var1..Var3): TIME, and X, Y in global Cartesian coordinates (X is
@@ -87,7 +87,8 @@ def in_use(db: Database) -> bool:
         return False
     f = db.faces
     return any(bool(np.any(a >= 0)) for a in (
-        db.nodes.arrays["d_temp_table"], db.elements.arrays["hgen_table"],
+        db.nodes.arrays["d_temp_table"], db.nodes.arrays["f_heat_table"],
+        db.elements.arrays["hgen_table"],
         f.conv_h_table, f.conv_bulk_table, f.hflux_table))
 
 

@@ -1,4 +1,5 @@
-"""Tabular loads (`D,ALL,TEMP,%T%`, SF/SFE CONV and HFLUX, BF/BFE HGEN) against closed forms.
+"""Tabular loads (`D,ALL,TEMP,%T%`, F,,HEAT, SF/SFE CONV and HFLUX, BF/BFE HGEN) and nodal
+heat flows (F,,HEAT) against closed forms.
 
 Every expected value is a textbook formula (series, Duhamel superposition, energy balance,
 linear profiles) evaluated here, never a number taken from the code.
@@ -256,6 +257,63 @@ SOLVE
     assert np.max(np.abs(got - exact)) < 2e-3 * np.max(exact)
 
 
+def test_nodal_heat_flow_f_heat_conducts_through_the_slab():
+    """F,n,HEAT puts VALUE into each node: 0.05 W on each of the two nodes at y = 0 of the
+    1 mm wide (unit thickness) column, T = 0 at y = L: q = 0.1 W / 1e-3 m² and
+    T(0) = q L/k = 1 °C, exact for linear elements.  FDELE takes it away again."""
+    s = run(SLAB + f"""
+/SOLU
+ANTYPE,STATIC
+NSEL,S,LOC,Y,{L}
+D,ALL,TEMP,0
+NSEL,S,LOC,Y,0
+F,ALL,HEAT,0.05
+ALLSEL
+SOLVE
+*GET,T_A,NODE,1,TEMP
+FDELE,ALL,HEAT
+SOLVE
+*GET,T_B,NODE,1,TEMP
+""")
+    assert s.params["T_A"] == pytest.approx(0.1 / 1e-3 * L / K, rel=1e-10)
+    assert s.params["T_B"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_nodal_heat_flow_from_a_table_heats_an_axisymmetric_ring_by_its_energy():
+    """F,n,HEAT,%QF% on an axisymmetric ring (MAPDL: the heat of the whole circumference),
+    Q(t) = 10 t W for 10 s; with a conductivity high enough to keep it uniform, the insulated
+    ring warms by its energy over ρcV, V = π(ro² − ri²)h.  Backward Euler takes each substep's
+    load at its end: E = Σ Q(k Δt) Δt = 550 J (the integral is 500 J), exactly."""
+    ri, ro, h, rho_c = 0.01, 0.03, 0.02, 7800 * 460
+    s = run(f"""
+/PREP7
+ET,1,PLANE55,,,1
+MP,KXX,1,1E9
+MP,DENS,1,7800
+MP,C,1,460
+RECTNG,{ri},{ro},0,{h}
+ESIZE,0.005
+AMESH,ALL
+*DIM,QF,TABLE,2,1,1,TIME
+QF(1,0) = 0,10
+QF(1,1) = 0,100
+/SOLU
+ANTYPE,TRANS
+TUNIF,20
+KBC,1
+AUTOTS,OFF
+F,NODE({ri},0),HEAT,%QF%
+TIME,10
+DELTIM,1
+SOLVE
+*GET,T_A,NODE,NODE({ro},{h}),TEMP
+""")
+    energy = sum(10.0 * k * 1.0 for k in range(1, 11))
+    assert energy == 550.0
+    volume = math.pi * (ro**2 - ri**2) * h
+    assert s.params["T_A"] == pytest.approx(20.0 + energy / (rho_c * volume), rel=1e-6)
+
+
 @pytest.mark.parametrize("deck, message", [
     ("NSEL,S,LOC,Y,0\nD,ALL,TEMP,%NOPE%",
      r"deck.inp:\d+: D: field 3: %NOPE% names no parameter"),
@@ -267,6 +325,7 @@ SOLVE
     ("*DIM,A,ARRAY,2\nBFE,ALL,HGEN,,%A%", r"BFE: field 4: %A% is not a TABLE parameter"),
     ("IC,ALL,TEMP,%RAMP%", r"IC: field 3 \(VALUE\): a table \(%RAMP%\) is not accepted here"),
     ("D,1,UX,%RAMP%", r"D: field 3 \(VALUE\): a table is supported for TEMP only"),
+    ("F,1,FX,1", r"F: field 2: nodal load must be HEAT, got 'FX'"),
 ])
 def test_bad_table_loads_are_located_errors(deck, message):
     with pytest.raises(ApdlError, match=message):
@@ -307,3 +366,7 @@ def test_the_spindle_session_refuses_tabular_loads():
     with pytest.raises(ApdlError, match=r"tabular loads \(%table%\) are read on a deck's own"):
         Session.from_mesh(mesh, {"body": steel}).read_window_deck(
             "WINDOW = 0\nT_START = 0\n" + deck)
+    with pytest.raises(ApdlError, match=r"SOLVE: nodal heat flows \(F,,HEAT\) are solved on a "
+                                        "deck's own mesh only"):
+        Session.from_mesh(mesh, {"body": steel}).run_text(
+            deck.replace("D,ALL,TEMP,%TB%", "F,ALL,HEAT,5"), "deck.inp")

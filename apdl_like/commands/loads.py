@@ -1,9 +1,10 @@
-"""Loads (valid in /PREP7 and /SOLU): D, SF, SFE, BF, BFE, IC, TUNIF, BFUNIF, TREF.
+"""Loads (valid in /PREP7 and /SOLU): D, F, SF, SFE, BF, BFE, IC, TUNIF, BFUNIF, TREF.
 
 Every load command is a *record*: the entities it touches remember its id, so a later
 command on a subset overrides only that subset, and the solver can turn each record back
-into one region or boundary of the FEM mesh (see `apdl_like.fem_bridge`).  D,,TEMP, SF/SFE
-(CONV, HFLUX) and BF/BFE (HGEN) also take a table, `%NAME%` (`apdl_like.tabular_loads`).
+into one region or boundary of the FEM mesh (see `apdl_like.fem_bridge`).  D,,TEMP, F,,HEAT,
+SF/SFE (CONV, HFLUX) and BF/BFE (HGEN) also take a table, `%NAME%`
+(`apdl_like.tabular_loads`).
 """
 
 from __future__ import annotations
@@ -116,6 +117,33 @@ def _dof_label(c: Call, i: int) -> str:
     if (lab := c.label(i)) in _D_LABELS:
         return lab
     raise ApdlError(f"field {i}: DOF label must be TEMP, UX, UY or ALL, got {lab or '(empty)'!r}")
+
+
+@command("F", LOADS, 6)
+def f_load(s: SessionState, c: Call) -> None:
+    """F,NODE,HEAT,VALUE,,NEND,NINC: a heat flow into nodes, W (axisymmetric: over the whole
+    circumference, as MAPDL takes it), a value or a table."""
+    if c.label(2) != "HEAT":
+        raise ApdlError(f"field 2: nodal load must be HEAT, got {c.label(2) or '(empty)'!r}")
+    if c.given(4) and c.num(4) != 0.0:
+        raise ApdlError("field 4 (VALUE2, imaginary part) is not supported")
+    slot = table_slot(s, c, 3)
+    value = 0.0 if slot is not None else c.num(3, 0.0, what="VALUE")
+    idx = node_targets(s, c, 1, end_field=5)
+    arrays = s.db.nodes.arrays
+    arrays["f_heat"][idx] = value
+    mark(s.db, arrays["f_heat_table"], idx, slot)
+    s.note_load(c)
+
+
+@command("FDELE", LOADS, 4)
+def fdele(s: SessionState, c: Call) -> None:
+    """FDELE,NODE,HEAT|ALL,NEND,NINC."""
+    if c.label(2, "ALL") not in ("HEAT", "ALL"):
+        raise ApdlError(f"field 2 must be HEAT or ALL, got {c.label(2)!r}")
+    idx = node_targets(s, c, 1, end_field=3)
+    s.db.nodes.arrays["f_heat"][idx] = np.nan
+    mark(s.db, s.db.nodes.arrays["f_heat_table"], idx, None)
 
 
 # ------------------------------------------------------------------ solid-model loads
@@ -489,6 +517,6 @@ def tref(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(d, ddele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfa, bfedele, ic, tunif, bfunif,
-              tref),
+    *specs_of(d, ddele, f_load, fdele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfa, bfedele,
+              ic, tunif, bfunif, tref),
 )
