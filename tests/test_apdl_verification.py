@@ -686,6 +686,10 @@ SOLVE
     ("LSEL,S,LOC,X,0\nDL,ALL,,TEMP,{t0}", "LSEL,S,LOC,X,{length}\nSFL,ALL,CONV,{h},,{tb}"),
     ("LSEL,S,LINE,,4\nDL,ALL,,TEMP,{t0}",
      "LSEL,S,LOC,Y,0,1\nLSEL,R,LOC,X,0.09,1\nSFL,ALL,CONV,{h},,{tb}"),
+    # the same values from tables (%NAME%) of one row, their value at every TIME
+    ("*DIM,TT,TABLE,1,1,1,TIME\nTT(1,1) = {t0}\nDL,4,,TEMP,%TT%",
+     "*DIM,TH,TABLE,1,1,1,TIME\nTH(1,1) = {h}\n*DIM,TB,TABLE,1,1,1,TIME\nTB(1,1) = {tb}\n"
+     "SFL,2,CONV,%TH%,,%TB%"),
 ])
 def test_solid_model_loads_dl_and_sfl_on_a_convecting_slab(left, right):
     """Planar slab (k, length L), DL: T0 on the line x = 0, SFL: film h to T_b on the line
