@@ -253,8 +253,9 @@ SOLVE
     x = nodes.xy[:, 0]
     exact = q0 * x * (w**2 - x**2) / (6 * k * w)
     got = s.state.solution.results[-1].nodal_temperature
-    # the element-centroid sampling of q converges as h²: 40 elements along x
-    assert np.max(np.abs(got - exact)) < 2e-3 * np.max(exact)
+    # q sampled at element centroids: for a linear q the slope terms of the two elements
+    # at an interior node cancel, so its load, and the 1-D nodal solution, are exact
+    assert np.max(np.abs(got - exact)) < 1e-9 * np.max(exact)
 
 
 def test_nodal_heat_flow_f_heat_conducts_through_the_slab():
