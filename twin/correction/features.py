@@ -197,14 +197,41 @@ class WindowFeatures:
         """T1..T5 at the start of the run: the first finite sample of each sensor (°C)."""
         return first_finite(self.measured_C)
 
+    def seen_in_last_window(self) -> np.ndarray:
+        """(5,) True for each of T1..T5 with a valid sample in the last window (the span of
+        `window_line_fit`: a column with a finite sample there has a level)."""
+        time = self.measured_time_s
+        in_span = (time > self.start_s - self.window_s - 1e-9) & (time <= self.start_s + 1e-9)
+        return np.isfinite(self.measured_C[in_span]).any(axis=0)
+
     def dead_rings(self) -> tuple[str, ...]:
         """Bearings whose ring sensor has no valid sample in the last window while the
         sleeve sensor has (a stuck or dropped-out ring thermocouple)."""
-        # the span of `window_line_fit`: a column with a finite sample there has a level
-        time = self.measured_time_s
-        in_span = (time > self.start_s - self.window_s - 1e-9) & (time <= self.start_s + 1e-9)
-        seen = np.isfinite(self.measured_C[in_span]).any(axis=0)
+        seen = self.seen_in_last_window()
         return tuple(b for b in BEARINGS if not seen[RING_SENSOR[b]] and seen[SLEEVE_SENSOR[b]])
+
+    def without_dead_sensors(self) -> WindowFeatures:
+        """These features with the measured column of every sensor that has no valid
+        sample in the last window left out entirely (NaN): a correction then holds what
+        that sensor would correct instead of reading its last value before it died.
+
+        Why: `RatioCorrection` falls back on a sensor's last valid sample when the last
+        window has none.  For a sleeve in a dropout that stale value entered the Eq. 5
+        pressure factor of *now* while the factor of the window before (level minus rise,
+        and the rise is unknown) was neutral, so every window of the dropout multiplied
+        the resistance by the whole pressure factor since the start: a rear sleeve lost
+        for 6 min across a step to 14 500 rpm took the rear resistance to its lower guard,
+        and the twin's T4 needed 15 min to come back (suite 555 run 4).  The drop ratio
+        (Eq. 6) compared the stale sleeve with the twin's moving one as well.  Without the
+        column every factor it enters is neutral: the resistance is held until the sleeve
+        reads again (a dead ring is then read on its sleeve, `with_sleeve_for_dead_rings`).
+        """
+        seen = self.seen_in_last_window()
+        if seen.all():
+            return self
+        measured = self.measured_C.copy()
+        measured[:, ~seen] = np.nan
+        return dataclasses.replace(self, measured_C=measured)
 
     def with_sleeve_for_dead_rings(self) -> WindowFeatures:
         """These features with the ring column (measured and simulated) of each of

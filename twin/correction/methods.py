@@ -144,7 +144,9 @@ def ratio_anchor(features: WindowFeatures, anchor_factors: ArrayLike) -> np.ndar
     """The value the anchored networks correct, in BoundaryValues order: the ratio law
     (`RatioCorrection`) applied to the previous *anchor* — `anchor_factors`, its factors
     on the previous nominal values (ones at window 0) — not to the corrected values, with a
-    dead ring sensor's place taken by its sleeve (`WindowFeatures.with_sleeve_for_dead_rings`).
+    dead ring sensor's place taken by its sleeve (`WindowFeatures.with_sleeve_for_dead_rings`)
+    and no sensor read on its last value from before it died
+    (`WindowFeatures.without_dead_sensors`: a resistance is held while its sleeve is dead).
 
     Why its own chain: the ratio law is an integral action on the key-point error.  Chained
     on the corrected values, any lasting network output δ would settle where the ratio
@@ -156,7 +158,7 @@ def ratio_anchor(features: WindowFeatures, anchor_factors: ArrayLike) -> np.ndar
     Why the sleeve: with T3 stuck the ratio law has nothing to correct the rear heat by and
     holds it; the twin's T4 then ran 1.8 K off on a suite run, on the sleeve 0.2 K.
     """
-    f = features.with_sleeve_for_dead_rings()
+    f = features.without_dead_sensors().with_sleeve_for_dead_rings()
     factors = tuple(float(a) for a in np.asarray(anchor_factors, dtype=float))
     f = dataclasses.replace(f, previous_factors=factors)
     return np.asarray(RatioCorrection().correct(f).values, dtype=float)
