@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "f7b80109fe5aebcef1c57aab578fe41081bbad9e72abb4f702d1d5e5460bf879"
+BUNDLED_MODEL_SHA256 = "3b8daaa9a948ba4b87f00d60435754394fe642b838e5d096dc8174aa4f14a05f"
 
 
 def _make_model():

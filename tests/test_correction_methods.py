@@ -233,3 +233,61 @@ def test_paper_literal_law_is_worse_in_closed_loop():
     values_default, err_default = _twin(RatioCorrection(), t, T)
     assert err_paper[0] > 2 * err_default[0]
     assert np.std(values_paper[-10:, 0]) > 3 * np.std(values_default[-10:, 0])
+
+
+def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
+    from twin.correction.methods import ratio_anchor
+
+    t, T = _measured()
+    T = T.copy()
+    T[(t > 300) & (t <= 600), 3] = np.nan  # T4 (rear sleeve) drops out while warming up
+    nominal = _nominal()
+    previous = BoundaryValues(*(np.array(nominal) * 1.05))
+    sim = T + np.array([0.3, 0.2, 0.4, 0.1, 0.0])
+    sim[:, 3] = np.where(np.isnan(sim[:, 3]), T[:, 2] - 1.0, sim[:, 3])  # the twin has T4
+    upto = t <= 600
+    factors = (1.05, 1.05, 1.05, 1.05)
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto], t[upto], sim[upto],
+                       nominal, previous, previous_factors=factors)
+    absent = T[upto].copy()
+    absent[:, 3] = np.nan  # as if the rear sleeve had never been recorded
+    g = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], absent, t[upto], sim[upto],
+                       nominal, previous, previous_factors=factors)
+    anchor = ratio_anchor(f, np.array(factors))
+    # the ratio law reads T4 at 300 s as now: the Eq. 5 pressure factor of the whole warm-up
+    # lands on the rear resistance in this one window
+    stale = np.array(RatioCorrection().correct(f).values)
+    assert stale[3] / anchor[3] < 0.9
+    # the anchor holds what the dead sleeve would correct, as for a sensor never recorded;
+    # the front bearing and the rear heat are read as before
+    assert anchor == pytest.approx(np.array(RatioCorrection().correct(g).values), rel=1e-12)
+    assert anchor[[0, 1, 2]] == pytest.approx(stale[[0, 1, 2]], rel=1e-12)
+
+
+def test_anchored_inputs_are_relative_to_the_twins_rise_and_drop():
+    """Twice the heat flux doubles every rise, drop and error; the networks' rows (their
+    loop gain on a log factor) stay the same, as the ratio law's Eq. 2 and Eq. 6 do."""
+    t, T = _measured(noise=0.0)
+    sim = AMBIENT + (T - AMBIENT) * np.array([1.1, 0.95, 1.1, 1.0, 1.0])
+    upto = t <= 900
+    nominal = _nominal()
+    anchor = np.array(nominal) * 1.1
+
+    def rows(scale):
+        f = WindowFeatures(15, 900.0, SPEED, AMBIENT, t[upto],
+                           AMBIENT + scale * (T[upto] - AMBIENT), t[upto],
+                           AMBIENT + scale * (sim[upto] - AMBIENT), nominal, nominal)
+        return f.anchored_inputs(anchor)
+
+    # (×4: the twin's rear drop, 0.4 K here, is then above the 0.5 K floor of the divisor)
+    once, twice = rows(4.0), rows(8.0)
+    for output in once:
+        assert np.all(np.isfinite(once[output]))
+        assert twice[output] == pytest.approx(once[output], rel=1e-9, abs=1e-12)
+    # the resistance rows carry the drop error per unit of the twin's drop
+    ring, sleeve = 0, 1
+    level = window_line_fit(t[upto], AMBIENT + 4 * (T[upto] - AMBIENT), 900.0)[0]
+    level_sim = window_line_fit(t[upto], AMBIENT + 4 * (sim[upto] - AMBIENT), 900.0)[0]
+    drop_error = (level[ring] - level[sleeve]) - (level_sim[ring] - level_sim[sleeve])
+    assert once["resistance_front"][0, 2] == pytest.approx(
+        drop_error / (level_sim[ring] - level_sim[sleeve]), rel=1e-9)

@@ -41,7 +41,7 @@ def test_round_trip(tmp_path, config):
         assert np.array_equal(back.predict(output, x, anchor), model.predict(output, x, anchor))
     # the file names the inputs of its configuration
     names = back.metadata["inputs"]["heat_front"]
-    assert ("previous_log_correction" in names) == config.anchored
+    assert ("drop_level_error_per_drop" in names) == config.anchored
     assert ("nominal_heat_W_m3" in names) == (not config.anchored)
     assert not list(tmp_path.glob(".*.tmp"))  # atomic write left nothing behind
 

@@ -63,8 +63,11 @@ def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
     rows = samples[0].anchored_inputs["heat_front"]
     assert np.isnan(rows[0, 3])  # window 0: no rise to compare yet (the anchor is used)
     np.testing.assert_array_equal(rows[1:, 4], 60.0 * np.arange(1, 6))
-    # undriven, the network's previous correction on the anchor is none
-    np.testing.assert_allclose(rows[1:, 5], 0.0, atol=1e-12)
+    # the sixth input is the other signal of the bearing: a heat network sees the drop
+    # error a resistance network sees first, and the reverse (never its own past output)
+    drop_rows = samples[0].anchored_inputs["resistance_front"]
+    np.testing.assert_array_equal(rows[1:, 5], drop_rows[1:, 2])
+    np.testing.assert_array_equal(drop_rows[1:, 5], rows[1:, 2])
     np.testing.assert_array_equal(samples[0].anchors["heat_front"], exact.anchors[:, 0])
 
 

@@ -57,27 +57,52 @@ ANCHORED_INPUT_NAMES = {
     "heat": (
         "speed_rpm",
         "anchor_log_factor",
-        "ring_level_error_C",
-        "ring_rise_error_C",
+        "ring_level_error_per_rise",
+        "ring_rise_error_per_rise",
         "run_time_s",
-        "previous_log_correction",
+        "drop_level_error_per_drop",
     ),
     "resistance": (
         "speed_rpm",
         "anchor_log_factor",
-        "drop_level_error_C",
-        "drop_rise_error_C",
+        "drop_level_error_per_drop",
+        "drop_rise_error_per_drop",
         "run_time_s",
-        "previous_log_correction",
+        "ring_level_error_per_rise",
     ),
 }
 """Six inputs per network of the anchored configuration (`twin.correction.network.ANCHORED`),
 which learns a log-correction on the ratio-law value (the anchor).  Errors are measured
 minus simulated key point (ring, or ring-to-sleeve drop) from a line through the last
 window: the level the ratio law also reads, and the *rate* (rise over the window), which it
-does not (a speed step or a lagging correction shows there first).  The anchor's log factor
-on nominal says where the ratio law stands, the previous log-correction what the network
-itself added last window.  See `WindowFeatures.anchored_inputs`."""
+does not (a speed step or a lagging correction shows there first).  Both are relative:
+divided by the twin's own ring rise over ambient (heat) or ring-to-sleeve drop (resistance),
+at least `RELATIVE_ERROR_FLOOR_C`, as the ratio law's Eq. 2 and Eq. 6 divide.  The anchor's
+log factor on nominal says where the ratio law stands; the sixth input is the level error of
+the bearing's other key-point signal (the drop for a heat network, the ring for a resistance
+network), which tells a heat error from a resistance error.  See
+`WindowFeatures.anchored_inputs`.
+
+Why not the network's own previous log-correction (the sixth input until the model of
+2026-11-22): in training it is the previous window's look-ahead fit (or the anchor, or a
+random scatter), a near copy of the target, and the networks learnt to repeat it (gain
+0.88–0.94).  In closed loop they read their own output there instead, an integrator that
+no measurement checks: on suite 31337 run 8 the rear resistance walked 1.5 → 5 → 0.2 of its
+nominal value over 25 min while T4 ran 3 K off."""
+
+RELATIVE_ERROR_FLOOR_C = 0.5
+"""Least divisor (K) of the anchored networks' relative errors: ten times a thermocouple's
+noise, as `twin.correction.formulas.RatioGuards.total`, so a rise or drop of the size of the
+noise (the run's first seconds, a stop) does not blow the error up.
+
+Why relative: the drop across a contact is heat flux × resistance, so a change δ of log R
+moves it by about δ × drop.  With the error in kelvin, a network's gain on log R per window
+is its weight × the drop: the bundled networks had learnt 0.53 per K on runs where the
+front drop is 2–11 K, and at ≥ 14 000 rpm (drop 6–9 K) that closed loop exceeded the gain of
+2 at which a per-window correction overshoots by more than it corrects.  Front resistance
+and, through T1, the anchor's front heat then swung window by window (T1 ±1–2 K on suite
+31337 runs 4 and 8 and suite 90210 run 3, where the ratio law alone held it within
+0.3 K).  Per unit of the drop, the same error means the same δ at any speed, as in Eq. 6."""
 
 TARGET_UNITS = {"heat": "W/m³", "resistance": "m²K/W"}
 
@@ -251,11 +276,9 @@ class WindowFeatures:
             simulated[:, ring] = simulated[:, sleeve]
         return dataclasses.replace(self, measured_C=measured, simulated_C=simulated)
 
-    def anchored_inputs(self, anchor: ArrayLike,
-                        previous_anchor_factors: ArrayLike) -> dict[str, np.ndarray]:
+    def anchored_inputs(self, anchor: ArrayLike) -> dict[str, np.ndarray]:
         """The (1, 6) input row of each anchored network (ANCHORED_INPUT_NAMES) for this
-        window, given the anchor values (4,) and the previous window's anchor as factors on
-        its nominal values (4,), in BoundaryValues order.
+        window, given the anchor values (4,) in BoundaryValues order.
 
         A row is NaN where it has no meaning — window 0 (no rise yet), a stopped bearing's
         heat, a missing sensor, a dead ring (the networks never saw a sleeve standing in for
@@ -266,25 +289,29 @@ class WindowFeatures:
         sim_level, sim_rise = window_line_fit(self.simulated_time_s, self.simulated_C,
                                               self.start_s, self.window_s)
         level_error, rise_error = meas_level - sim_level, meas_rise - sim_rise
+        floor = RELATIVE_ERROR_FLOOR_C
         with np.errstate(divide="ignore", invalid="ignore"):
             anchor_log = np.log(np.asarray(anchor, dtype=float)
                                 / np.asarray(self.nominal, dtype=float))
-        previous = np.log(self.previous_factor() / np.asarray(previous_anchor_factors, float))
         dead = self.dead_rings()
         out = {}
-        for i, output in enumerate(OUTPUTS):
-            bearing = bearing_of(output)
+        for bearing in BEARINGS:
             ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
-            if kind_of(output) == "heat":
-                level, rise = level_error[ring], rise_error[ring]
-            else:
-                level = level_error[ring] - level_error[sleeve]
-                rise = rise_error[ring] - rise_error[sleeve]
-            row = [self.speed_rpm, anchor_log[i], level, rise, self.start_s, previous[i]]
-            out[output] = np.asarray(row, dtype=float)[None, :]
-            if bearing in dead:
-                out[output][:] = np.nan
-        return out
+            # NaN (no twin value) stays NaN through max(): no row
+            rise_scale = max(abs(sim_level[ring] - self.ambient_C), floor)
+            drop_scale = max(abs(sim_level[ring] - sim_level[sleeve]), floor)
+            ring_errors = np.array([level_error[ring], rise_error[ring]]) / rise_scale
+            drop_errors = np.array([level_error[ring] - level_error[sleeve],
+                                    rise_error[ring] - rise_error[sleeve]]) / drop_scale
+            for kind, own, other in (("heat", ring_errors, drop_errors),
+                                     ("resistance", drop_errors, ring_errors)):
+                output = f"{kind}_{bearing}"
+                row = [self.speed_rpm, anchor_log[OUTPUTS.index(output)], own[0], own[1],
+                       self.start_s, other[0]]
+                out[output] = np.asarray(row, dtype=float)[None, :]
+                if bearing in dead:
+                    out[output][:] = np.nan
+        return {o: out[o] for o in OUTPUTS}
 
     def network_inputs(self) -> dict[str, np.ndarray]:
         """The (1, 6) input row of each network for this window."""

@@ -198,7 +198,7 @@ class BpnnCorrection:
                 self.anchor_factors = np.ones(4)
             # without usable inputs the network's correction is none: the anchor itself
             fallback = ratio_anchor(features, self.anchor_factors)
-            inputs = features.anchored_inputs(fallback, self.anchor_factors)
+            inputs = features.anchored_inputs(fallback)
             self.anchor_factors = correction_factors(fallback, nominal,
                                                      fallback=self.anchor_factors)
         else:

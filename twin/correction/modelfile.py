@@ -76,6 +76,7 @@ class _Metadata(BaseModel):
     config: str
     outputs: list[str]
     hidden_sizes: dict[str, int]
+    inputs: dict[str, list[str]] = {}
     r2: dict[str, dict[str, float | None]] | None = None
     training_runs: list[str] = []
     runs: list[str] = []
@@ -173,6 +174,13 @@ def load_model(path: str | Path) -> CorrectionModel:
                          file=str(path))
     if meta.get("outputs") != list(OUTPUTS):
         raise InputError(f"outputs must be {list(OUTPUTS)}", file=str(path))
+    for output in OUTPUTS:
+        # a model trained on other inputs (an earlier release) would be fed rows it never
+        # saw, in the same six columns: refuse it rather than predict nonsense
+        want = list(input_names(config)[kind_of(output)])
+        if meta.get("inputs", {}).get(output, want) != want:  # absent: not checked
+            raise InputError(f"{output}: inputs {meta['inputs'][output]} are not this "
+                             f"version's {want}; retrain with `twin train`", file=str(path))
 
     expected = {f"{o}.{p}" for o in OUTPUTS for p in PARTS}
     missing, extra = sorted(expected - set(tensors)), sorted(set(tensors) - expected)

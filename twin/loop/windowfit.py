@@ -117,7 +117,7 @@ class WindowFit:
         self.fitted.append(fitted)
         anchor = ratio_anchor(f, self._anchor_factors)
         self.anchors.append(anchor)
-        rows = f.anchored_inputs(anchor, self._anchor_factors)
+        rows = f.anchored_inputs(anchor)
         self.anchored_inputs.append(np.vstack([rows[o] for o in OUTPUTS]))
         self._anchor_factors = correction_factors(anchor, nominal, fallback=self._anchor_factors)
         driven = anchor if self.drive == "anchor" else fitted
