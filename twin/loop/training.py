@@ -100,7 +100,8 @@ def gate_networks(model: CorrectionModel, runs: list, spindle) -> tuple[Correcti
     is returned, with {"kept": kinds, "held_out_temperature_accuracy_pct": per group}.
 
     Why: the targets are each window's look-ahead fit, which the networks learn only in
-    part (held-out R² 0.3–0.8); the rest is noise added to every window's value.  Measured
+    part (held-out R² of value/anchor 0.15–0.33 with the current inputs); the rest is noise
+    added to every window's value.  Measured
     on held-out suite runs, the heat networks cost temperature accuracy against the ratio
     law they correct while the resistance networks could bring the sleeves closer; a
     network is kept only where the held-out runs confirm it (the issue's "shrink to the
