@@ -107,7 +107,8 @@ Thermocouples (T1..T5 as reported)
     0.8 points of temperature accuracy per run, most in the windows after a speed step).
     Measured (temperature accuracy, median / worst): suite 271828 99.70 / 99.11 → 99.73 /
     99.25 % (every run up or equal), the fresh suite 5150 99.71 / 99.39 → 99.77 / 99.46 %;
-    the drift within ±0.02 points, the band's coverage 88.6–91.8 % (was 89.1–91.9 %).  Identifying each run's τ from the
+    the drift within ±0.02 points, the band's coverage 88.6–91.8 % (was 89.1–91.9 %).
+    Identifying each run's τ from the
     misfit of the forecast through candidate lags (3–28 s) was tried and dropped: the
     forecast's own errors dominate that misfit, it picked 3 s for a 16.5 s sensor and 14 s
     for 4.5–6.5 s ones, and scored below the fixed 10 s.
