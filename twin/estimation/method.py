@@ -238,7 +238,7 @@ class EnsembleEstimator:
     _band_scale: np.ndarray | None = field(default=None, init=False, repr=False)
     _band_sd_used: np.ndarray | None = field(default=None, init=False, repr=False)
     _readings_C: np.ndarray | None = field(default=None, init=False, repr=False)
-    _reported: tuple[np.ndarray, float] | None = field(default=None, init=False, repr=False)
+    """T1..T5's readings at the start of the window being forecast (the lag's state)."""
 
     def __post_init__(self) -> None:
         self._params = parameters(self.config.parameters)
@@ -302,13 +302,11 @@ class EnsembleEstimator:
             )
         extra = {k: v for k, v in factors.items() if k not in BOUNDARY_VALUES}
         self._band_sd_used = self._band_sd(self._forecast)
-        lag, start = cfg.sensor_lag_s, self._readings_C.copy()
-        self._reported = (start, lag) if cfg.report_readings else None
         return Correction.relative_to(
             (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
-            readings_start_C=start if cfg.report_readings else None,
-            sensor_lag_s=lag,
+            readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
+            sensor_lag_s=cfg.sensor_lag_s,
         )
 
     # ------------------------------------------------------------------ steps
@@ -336,10 +334,7 @@ class EnsembleEstimator:
         if len(read_t) != steps:  # the loop's history must hold the whole window
             raise ValueError(f"window {f.window}: expected {steps} simulated steps, "
                              f"got {len(read_t)}")
-        rows = slice(len(sim_t) - steps - 1, len(sim_t))  # the window's start and steps
-        metal = sim_C[rows].copy()
-        metal[0] = self._sensors @ self._window[0]  # the field the window started from
-        reads = thermocouple_reading(sim_t[rows], metal, cfg.sensor_lag_s, self._readings_C)
+        reads = self._window_readings(sim_t, sim_C)
         read = reads[1:]
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
@@ -395,6 +390,17 @@ class EnsembleEstimator:
         # points (a thermocouple follows its metal; the analysis corrects the metal)
         self._readings_C = reads[-1] + self._sensors @ (mean[:n] - prior_mean[:n])
         return Ensemble.from_stacked(mean, anomalies, n)
+
+    def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray) -> np.ndarray:
+        """T1..T5's readings over the window just ended, its start and steps (the last
+        steps + 1 rows of `time_s`, `sensors_C`), from their readings at its start: the
+        metal at the sensor points through the lag, starting from the field the window
+        started from (the analysed one, not the row the loop's history holds there)."""
+        rows = slice(len(time_s) - self.config.steps_per_window - 1, len(time_s))
+        metal = np.array(sensors_C[rows], float)
+        metal[0] = self._sensors @ self._window[0]
+        return thermocouple_reading(time_s[rows], metal, self.config.sensor_lag_s,
+                                    self._readings_C)
 
     def _conditions_at(self, bc: BoundaryConditions, field_C: np.ndarray) -> BoundaryConditions:
         """The loop's nominal conditions with the bearing heat and contact resistance taken
@@ -478,10 +484,8 @@ class EnsembleEstimator:
             return
         sim_t = np.asarray(f.simulated_time_s, float)[-cfg.steps_per_window - 1:]
         sim_C = np.asarray(f.simulated_C, float)[-cfg.steps_per_window - 1:]
-        if self._reported is not None:  # T1..T5 were reported as readings: judge those
-            metal = sim_C.copy()
-            metal[0] = self._sensors @ self._window[0]  # the field the window started from
-            sim_C = thermocouple_reading(sim_t, metal, self._reported[1], self._reported[0])
+        if cfg.report_readings:  # T1..T5 were reported as readings: judge those
+            sim_C = self._window_readings(sim_t, sim_C)
         drift, drift_anom = self._drift_forecast(fc)
         var_T, var_d = fc.spread_at_steps(drift_anom)
         var_T = np.vstack([var_T[:1], var_T])  # the window start: as its first step
