@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin.drift.features import first_order_lag
+from twin.lag import first_order_lag
 
 
 def synthetic_columns(hours: float = 4.0, seed: int = 0, noise_um: float = 0.05
@@ -18,10 +18,10 @@ def synthetic_columns(hours: float = 4.0, seed: int = 0, noise_um: float = 0.05
     t = np.arange(0.0, hours * 3600.0, 15.0)
     speed = np.where((t // 2400) % 2 == 0, 3000.0, 0.0) * (1 + (t // 4800) % 2)
     heat = (speed / 1000.0) ** 1.5
-    a = 20.0 + first_order_lag(heat, t, np.array([900.0]))[:, 0]
-    b = 20.0 + 0.5 * first_order_lag(heat, t, np.array([2400.0]))[:, 0]
+    a = 20.0 + first_order_lag(heat, t, 900.0, between="held")
+    b = 20.0 + 0.5 * first_order_lag(heat, t, 2400.0, between="held")
     c = 20.0 + 0.1 * np.sin(t / 3000.0)
-    drift = (3.0 * (first_order_lag(a - 20.0, t, np.array([1200.0]))[:, 0])
+    drift = (3.0 * (first_order_lag(a - 20.0, t, 1200.0, between="held"))
              + 1.5 * (b - 20.0) + rng.normal(0.0, noise_um, t.size))
     return {"time_s": t, "speed_rpm": speed, "A_C": a + rng.normal(0, 0.01, t.size),
             "B_C": b + rng.normal(0, 0.01, t.size), "C_C": c, "drift_um": drift}

@@ -5,27 +5,25 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.drift.features import FeatureSpec, dynamic_features, first_order_lag
+from twin.drift.features import FeatureSpec, dynamic_features
 from twin.drift.ranking import correlation_clusters, grey_relational_grade, rank_sensors
 
 
-def test_first_order_lag_of_a_step_is_one_minus_exponential():
-    t = np.arange(0.0, 3600.0, 15.0)
-    tau = np.array([600.0, 1800.0])
-    y = first_order_lag(np.where(t > 0, 1.0, 0.0), t, tau)
-    expected = 1.0 - np.exp(-t[:, None] / tau[None, :])
-    np.testing.assert_allclose(y, expected, atol=1e-12)
-
-
-def test_first_order_lag_is_exact_for_uneven_sampling_and_restarts_per_segment():
-    t = np.array([0.0, 10.0, 25.0, 70.0, 0.0, 5.0])
-    x = np.array([0.0, 2.0, 2.0, 2.0, 5.0, 5.0])
-    y = first_order_lag(x, t, np.array([30.0]), segment_starts=np.array([0, 4]))[:, 0]
-    # each sample's value is held over the step that ends at it: from 0 the input is 2,
-    # so y(t) = 2·(1 − exp(−t/τ)) at every later sample, whatever the step lengths
-    assert y[0] == 0.0
-    np.testing.assert_allclose(y[1:4], 2.0 * (1.0 - np.exp(-t[1:4] / 30.0)), atol=1e-12)
-    np.testing.assert_allclose(y[4:], [5.0, 5.0])       # the second file starts anew
+def test_lag_features_are_held_step_responses_tau_major_restarting_per_file():
+    # two sensors stepping by 1 and 2 K after the first row, in two files of 15 s samples
+    t = np.r_[np.arange(0.0, 3600.0, 15.0), np.arange(0.0, 600.0, 15.0)]
+    second = np.arange(t.size) >= 240
+    step = np.where((t > 0) | second, 1.0, 0.0)
+    spec = FeatureSpec(("a_C", "b_C"), (20.0, 20.0), taus_min=(10.0, 30.0), groups=("lag",))
+    X = dynamic_features(spec, t, 20.0 + np.c_[step, 2.0 * step], None,
+                         segment_starts=np.array([0, 240]))
+    assert spec.names == ["a_C:lag10min", "b_C:lag10min", "a_C:lag30min", "b_C:lag30min"]
+    # each sample held over the step that ends at it: 1 − e^(−t/τ) at the samples
+    first = ~second
+    for col, (gain, tau_s) in enumerate([(1, 600.0), (2, 600.0), (1, 1800.0), (2, 1800.0)]):
+        np.testing.assert_allclose(X[first, col], gain * (1 - np.exp(-t[first] / tau_s)),
+                                   atol=1e-12)
+        np.testing.assert_allclose(X[second, col], gain, atol=1e-12)  # starts settled
 
 
 def test_features_are_causal():

@@ -25,12 +25,12 @@ from twin.estimation.parameters import (
     apply_factors,
     factors_of,
 )
+from twin.lag import first_order_lag
 from twin.loop.metrics import accuracy_metrics, band_coverage
 from twin.loop.replay import deck_window_solver, direct_window_solver, replay_method
 from twin.loop.runfiles import band_of
 from twin.runs import read_run
 from twin.spindle.conditions import nominal_conditions
-from twin.spindle.thermocouple import thermocouple_reading
 
 from .test_replay import make_recorded_run
 
@@ -134,21 +134,6 @@ def test_tangent_linear_members_match_finite_differences_of_the_fem(spindle_mode
         assert np.abs(finite_difference).max() > 1e-3, name  # the parameter does something
         np.testing.assert_allclose(tangent, finite_difference, rtol=0.05,
                                    atol=0.02 * np.abs(finite_difference).max(), err_msg=name)
-
-
-def test_thermocouple_reading_is_the_exact_ramp_response():
-    t = np.arange(0.0, 200.0, 4.0)
-    reading = thermocouple_reading(t, np.c_[0.1 * t], 10.0)[:, 0]
-    np.testing.assert_allclose(reading, 0.1 * (t - 10.0 * (1 - np.exp(-t / 10.0))), atol=1e-9)
-
-
-def test_thermocouple_reading_from_an_unsettled_start_decays_to_the_metal():
-    t = np.arange(0.0, 60.0, 4.0)
-    metal = np.full((t.size, 2), 30.0)
-    reading = thermocouple_reading(t, metal, 12.0, start_C=np.array([25.0, 31.0]))
-    expected = 30.0 + np.outer(np.exp(-t / 12.0), [-5.0, 1.0])
-    np.testing.assert_allclose(reading, expected, atol=1e-9)
-    np.testing.assert_array_equal(thermocouple_reading(t, metal, 0.0, np.zeros(2)), metal)
 
 
 # ------------------------------------------------------------------ the method
@@ -279,8 +264,8 @@ def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, s
         assert c.sensor_lag_s == 10.0
         if readings:
             window = np.vstack([model.sensor_matrix @ c.state_C, fc])
-            fc = thermocouple_reading(4.0 * np.arange(16), window, c.sensor_lag_s,
-                                      c.readings_start_C)[1:]
+            fc = first_order_lag(window, 4.0 * np.arange(16), c.sensor_lag_s,
+                                 c.readings_start_C)[1:]
         else:
             assert c.readings_start_C is None
         np.testing.assert_allclose(replay.T_twin_C[15 * k: 15 * (k + 1)], fc, atol=1e-4)

@@ -8,7 +8,7 @@ import pytest
 from twin.errors import InputError
 from twin.plant.profile import read_speed_profile
 from twin.plant.scenario import load_scenario, parse_scenario
-from twin.plant.sensors import add_noise, apply_faults, first_order_lag
+from twin.plant.sensors import add_noise, apply_faults
 from twin.plant.timetable import StepTable, TimeTable
 from twin.plant.truth import (
     XY_GAIN_UM_PER_K,
@@ -132,19 +132,6 @@ def test_tables():
     np.testing.assert_allclose(s([50, 100, 500]), [1.0, 2.0, 2.0])
     with pytest.raises(ValueError):
         TimeTable([0, 0], [1, 2])
-
-
-def test_lag_matches_closed_forms():
-    tau, dt = 8.0, 1.0
-    t = np.arange(0.0, 120.0, dt)
-    # ramp x = m t from rest: y = m (t − τ (1 − e^(−t/τ)))
-    y = first_order_lag(0.1 * t, dt, tau)
-    np.testing.assert_allclose(y, 0.1 * (t - tau * (1 - np.exp(-t / tau))), atol=1e-12)
-    # a sensor started 5 K colder than a constant truth relaxes as 5 e^(−t/τ)
-    y = first_order_lag(np.full((t.size, 2), 30.0), dt, tau, y0=np.array([25.0, 30.0]))
-    np.testing.assert_allclose(y[:, 0], 30.0 - 5.0 * np.exp(-t / tau), atol=1e-12)
-    np.testing.assert_allclose(y[:, 1], 30.0)
-    np.testing.assert_array_equal(first_order_lag(t, dt, 0.0), t)
 
 
 def test_noise_statistics_and_determinism():

@@ -44,11 +44,11 @@ from pathlib import Path
 import numpy as np
 
 from twin.contract import SENSOR_NAMES, WINDOW_S
+from twin.lag import first_order_lag
 from twin.loop.metrics import T_FLOOR_C
 from twin.plant.emulator import synthesize
 from twin.plant.profile import read_speed_profile
 from twin.plant.scenario import load_scenario
-from twin.plant.sensors import first_order_lag
 from twin.plant.timetable import StepTable
 
 FIRST_WINDOWS = 3
@@ -150,7 +150,7 @@ def oracle_windows(run_csv: Path, windows: set[int], lag_s: float
                          coolant_C=args.get("coolant"))
         t = run.truth["time_s"]
         metal = np.column_stack([run.truth[f"{s}_true_C"] for s in SENSOR_NAMES])
-        out[k] = (t, first_order_lag(metal, float(t[1] - t[0]), lag_s),
+        out[k] = (t, first_order_lag(metal, t, lag_s),
                   run.truth["disp_z_true_um"])
     return out
 
@@ -164,7 +164,7 @@ def analyse_run(run_csv: Path, replay_dir: Path, method: str) -> dict:
     lag_s = float(meta.get("thermocouple_lag_s", 0.0))
     tt = truth["time_s"]
     truth_T = first_order_lag(np.column_stack([truth[f"{s}_true_C"] for s in SENSOR_NAMES]),
-                              float(tt[1] - tt[0]), lag_s)
+                              tt, lag_s)
     rows = {m: kp["method"] == m for m in ("open_loop", method)}
     t = kp["time_s"][rows[method]]
     meas = np.column_stack([kp[f"{s}_meas_C"][rows[method]] for s in SENSOR_NAMES])

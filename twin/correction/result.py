@@ -44,7 +44,7 @@ class Correction:
     readings_start_C: np.ndarray | None = field(default=None, repr=False, compare=False)
     """(5,) what T1..T5's thermocouples read at the window start, °C: the loop then reports
     T1..T5 as the readings of the window's metal temperatures at their points through the
-    first-order lag `sensor_lag_s` (`twin.spindle.thermocouple`).  None: the metal."""
+    first-order lag `sensor_lag_s` (`twin.lag`).  None: the metal."""
     sensor_lag_s: float = 0.0
     """The thermocouples' time constant, s (a method that estimates it; 0: not estimated)."""
 

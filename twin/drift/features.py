@@ -20,6 +20,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from twin.lag import first_order_lag
+
 DEFAULT_TAUS_MIN: tuple[float, ...] = (10.0, 30.0, 90.0)
 """Lag time constants (min); the published ridge baseline uses 10/30/90 min (REFERENCE §8)."""
 
@@ -70,34 +72,14 @@ class FeatureSpec:
                    groups=tuple(doc["groups"]))
 
 
-def first_order_lag(x: np.ndarray, time_s: np.ndarray, tau_s: np.ndarray,
-                    segment_starts: np.ndarray | None = None) -> np.ndarray:
-    """First-order lag y' = (x − y)/τ of every column of x at every τ, exact for a held x.
-
-    x (n, m), time_s (n,), tau_s (k,) → (n, k·m), τ-major.  y starts at x at the first
-    row of every segment.  y[i] uses x[0..i] only.
-    """
-    x = np.asarray(x, dtype=float)
-    if x.ndim == 1:
-        x = x[:, None]
-    tau_s = np.asarray(tau_s, dtype=float)
-    n, m = x.shape
-    starts = np.zeros(n, dtype=bool)
-    starts[0] = True
-    if segment_starts is not None:
-        starts[np.asarray(segment_starts, dtype=np.int64)] = True
-    dt = np.diff(time_s, prepend=time_s[0])
-    # weight of the new sample: 1 − exp(−Δt/τ); 1 at a segment start restarts the filter
-    w = -np.expm1(-dt[:, None] / tau_s[None, :])
-    w[starts] = 1.0
-    w = np.repeat(w, m, axis=1)
-    xs = np.tile(x, (1, tau_s.size))
-    y = np.empty_like(xs)
-    prev = xs[0]
-    for i in range(n):
-        prev = prev + w[i] * (xs[i] - prev)
-        y[i] = prev
-    return y
+def _lagged(x: np.ndarray, time_s: np.ndarray, taus_s: np.ndarray,
+            segment_starts: np.ndarray | None = None) -> np.ndarray:
+    """First-order lags of every column of x (n, m) at every τ of `taus_s` (s) → (n, k·m),
+    τ-major; each sample is held over the step that ends at it (`twin.lag`), so y[i] uses
+    x[0..i] only; y starts at x at the first row of every segment."""
+    x = np.asarray(x, dtype=float).reshape(len(time_s), -1)
+    return np.hstack([first_order_lag(x, time_s, float(tau), between="held",
+                                       segment_starts=segment_starts) for tau in taus_s])
 
 
 def reference_temperatures(T_C: np.ndarray, n_rows: int = 20) -> np.ndarray:
@@ -115,11 +97,11 @@ def dynamic_features(spec: FeatureSpec, time_s: np.ndarray, T_C: np.ndarray,
     if "rise" in spec.groups:
         blocks.append(rise)
     if "lag" in spec.groups:
-        blocks.append(first_order_lag(rise, time_s, taus_s, segment_starts))
+        blocks.append(_lagged(rise, time_s, taus_s, segment_starts))
     if "speed" in spec.groups:
         if speed_rpm is None:
             raise ValueError("the features need speed_rpm")
         krpm = np.asarray(speed_rpm, dtype=float)[:, None] / 1000.0
         s = np.hstack([krpm, krpm**2])
-        blocks += [s, first_order_lag(s, time_s, taus_s, segment_starts)]
+        blocks += [s, _lagged(s, time_s, taus_s, segment_starts)]
     return np.hstack(blocks)

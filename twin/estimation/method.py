@@ -94,9 +94,9 @@ Drift (default where recorded)
 
 Thermocouples (T1..T5 as reported)
     The field is the metal; a thermocouple in its bore follows with a first-order lag
-    (`twin.spindle.thermocouple`, τ = sensor_lag_s, 10 s: sheathed thermocouples are
-    4–20 s).  The filter compares the window's forecast with the samples through that lag,
-    and with `report_readings` (default) the estimator also *reports* T1..T5 as readings:
+    (`twin.lag`, τ = sensor_lag_s, 10 s: sheathed thermocouples are 4–20 s).  The filter
+    compares the window's forecast with the samples through that lag, and with
+    `report_readings` (default) the estimator also *reports* T1..T5 as readings:
     the readings at the window start (the lag's state) go with the correction, and the
     loop puts the deck's metal at the sensor points through the lag from there.  The
     readings are carried from window to window (never re-started at the metal, never set
@@ -155,8 +155,8 @@ from twin.estimation.parameters import (
     factors_of,
     parameters,
 )
+from twin.lag import first_order_lag
 from twin.spindle.conditions import BoundaryConditions, bearing_values
-from twin.spindle.thermocouple import thermocouple_reading
 
 HEAT_FACTORS = frozenset({"H_front", "H_rear", "motor"})
 """The factors on heat that a stopped spindle does not generate."""
@@ -399,8 +399,8 @@ class EnsembleEstimator:
         rows = slice(len(time_s) - self.config.steps_per_window - 1, len(time_s))
         metal = np.array(sensors_C[rows], float)
         metal[0] = self._sensors @ self._window[0]
-        return thermocouple_reading(time_s[rows], metal, self.config.sensor_lag_s,
-                                    self._readings_C)
+        return first_order_lag(metal, time_s[rows], self.config.sensor_lag_s,
+                               self._readings_C)
 
     def _conditions_at(self, bc: BoundaryConditions, field_C: np.ndarray) -> BoundaryConditions:
         """The loop's nominal conditions with the bearing heat and contact resistance taken

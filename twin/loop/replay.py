@@ -54,10 +54,10 @@ from twin.correction.features import (
 )
 from twin.correction.rerun import recorded_step_speeds, rerun_window, speed_change_s
 from twin.correction.result import Correction, Corrector
+from twin.lag import first_order_lag
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
-from twin.spindle.thermocouple import thermocouple_reading
 
 FILM_AMBIENT_STEP_K = 0.5
 """The film coefficients see the ambient on this grid (the sink temperature stays exact).
@@ -341,7 +341,7 @@ def _reported(metal_C: np.ndarray, corr: Correction) -> np.ndarray:
     if corr.readings_start_C is None or corr.sensor_lag_s <= 0:
         return metal_C[1:]
     time_s = STEP_S * np.arange(len(metal_C))
-    return thermocouple_reading(time_s, metal_C, corr.sensor_lag_s, corr.readings_start_C)[1:]
+    return first_order_lag(metal_C, time_s, corr.sensor_lag_s, corr.readings_start_C)[1:]
 
 
 @dataclass(frozen=True)

@@ -31,9 +31,10 @@ import numpy as np
 
 from twin.contract import SENSOR_NAMES
 from twin.errors import InputError
+from twin.lag import first_order_lag
 from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
-from twin.plant.sensors import add_noise, apply_faults, first_order_lag
+from twin.plant.sensors import add_noise, apply_faults
 from twin.plant.timetable import StepTable
 from twin.plant.truth import (
     FILM_GROUPS,
@@ -238,7 +239,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     rng = np.random.default_rng(noise_seed)
     sensors = scenario.sensors
     t_out = np.arange(0.0, duration + 1e-9, 1.0 / rate_hz)
-    lagged = first_order_lag(truth.sensors_C, DT_S, sensors.lag_s)
+    lagged = first_order_lag(truth.sensors_C, truth.time_s, sensors.lag_s)
     T_meas = np.stack([np.interp(t_out, truth.time_s, lagged[:, j]) for j in range(5)], axis=1)
     disp_z = np.interp(t_out, truth.time_s, truth.disp_z_um)
     if tables.x_um is None or tables.y_um is None:  # the spindle's own X/Y response

@@ -53,8 +53,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.lag import first_order_lag
 from twin.plant.scenario import Scenario
-from twin.plant.sensors import first_order_lag
 from twin.plant.timetable import TimeTable
 from twin.spindle.conditions import FILM_GROUPS, film_group
 
@@ -180,8 +180,7 @@ def xy_drift_um(time_s: np.ndarray, sensors_C: np.ndarray,
     follows the housing, which warms more slowly than the bearing rings).
     """
     rise = np.asarray(sensors_C, float) - np.asarray(sensors_C, float)[0]
-    dt = float(time_s[1] - time_s[0]) if len(time_s) > 1 else 1.0
-    lagged = first_order_lag(rise, dt, XY_LAG_S)
+    lagged = first_order_lag(rise, time_s, XY_LAG_S)
     return np.asarray(gain_scale, float)[:, None] * (XY_GAIN_UM_PER_K @ lagged.T)
 
 
