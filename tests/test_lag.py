@@ -104,6 +104,21 @@ def test_start_value_relaxes_to_a_constant_input(t, between):
     np.testing.assert_allclose(first_order_lag(x, t, tau, between=between), x, atol=1e-12)
 
 
+@SAMPLINGS
+def test_several_time_constants_at_once(t):
+    taus = np.array([5.0, 0.0, 40.0])
+    slopes = np.array([0.1, -0.3])
+    y = first_order_lag(np.outer(t, slopes), t, taus, start=np.zeros(2))
+    assert y.shape == (t.size, 3, 2)
+    for j in (0, 2):
+        np.testing.assert_allclose(y[:, j], np.outer(ramp_response(t, taus[j]), slopes),
+                                   atol=1e-12)
+    np.testing.assert_array_equal(y[:, 1], np.outer(t, slopes))    # τ = 0: the input
+    step = first_order_lag(np.where(t > 0, 1.0, 0.0), t, taus, between="held")
+    np.testing.assert_allclose(step[:, [0, 2]], 1.0 - np.exp(-t[:, None] / taus[[0, 2]]),
+                               atol=1e-12)
+
+
 @pytest.mark.parametrize("tau", [0.0, -3.0])
 def test_no_time_constant_reads_the_input_itself(tau):
     x = np.sin(EVEN_S / 17.0)

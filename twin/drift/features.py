@@ -78,8 +78,9 @@ def _lagged(x: np.ndarray, time_s: np.ndarray, taus_s: np.ndarray,
     τ-major; each sample is held over the step that ends at it (`twin.lag`), so y[i] uses
     x[0..i] only; y starts at x at the first row of every segment."""
     x = np.asarray(x, dtype=float).reshape(len(time_s), -1)
-    return np.hstack([first_order_lag(x, time_s, float(tau), between="held",
-                                       segment_starts=segment_starts) for tau in taus_s])
+    y = first_order_lag(x, time_s, np.asarray(taus_s, dtype=float), between="held",
+                        segment_starts=segment_starts)
+    return y.reshape(len(time_s), -1)
 
 
 def reference_temperatures(T_C: np.ndarray, n_rows: int = 20) -> np.ndarray:
