@@ -16,8 +16,8 @@ plant, the estimator and the drift models share it without depending on each oth
 Over a step h = t₁ − t₀, with w = 1 − exp(−h/τ) the weight of the new sample,
     y₁ = y₀ + w·(x₁ − y₀) − c·(x₁ − x₀)
 exactly: c = 0 for x held at x₁ over the step, c = τ·w/h − (1 − w) for x linear over it
-(the ramp within the step lags by less than its end value; c → 0 as h → 0, so a jump of
-x in no time does not move y).  One recursion, two ways to run it:
+(a rising ramp stays below its end value x₁ within the step, so y rises by less; c → 0
+as h → 0, so a jump of x in no time does not move y).  One recursion, two ways to run it:
   - constant steps and the linear form as a linear filter (scipy.signal.lfilter: the
     emulator's truth over long runs, many columns);
   - otherwise row by row.  The held form always runs so: the drift models were fitted on
