@@ -1,7 +1,7 @@
 """The first-order lag τ·y' + y = x (`twin.lag`) against closed-form responses.
 
-Even steps run as a linear filter, uneven ones row by row: every closed form is checked on
-both kinds of sampling.
+Long records of even steps run as a linear filter, short or uneven ones row by row: the
+closed forms are checked on each kind of sampling.
 """
 
 from __future__ import annotations
@@ -9,11 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.lag import first_order_lag
+from twin.lag import FILTER_MIN_ROWS, first_order_lag
 
-EVEN_S = np.arange(0.0, 240.0, 4.0)
+EVEN_S = np.arange(0.0, 1200.0, 4.0)     # long enough to run as a linear filter
+SHORT_S = np.arange(0.0, 64.0, 4.0)      # an estimator window: row by row
 UNEVEN_S = np.cumsum(np.r_[0.0, np.tile([1.0, 7.0, 2.5, 4.0, 0.5], 12)])
-SAMPLINGS = pytest.mark.parametrize("t", [EVEN_S, UNEVEN_S], ids=["even", "uneven"])
+assert EVEN_S.size >= FILTER_MIN_ROWS > SHORT_S.size
+SAMPLINGS = pytest.mark.parametrize("t", [EVEN_S, SHORT_S, UNEVEN_S],
+                                    ids=["even", "short", "uneven"])
 
 
 def ramp_response(t: np.ndarray, tau: float) -> np.ndarray:
@@ -48,7 +51,7 @@ def test_linear_form_is_exact_for_piecewise_linear_input_sampled_unevenly():
     def expected(t):
         return sum(dm * ramp_response(t - b, tau) for b, dm in pieces)
 
-    even = np.arange(0.0, 301.0, 2.0)
+    even = np.arange(0.0, 601.0, 2.0)
     uneven = np.unique(np.r_[breaks, np.cumsum(np.tile([0.7, 3.1, 5.3], 30))])
     uneven = uneven[uneven <= 300.0]
     for t in (even, uneven):

@@ -18,12 +18,14 @@ Over a step h = t₁ − t₀, with w = 1 − exp(−h/τ) the weight of the new
 exactly: c = 0 for x held at x₁ over the step, c = τ·w/h − (1 − w) for x linear over it
 (a rising ramp stays below its end value x₁ within the step, so y rises by less; c → 0
 as h → 0, so a jump of x in no time does not move y).  One recursion, two ways to run it:
-  - constant steps and the linear form as a linear filter (scipy.signal.lfilter: the
-    emulator's truth over long runs, many columns);
-  - otherwise row by row.  The held form always runs so: the drift models were fitted on
-    its exact rounding, and their network fits are chaotic in it (run as a filter, the
-    features of examples/real moved by 1e-13 and a refit's validation RMSE by up to
-    0.4 µm on a probe), so the drift features stay bit for bit what they were.
+  - constant steps of the linear form over at least `FILTER_MIN_ROWS` rows as a linear
+    filter (scipy.signal.lfilter: the emulator's truth over long runs, many columns);
+  - otherwise row by row: an estimator window's 16 rows cost less so than the filter's
+    set-up, and `twin replay` does not import scipy.signal (0.5 s of start-up) for them.
+    The held form always runs so: the drift models were fitted on its exact rounding, and
+    their network fits are chaotic in it (run as a filter, the features of examples/real
+    moved by 1e-13 and a refit's validation RMSE by up to 0.4 µm on a probe), so the
+    drift features stay bit for bit what they were.
 """
 
 from __future__ import annotations
@@ -31,11 +33,13 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from scipy.signal import lfilter
 
 CONSTANT_STEP_RTOL = 1e-9
 """Steps equal to this relative tolerance count as constant (the filter then uses their
 mean: a change of exp(−h/τ) far below the rounding of any logged value)."""
+
+FILTER_MIN_ROWS = 200
+"""Records of constant steps at least this long run as a linear filter (shorter: row by row)."""
 
 
 def first_order_lag(x: np.ndarray, time_s: np.ndarray, tau_s: float | np.ndarray,
@@ -86,7 +90,8 @@ def _record(x_k: np.ndarray, time_s: np.ndarray, taus: np.ndarray, between: str,
     if x_k.shape[0] < 2:
         return
     h = np.diff(time_s)
-    constant = between == "linear" and np.ptp(h) <= CONSTANT_STEP_RTOL * abs(h[0])
+    constant = (between == "linear" and x_k.shape[0] >= FILTER_MIN_ROWS
+                and np.ptp(h) <= CONSTANT_STEP_RTOL * abs(h[0]))
     if constant:
         h = np.full(1, h.mean())
     # per step and τ, broadcast over the columns
@@ -100,6 +105,8 @@ def _record(x_k: np.ndarray, time_s: np.ndarray, taus: np.ndarray, between: str,
     w, ramp = w.reshape(w.shape + trailing), ramp.reshape(ramp.shape + trailing)
     drive = np.diff(x_k, axis=0) * ramp
     if constant:
+        from scipy.signal import lfilter  # only for long records: kept off replay's start-up
+
         # y₁ = (1 − w)·y₀ + (w·x₁ − c·Δx), one τ at a time (lfilter takes one set of
         # coefficients)
         x_full, drive = np.broadcast_to(x_k, y.shape), np.broadcast_to(drive, y[1:].shape)
