@@ -67,7 +67,7 @@ ALL_PARAMETERS: dict[str, Parameter] = {
 and the paper's corrections (bearing heat and contact resistance moving by tens of %)."""
 
 DEFAULT_PARAMETERS: tuple[str, ...] = (
-    "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor", "expansion",
+    "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor", "film_coolant", "expansion",
 )
 """The estimator's default set; see `twin.estimation.method` for the sensitivity study."""
 
