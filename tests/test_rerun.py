@@ -36,10 +36,19 @@ def test_stretches_of_equal_speed_are_solved_one_after_another():
         calls.append((speed, n, start_s))
         return T + 1e-3 * speed * np.arange(1, n + 1)[:, None]
 
-    fields = rerun_window(np.zeros(2), 60.0, speeds, 4.0, advance)
+    fields = rerun_window(np.zeros(2), 60.0, speeds, 4.0, advance, max_steps=None)
     assert calls == [(6000.0, 4, 60.0), (12000.0, 6, 76.0), (3000.0, 5, 100.0)]
     assert fields.shape == (15, 2)
     np.testing.assert_allclose(fields[:, 0], np.cumsum(1e-3 * speeds))
+    # by default a stretch is solved in pieces of 20 s (5 steps), each from where the
+    # last ended, so that its loads can follow the field
+    calls.clear()
+    pieces = rerun_window(np.zeros(2), 60.0, speeds, 4.0, advance)
+    assert calls == [(6000.0, 4, 60.0), (12000.0, 5, 76.0), (12000.0, 1, 96.0),
+                     (3000.0, 5, 100.0)]
+    np.testing.assert_allclose(pieces, fields)
+    assert speed_stretches(np.full(12, 9000.0), max_steps=5) == [
+        (9000.0, 0, 5), (9000.0, 5, 5), (9000.0, 10, 2)]
 
 
 def test_bpnn_starts_the_next_window_from_the_rerun(tmp_path, spindle_model, monkeypatch):
@@ -81,9 +90,12 @@ def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
     replay = replay_method(run, model, BpnnCorrection(load_model(BUNDLED_MODEL)),
                            solver=deck_window_solver(model), keep_fields=False)
     w = replay.windows
+    assert w[0].rerun_deck is not None  # the first window (its rings warm fastest)
     assert w[1].rerun_deck is not None  # the speed changed inside window 1
-    assert all(x.rerun_deck is None for x in w if x.window != 1)
-    assert w[1].rerun_deck.count("SOLVE") == 3  # 6000, 12000 and 3000 rpm stretches
+    assert all(x.rerun_deck is None for x in w if x.window > 1)
+    assert w[0].rerun_deck.count("SOLVE") == 3  # three 20 s pieces at 6000 rpm
+    # 6000 rpm for 16 s, 12000 rpm for 24 s (20 + 4), 3000 rpm for 20 s
+    assert w[1].rerun_deck.count("SOLVE") == 4
     # a replay done in another process brings its re-run decks back
     assert method_replay_from_json(method_replay_to_json(replay)).windows[1].rerun_deck == \
         w[1].rerun_deck
@@ -104,9 +116,10 @@ def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
     T = np.full(model.n_dofs, replay.T_initial_C)
     window0 = session.advance(T, 0.0, w[0].deck)
     np.testing.assert_allclose(sensors(window0), reported(0), atol=1e-9)
-    window1 = session.advance(window0[-1], 60.0, w[1].deck)
+    rerun0_end = session.advance(T, 0.0, w[0].rerun_deck)[-1]
+    window1 = session.advance(rerun0_end, 60.0, w[1].deck)
     np.testing.assert_allclose(sensors(window1), reported(1), atol=1e-9)
-    rerun_end = session.advance(window0[-1], 60.0, w[1].rerun_deck)[-1]
+    rerun_end = session.advance(rerun0_end, 60.0, w[1].rerun_deck)[-1]
     # the re-run ends elsewhere than the forecast (it saw the step) ...
     assert np.abs(sensors([rerun_end]) - sensors([window1[-1]])).max() > 0.5
     # ... and window 2 starts from it

@@ -27,6 +27,12 @@ import numpy as np
 
 from twin.correction.features import WindowFeatures
 
+LOAD_UPDATE_STEPS = 5
+"""A re-run's nominal loads follow its own temperatures every 5 solver steps (20 s), as
+the spindle's follow its rings: a stretch longer than that is solved in pieces, each from
+the field the last one ended on (from a cold start the Palmgren heat falls by about a
+fifth in the first minute as the oil warms)."""
+
 Advance = Callable[[float, np.ndarray, int, float], np.ndarray]
 """(speed_rpm, T at the stretch start, n_steps, stretch start s) → T after each step
 (n_steps, n_dofs)."""
@@ -54,23 +60,29 @@ def recorded_step_speeds(f: WindowFeatures, steps: int, step_s: float) -> np.nda
     return recorded[np.clip(np.searchsorted(t, mid - 1e-9) - 1, 0, len(t) - 1)]
 
 
-def speed_stretches(speeds: np.ndarray) -> list[tuple[float, int, int]]:
-    """(speed rpm, first step, number of steps) of each run of equal speeds, in order."""
+def speed_stretches(speeds: np.ndarray, max_steps: int | None = None
+                    ) -> list[tuple[float, int, int]]:
+    """(speed rpm, first step, number of steps) of each run of equal speeds, in order; with
+    `max_steps`, a run longer than that is cut into pieces of max_steps from its start."""
     speeds = np.asarray(speeds, float)
     edges = np.flatnonzero(np.abs(np.diff(speeds)) > 0.5) + 1
     bounds = np.r_[0, edges, speeds.size]
-    return [(float(speeds[a]), int(a), int(b - a)) for a, b in zip(bounds[:-1], bounds[1:],
-                                                                   strict=True)]
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        step = int(b - a) if max_steps is None else int(max_steps)
+        out += [(float(speeds[a]), int(i), int(min(step, b - i))) for i in range(a, b, step)]
+    return out
 
 
 def rerun_window(T_start: np.ndarray, start_s: float, speeds: np.ndarray, step_s: float,
-                 advance: Advance) -> np.ndarray:
+                 advance: Advance, max_steps: int | None = LOAD_UPDATE_STEPS) -> np.ndarray:
     """The window re-run from `T_start` (°C per dof, at `start_s`) with `speeds` (one per
-    solver step of `step_s`): each stretch of equal speed solved by `advance` from where the
-    last one ended.  Returns the field after every step, (steps, n_dofs)."""
+    solver step of `step_s`): each stretch of equal speed, in pieces of at most `max_steps`
+    (None: whole), solved by `advance` from where the last one ended (`advance` takes its
+    loads at the field it is given).  Returns the field after every step, (steps, n_dofs)."""
     out = []
     T = np.asarray(T_start, float)
-    for speed, first, n in speed_stretches(speeds):
+    for speed, first, n in speed_stretches(speeds, max_steps):
         fields = np.asarray(advance(speed, T, n, start_s + first * step_s), float)
         out.append(fields)
         T = fields[-1]

@@ -249,10 +249,6 @@ class EstimatorConfig:
     """Least model-plus-noise spread of the drift band, µm."""
     rerun_first_window: bool = True
     """Re-run the first window of a run before its analysis (the cold start; module doc)."""
-    rerun_update_steps: int = 5
-    """A re-run of the window just ended re-evaluates the nominal bearing heat and contact
-    resistance at its own temperatures every this many solver steps (5: 20 s, as often as
-    the emulated spindle's own loads follow its bearings)."""
 
 
 @dataclass
@@ -451,13 +447,13 @@ class EnsembleEstimator:
     def _rerun(self, f: WindowFeatures, fc: WindowForecast
                ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
         """The window just ended re-run from its start field, each solver step at the speed
-        recorded at its midpoint (`twin.correction.rerun`), with the nominal bearing heat and
-        contact resistance re-evaluated every `rerun_update_steps` at the re-run's own ring
-        and sleeve temperatures, as the spindle's own follow them (this window's nominal
-        conditions at the current speed, nominal conditions for any other speed: a step up
-        and a stop inside one window), all with the same factors.  Returns T1..T5 history
-        with the window replaced, the end field and the forecast with that mean (the
-        members' anomalies are kept)."""
+        recorded at its midpoint, with the nominal bearing heat and contact resistance
+        re-evaluated every 20 s at the re-run's own ring and sleeve temperatures, as the
+        spindle's follow them (`twin.correction.rerun`): this window's nominal conditions
+        at the current speed, nominal conditions for any other speed (a step up and a stop
+        inside one window), all with the same factors.  Returns T1..T5 history with the
+        window replaced, the end field and the forecast with that mean (the members'
+        anomalies are kept)."""
         from twin.spindle.conditions import nominal_conditions
 
         cfg = self.config
@@ -470,14 +466,9 @@ class EnsembleEstimator:
             if abs(speed - current.speed_rpm) > 0.5:
                 base = nominal_conditions(self.model, speed, current.ambient_C,
                                           current.coolant_C)
-            blocks = []
-            while n > 0:
-                k = min(n, cfg.rerun_update_steps)
-                bc = apply_factors(self._conditions_at(base, T), factors)
-                stepper = self.model.thermal.transient(bc.to_thermal_loads(), cfg.step_s)
-                blocks.append(np.array(list(stepper.march(T, k))))
-                T, n = blocks[-1][-1], n - k
-            return np.concatenate(blocks)
+            bc = apply_factors(self._conditions_at(base, T), factors)
+            stepper = self.model.thermal.transient(bc.to_thermal_loads(), cfg.step_s)
+            return np.array(list(stepper.march(T, n)))
 
         fields = rerun_window(T0, f.start_s - cfg.window_s,
                               recorded_step_speeds(f, steps, cfg.step_s), cfg.step_s, advance)

@@ -18,10 +18,12 @@ Re-run of a missed speed change (methods with `rerun_missed_speed`: `bpnn`; the 
 `ratio` and `open_loop` keep the forecast, the `estimator` re-runs inside its own
 analysis).  When the recorded speed changed inside window k−1, after its loads were
 fixed, that window is re-run from its start field with the recorded speed
-(`twin.correction.rerun`: one stretch per speed, the window's own loads at its own speed,
-the nominal loads of the other speeds, at the window start's temperatures, times the
-window's correction factors) before window k's correction; all of it was measured before
-60k s.  Window k then starts from the re-run's end field, and the method reads its
+(`twin.correction.rerun`: per speed, in pieces of 20 s, each with the nominal loads at
+its own temperatures times the window's correction factors, as the spindle's loads follow
+its rings) before window k's correction; all of it was measured before 60k s.  So is
+window 0 of a run, whose loads were held at the cold start's temperatures for 60 s while
+the rings warmed by kelvins and the Palmgren heat fell by about a fifth.
+Window k then starts from the re-run's end field, and the method reads its
 simulated key points over window k−1 from the re-run (`WindowFeatures.simulated_C`), not
 from the forecast that missed the input.  The reported trajectory of window k−1 stays its
 forecast (what was known when it started).  Every stretch is solved through a deck like any
@@ -277,7 +279,9 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
         )
-        if reruns and last is not None and speed_change_s(features, last.bc.speed_rpm) is not None:
+        first = k == 1 and last is not None and last.bc.speed_rpm > 0
+        if reruns and last is not None and (
+                first or speed_change_s(features, last.bc.speed_rpm) is not None):
             rerun, records[-1].rerun_deck = _rerun(model, solver, last, features, factors,
                                                    conditions)
             # the twin's state is the re-run's: it starts the window, its key points over
@@ -363,20 +367,18 @@ def _rerun(model: SpindleModel, solver: WindowSolver, last: _WindowRun,
     """Window k−1 (`last`) re-run with the speed recorded in it (module doc): the fields
     after each step (15, n) and the decks of its stretches as one text (None without decks).
     `features` are window k's (the recorded speed up to its start), `factors` each value's
-    correction factor of window k−1 (held through a stop); a stretch at another speed gets
-    the nominal conditions there, at the window start's temperatures, times those factors."""
+    correction factor of window k−1 (held through a stop); each piece gets the nominal
+    conditions at its speed and its own starting temperatures, times those factors."""
     bc0 = last.bc
-    T_start_C = model.sensor_matrix @ last.T_start
     decks: list[str] = []
 
     def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
-        bc, corr = bc0, last.correction
-        if abs(speed - bc0.speed_rpm) > 0.5:
-            bc = conditions(speed, bc0.ambient_C, bc0.coolant_C, T_start_C)
-            if last.thermal_factors:
-                bc = bc.scaled(last.thermal_factors)
-            corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front,
-                                                    bc.R_rear])))
+        # the nominal loads at this piece's own temperatures (they follow the rings every
+        # LOAD_UPDATE_STEPS), times the window's correction and model-form factors
+        bc = conditions(speed, bc0.ambient_C, bc0.coolant_C, model.sensor_matrix @ T)
+        if last.thermal_factors:
+            bc = bc.scaled(last.thermal_factors)
+        corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front, bc.R_rear])))
         steps, deck = solver(bc, corr, T, start_s, last.window, n_steps=n)
         if deck is not None:
             decks.append(deck)
