@@ -73,7 +73,8 @@ def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
 
 def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, spindle_model):
     # driven by its anchor, the window fit's twin runs exactly as the loop runs `bpnn` with
-    # networks that output 0: the anchored design reproduces the ratio law
+    # networks that output 0 and no re-run (the fit does not re-run): the anchored design
+    # reproduces the ratio law
     from twin.correction.methods import BpnnCorrection, RatioCorrection
     from twin.correction.modelfile import CorrectionModel
     from twin.correction.network import ANCHORED, TrainedNet
@@ -83,7 +84,7 @@ def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, sp
                           np.zeros((1, 10 if o.startswith("heat") else 12)), np.zeros(1),
                           np.zeros(6), np.ones(6), np.zeros(1), np.ones(1))
             for o in ("heat_front", "heat_rear", "resistance_front", "resistance_rear")}
-    zero = BpnnCorrection(CorrectionModel(nets))
+    zero = BpnnCorrection(CorrectionModel(nets), rerun_missed_speed=False)
     bpnn = replay_method(run, spindle_model, zero, keep_fields=False)
     ratio = replay_method(run, spindle_model, RatioCorrection(), keep_fields=False)
     fit = WindowFit(run, spindle_model, drive="anchor")
@@ -93,6 +94,13 @@ def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, sp
                                rtol=1e-12)
     np.testing.assert_allclose(used, np.array(fit.anchors), rtol=1e-12)
     np.testing.assert_allclose(bpnn.T_twin_C, ratio.T_twin_C, rtol=1e-12)
+    # with its re-run (the default) window 0 is re-run before window 1's correction: from
+    # then on the chain differs, window 0 itself does not
+    rerun = replay_method(run, spindle_model, BpnnCorrection(CorrectionModel(nets)),
+                          keep_fields=False)
+    again = np.array([list(w.correction.values) for w in rerun.windows])
+    np.testing.assert_array_equal(again[0], used[0])
+    assert np.abs(again[1] / used[1] - 1).max() > 1e-3
 
 
 def test_fit_needs_the_twin_state(run, spindle_model):

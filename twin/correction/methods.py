@@ -172,7 +172,8 @@ class BpnnCorrection:
     anchored model (the default) corrects the ratio-law value, `ratio_anchor`, by the
     factor exp(output); where its inputs are not finite (window 0, a dead sensor) the
     value is the anchor.  The twin's state and simulated key points it reads come from
-    the re-run of a window with a missed speed change (`rerun_missed_speed`).  A
+    the re-run of a window with a missed speed change and of a run's first window
+    (`rerun_missed_speed`).  A
     paper-configuration model predicts the value itself; non-finite
     inputs fall back to the previous window's correction factor on the current nominal
     value.  The output is kept within the guards' band around the nominal value.  A
@@ -188,8 +189,9 @@ class BpnnCorrection:
     """The last anchor as factors on its nominal values (held through a stop)."""
     rerun_missed_speed: bool = True
     """Ask the loop to re-run a window whose recorded speed changed after its loads were
-    fixed, and to start the next window (and read its inputs) from that re-run
-    (`twin.loop.replay`, `twin.correction.rerun`)."""
+    fixed, and a run's window 0 (its loads held at the cold start's temperatures), and to
+    start the next window (and read its inputs) from that re-run (`twin.loop.replay`,
+    `twin.correction.rerun`)."""
 
     def correct(self, features: WindowFeatures) -> Correction:
         nominal = np.asarray(features.nominal, dtype=float)
