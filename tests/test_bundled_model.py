@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "3b8daaa9a948ba4b87f00d60435754394fe642b838e5d096dc8174aa4f14a05f"
+BUNDLED_MODEL_SHA256 = "c89f963de33d643019d62ce6e7fe850b889a64fdbcda00b00908ea3a2c06c7d1"
 
 
 def _make_model():

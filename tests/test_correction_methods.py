@@ -147,7 +147,7 @@ class _ConstantCorrection:
 
 
 def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_sleeve():
-    from twin.correction.methods import ratio_anchor
+    from twin.correction.methods import ANCHOR_GAINS, ratio_anchor
 
     t, T = _measured()
     T = T.copy()
@@ -169,8 +169,8 @@ def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_
     on_sleeve = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto][:, [0, 1, 3, 3, 4]],
                                t[upto], sim[upto][:, [0, 1, 3, 3, 4]], nominal, previous,
                                previous_factors=(1.05, 1.05, 1.05, 1.05))
-    assert anchor == pytest.approx(np.array(RatioCorrection().correct(on_sleeve).values),
-                                   rel=1e-12)
+    with_gains = RatioCorrection(gains=ANCHOR_GAINS)
+    assert anchor == pytest.approx(np.array(with_gains.correct(on_sleeve).values), rel=1e-12)
     # the networks correct the anchor (× 1.2 here) where their inputs exist; the rear
     # bearing's networks never saw a sleeve for a ring, the anchor stands there
     method = make_corrector("bpnn", model=_ConstantCorrection())
@@ -236,7 +236,7 @@ def test_paper_literal_law_is_worse_in_closed_loop():
 
 
 def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
-    from twin.correction.methods import ratio_anchor
+    from twin.correction.methods import ANCHOR_GAINS, ratio_anchor
 
     t, T = _measured()
     T = T.copy()
@@ -256,11 +256,12 @@ def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
     anchor = ratio_anchor(f, np.array(factors))
     # the ratio law reads T4 at 300 s as now: the Eq. 5 pressure factor of the whole warm-up
     # lands on the rear resistance in this one window
-    stale = np.array(RatioCorrection().correct(f).values)
+    law = RatioCorrection(gains=ANCHOR_GAINS)  # the anchor's exponents
+    stale = np.array(law.correct(f).values)
     assert stale[3] / anchor[3] < 0.9
     # the anchor holds what the dead sleeve would correct, as for a sensor never recorded;
     # the front bearing and the rear heat are read as before
-    assert anchor == pytest.approx(np.array(RatioCorrection().correct(g).values), rel=1e-12)
+    assert anchor == pytest.approx(np.array(law.correct(g).values), rel=1e-12)
     assert anchor[[0, 1, 2]] == pytest.approx(stale[[0, 1, 2]], rel=1e-12)
 
 
