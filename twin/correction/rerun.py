@@ -7,6 +7,10 @@ whole window k−1 is known, so a method may re-run that window from its start f
 the recorded speed, step by step, and start window k from the re-run's end field and
 read its errors off the re-run instead of the forecast that missed the input.
 
+A run's window 0 is re-run the same way (`first_window_at_speed`): its loads were held
+at the cold start's temperatures while the rings warmed, and the re-run's loads follow its
+own temperatures every `LOAD_UPDATE_STEPS`.
+
 One implementation serves every method that does it: the `estimator`
 (`twin.estimation.method`, with its analysed factors) and the loop's state correction for
 `bpnn` (`twin.loop.replay`, through the window decks; the training fit may ask for it too,
@@ -48,6 +52,15 @@ def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None
     rows = (t > f.start_s - f.window_s + 1e-9) & (t < f.start_s - 1e-9)
     moved = np.abs(np.asarray(f.measured_speed_rpm, float)[rows] - forecast_speed_rpm) > 0.5
     return float(t[rows][np.argmax(moved)]) if moved.any() else None
+
+
+def first_window_at_speed(f: WindowFeatures, forecast_speed_rpm: float) -> bool:
+    """Whether the window just ended is a run's window 0 at speed (forecast at
+    `forecast_speed_rpm`), which is re-run like a missed speed change: from a cold start
+    the rings warm by kelvins in its minute and the Palmgren heat falls by about a fifth
+    with the oil's viscosity, while its forecast held the cold value for 60 s; read off
+    that forecast, the held heat looks like bearing heat and contact factors 13–32 % low."""
+    return f.window == 1 and forecast_speed_rpm > 0
 
 
 def recorded_step_speeds(f: WindowFeatures, steps: int, step_s: float) -> np.ndarray:

@@ -169,7 +169,12 @@ from threadpoolctl import threadpool_limits
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import WindowFeatures
-from twin.correction.rerun import recorded_step_speeds, rerun_window, speed_change_s
+from twin.correction.rerun import (
+    first_window_at_speed,
+    recorded_step_speeds,
+    rerun_window,
+    speed_change_s,
+)
 from twin.correction.result import Correction
 from twin.estimation.analysis import etkf_update
 from twin.estimation.ensemble import Ensemble, add_random_walk, cap_spread
@@ -322,7 +327,8 @@ class EnsembleEstimator:
         substeps = cfg.steps_per_window // cfg.bins_per_window
         with threadpool_limits(1):  # tiny dense blocks: BLAS threads only contend
             self._forecast_speed_rpm = f.speed_rpm
-            self._window = (ens.field_mean.copy(), thermal.transient(loads, cfg.step_s), factors)
+            # the window's start field and factors: its readings and its re-run need them
+            self._window = (ens.field_mean.copy(), factors)
             self._forecast = forecast_window(
                 thermal.transient(loads, cfg.step_s),
                 thermal.transient(loads, cfg.step_s * substeps),
@@ -351,13 +357,12 @@ class EnsembleEstimator:
         steps = cfg.steps_per_window
         sim_C = np.asarray(f.simulated_C, float)
         changed_s = speed_change_s(f, self._forecast_speed_rpm)
-        first = f.window == 1 and self._forecast_speed_rpm > 0 and cfg.rerun_first_window
+        first = cfg.rerun_first_window and first_window_at_speed(f, self._forecast_speed_rpm)
         if changed_s is not None or first:
             # the speed changed inside the window just ended, after its loads were fixed:
             # that window is re-run with the speed it really had (all measured before now)
-            # so the innovations and the analysed field are free of the unforeseen input.
-            # So is the first window of a start: its bearings warm fastest, and the heat
-            # the forecast held at the cold oil's viscosity for 60 s is read as wrong factors
+            # so the innovations and the analysed field are free of the unforeseen input;
+            # so is a run's first window (its held cold-start heat, `twin.correction.rerun`)
             sim_C, end.field_mean, fc = self._rerun(f, fc)
         # what the thermocouples would read of the mean over the window just ended: its
         # sensor values through the lag, from their readings at the window start
@@ -457,7 +462,7 @@ class EnsembleEstimator:
         from twin.spindle.conditions import nominal_conditions
 
         cfg = self.config
-        T0, _, factors = self._window
+        T0, factors = self._window
         current = f.twin_state.conditions
         steps = cfg.steps_per_window
 

@@ -54,7 +54,12 @@ from twin.correction.features import (
     WindowFeatures,
     correction_factors,
 )
-from twin.correction.rerun import recorded_step_speeds, rerun_window, speed_change_s
+from twin.correction.rerun import (
+    first_window_at_speed,
+    recorded_step_speeds,
+    rerun_window,
+    speed_change_s,
+)
 from twin.correction.result import Correction, Corrector
 from twin.lag import first_order_lag
 from twin.runs import RecordedRun
@@ -279,9 +284,9 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
         )
-        first = k == 1 and last is not None and last.bc.speed_rpm > 0
         if reruns and last is not None and (
-                first or speed_change_s(features, last.bc.speed_rpm) is not None):
+                first_window_at_speed(features, last.bc.speed_rpm)
+                or speed_change_s(features, last.bc.speed_rpm) is not None):
             rerun, records[-1].rerun_deck = _rerun(model, solver, last, features, factors,
                                                    conditions)
             # the twin's state is the re-run's: it starts the window, its key points over
