@@ -183,6 +183,7 @@ from twin.estimation.parameters import (
     BOUNDARY_VALUES,
     DEFAULT_PARAMETERS,
     DRIFT_ONLY,
+    OBSERVATION_ONLY,
     TangentOperators,
     apply_factors,
     factors_of,
@@ -193,6 +194,9 @@ from twin.spindle.conditions import BoundaryConditions, bearing_values
 
 HEAT_FACTORS = frozenset({"H_front", "H_rear", "motor"})
 """The factors on heat that a stopped spindle does not generate."""
+
+LAG_STEP = 0.05
+"""Log-step of the forward difference by which the readings' lag sensitivity is taken."""
 
 BAND_Z = 1.6448536269514722
 """Half-width of a central 90 % normal interval in σ."""
@@ -212,8 +216,10 @@ class EstimatorConfig:
     """Thermocouple noise per sample, °C."""
     sensor_lag_s: float = 10.0
     """Assumed thermocouple time constant, s (sheathed thermocouples: about 4–20 s)."""
-    lag_sd_s: float = 6.0
-    """Its uncertainty, s: a rate of change r adds lag_sd_s·r to the observation error."""
+    lag_sd_s: float = 3.0
+    """What one first-order lag common to T1..T5 leaves unexplained, s (the sensors' own
+    spread, their placement): a rate of change r adds lag_sd_s·r to the observation error.
+    The lag itself is estimated (`sensor_lag`); with it fixed, 6 s was used."""
     report_readings: bool = True
     """Report T1..T5 as what the thermocouples read (the metal at their points through
     the lag sensor_lag_s); False: the metal temperature at their points."""
@@ -274,6 +280,11 @@ class EnsembleEstimator:
     _band_sd_used: np.ndarray | None = field(default=None, init=False, repr=False)
     _readings_C: np.ndarray | None = field(default=None, init=False, repr=False)
     """T1..T5's readings at the start of the window being forecast (the lag's state)."""
+    _readings_slope_C: np.ndarray | None = field(default=None, init=False, repr=False)
+    """∂(readings at the window start)/∂(log-factor of the lag), °C: the readings' memory of
+    the lag they were read with, carried like the readings themselves."""
+    _lag_s: float = field(default=0.0, init=False, repr=False)
+    """The thermocouples' time constant the window being forecast is read with, s."""
 
     def __post_init__(self) -> None:
         self._params = parameters(self.config.parameters)
@@ -284,6 +295,7 @@ class EnsembleEstimator:
         self._sensors = S
         names = self.config.parameters
         self._expansion = names.index("expansion") if "expansion" in names else None
+        self._lag = names.index("sensor_lag") if "sensor_lag" in names else None
         self._drift_um = 1e6 * np.asarray(self.model.probe_vectors[0])
 
     @property
@@ -306,6 +318,7 @@ class EnsembleEstimator:
                                        cfg.drift_model_sd_um**2 + cfg.drift_noise_um**2])
             self._band_scale = np.ones(2)
             self._readings_C = self._sensors @ np.asarray(f.twin_state.field_C, float)
+            self._readings_slope_C = np.zeros_like(self._readings_C)
             self._ensemble = Ensemble.initial(
                 f.twin_state.field_C, cfg.initial_field_sd_C, self._prior_sd, cfg.members,
                 self._rng,
@@ -321,6 +334,7 @@ class EnsembleEstimator:
         ens.log_factor_mean = np.clip(ens.log_factor_mean, self._bounds[:, 0], self._bounds[:, 1])
 
         factors = factors_of(cfg.parameters, ens.log_factor_mean)
+        self._lag_s = cfg.sensor_lag_s * factors.get("sensor_lag", 1.0)
         bc = apply_factors(self._conditions_at(f.twin_state.conditions, ens.field_mean), factors)
         loads = bc.to_thermal_loads()
         thermal = self.model.thermal
@@ -336,13 +350,14 @@ class EnsembleEstimator:
                 TangentOperators(thermal, bc, cfg.parameters),
                 ens, self._sensors, self._drift_um, cfg.steps_per_window,
             )
-        extra = {k: v for k, v in factors.items() if k not in BOUNDARY_VALUES}
+        extra = {k: v for k, v in factors.items()
+                 if k not in BOUNDARY_VALUES and k not in OBSERVATION_ONLY}
         self._band_sd_used = self._band_sd(self._forecast)
         return Correction.relative_to(
             (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
             readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
-            sensor_lag_s=cfg.sensor_lag_s,
+            sensor_lag_s=self._lag_s,
         )
 
     # ------------------------------------------------------------------ steps
@@ -372,7 +387,7 @@ class EnsembleEstimator:
         if len(read_t) != steps:  # the loop's history must hold the whole window
             raise ValueError(f"window {f.window}: expected {steps} simulated steps, "
                              f"got {len(read_t)}")
-        reads = self._window_readings(sim_t, sim_C)
+        reads, slope = self._window_readings(sim_t, sim_C, with_slope=True)
         read = reads[1:]
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
@@ -383,7 +398,11 @@ class EnsembleEstimator:
             m, counts = bin_mean(t_meas, meas, lo, hi)
             observed.append(np.where(counts >= 2, m, np.nan))  # a lone sample is too noisy
             y_mean.append(read[b].mean(axis=0))
-            y_anom.append(0.5 * (fc.sensors_anomalies_C[i] + fc.sensors_anomalies_C[i + 1]))
+            anom = 0.5 * (fc.sensors_anomalies_C[i] + fc.sensors_anomalies_C[i + 1])
+            if self._lag is not None:  # a member reads its metal with its own lag
+                anom = anom + np.outer(slope[1:][b].mean(axis=0),
+                                       end.log_factor_anomalies[self._lag])
+            y_anom.append(anom)
             # the lag is known only roughly: its error grows with the rate of change
             rate = np.abs(read[b[-1]] - read[b[0]]) / max(hi - lo - cfg.step_s, cfg.step_s)
             sd.append(np.sqrt(cfg.model_sd_C**2 + (cfg.lag_sd_s * rate) ** 2
@@ -427,18 +446,31 @@ class EnsembleEstimator:
         # the readings at the window end, moved with the analysed metal at the sensor
         # points (a thermocouple follows its metal; the analysis corrects the metal)
         self._readings_C = reads[-1] + self._sensors @ (mean[:n] - prior_mean[:n])
+        if self._lag is not None:
+            # and with the analysed lag: the readings as that lag would have left them
+            dlag = mean[n + self._lag] - prior_mean[n + self._lag]
+            self._readings_C = self._readings_C + slope[-1] * dlag
+            self._readings_slope_C = slope[-1]
         return Ensemble.from_stacked(mean, anomalies, n)
 
-    def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray) -> np.ndarray:
+    def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray,
+                         with_slope: bool = False):  # noqa: ANN201
         """T1..T5's readings over the window just ended, its start and steps (the last
         steps + 1 rows of `time_s`, `sensors_C`), from their readings at its start: the
-        metal at the sensor points through the lag, starting from the field the window
-        started from (the analysed one, not the row the loop's history holds there)."""
+        metal at the sensor points through the window's lag, starting from the field the
+        window started from (the analysed one, not the row the loop's history holds there).
+        `with_slope`: also their derivative by the lag's log-factor (same shape), by a
+        forward difference that carries the start readings' own derivative."""
         rows = slice(len(time_s) - self.config.steps_per_window - 1, len(time_s))
         metal = np.array(sensors_C[rows], float)
         metal[0] = self._sensors @ self._window[0]
-        return first_order_lag(metal, time_s[rows], self.config.sensor_lag_s,
-                               self._readings_C)
+        reads = first_order_lag(metal, time_s[rows], self._lag_s, self._readings_C)
+        if not with_slope:
+            return reads
+        eps = LAG_STEP
+        moved = first_order_lag(metal, time_s[rows], self._lag_s * np.exp(eps),
+                                self._readings_C + eps * self._readings_slope_C)
+        return reads, (moved - reads) / eps
 
     def _conditions_at(self, bc: BoundaryConditions, field_C: np.ndarray) -> BoundaryConditions:
         """The loop's nominal conditions with the bearing heat and contact resistance taken

@@ -32,7 +32,8 @@ class Parameter:
 
     name       H_front, H_rear (bearing heat), R_front, R_rear (ring/sleeve contact
                resistance), motor (motor loss), film_<group> (FILM_GROUPS film coefficients),
-               expansion (every thermal expansion coefficient: the drift's scale)
+               expansion (every thermal expansion coefficient: the drift's scale),
+               sensor_lag (the thermocouples' time constant: what T1..T5 read of the metal)
     prior_sd   spread of the prior in log space (0.2 ≈ ±20 %)
     walk_sd    random-walk spread added per 60 s window, log space
     bounds     (lowest, highest) factor on the nominal value
@@ -61,13 +62,16 @@ ALL_PARAMETERS: dict[str, Parameter] = {
         Parameter("film_air_gap", 0.25, 0.005, (0.3, 3.0)),
         Parameter("film_rotor", 0.25, 0.005, (0.3, 3.0)),
         Parameter("expansion", 0.05, 0.002, (0.7, 1.4)),
+        Parameter("sensor_lag", 0.45, 0.01, (0.2, 4.0)),
     )
 }
 """Every candidate.  Prior spreads follow REFERENCE.md §7 (motor ±20–30 %, films ±20–40 %)
-and the paper's corrections (bearing heat and contact resistance moving by tens of %)."""
+and the paper's corrections (bearing heat and contact resistance moving by tens of %);
+sensor_lag's spread spans the 4–20 s of sheathed thermocouples around the assumed 10 s."""
 
 DEFAULT_PARAMETERS: tuple[str, ...] = (
     "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor", "film_coolant", "expansion",
+    "sensor_lag",
 )
 """The estimator's default set; see `twin.estimation.method` for the sensitivity study."""
 
@@ -75,6 +79,14 @@ DRIFT_ONLY: frozenset[str] = frozenset({"expansion"})
 """Parameters no temperature sees: an effective multiplier on every thermal expansion
 coefficient, which scales the nose drift and nothing else.  Only the drift measurement
 updates it; without one it keeps its prior (and widens the drift band by it)."""
+
+OBSERVATION_ONLY: frozenset[str] = frozenset({"sensor_lag"})
+"""Parameters of the sensors, not of the spindle: a factor on the thermocouples' assumed
+time constant.  It moves no temperature (no boundary value, no tangent column); the filter
+applies it where it compares the field with T1..T5 (`twin.estimation.method`)."""
+
+NOT_THERMAL: frozenset[str] = DRIFT_ONLY | OBSERVATION_ONLY
+"""The factors that are no thermal boundary condition (left out of the window's loads)."""
 
 
 def parameters(names: Sequence[str]) -> tuple[Parameter, ...]:
@@ -99,10 +111,11 @@ BOUNDARY_VALUES = ("H_front", "H_rear", "R_front", "R_rear")
 
 def apply_factors(bc: BoundaryConditions, factors: dict[str, float]) -> BoundaryConditions:
     """The conditions with every thermal factor applied (bearing heat, contact, motor,
-    films; the expansion factor is no boundary condition and is left out)."""
+    films; the expansion and sensor-lag factors are no boundary condition and are left
+    out)."""
     values = {v: getattr(bc, v) * factors[v] for v in BOUNDARY_VALUES if v in factors}
     out = bc.scaled({k: v for k, v in factors.items()
-                     if k not in BOUNDARY_VALUES and k not in DRIFT_ONLY})
+                     if k not in BOUNDARY_VALUES and k not in NOT_THERMAL})
     return out.with_values(**values) if values else out
 
 
@@ -116,7 +129,7 @@ class TangentOperators:
         motor      Σ q ∫ v dV over rotor and stator
         R_side     (1/R) K_side T⁺                                  (K_side: unit interface)
         film_g     Σ_b∈g h_b (∫ v T∞ dA − M_b T⁺)                   (M_b: unit film matrix)
-        expansion  0                                                (moves no temperature)
+        expansion, sensor_lag  0                                    (move no temperature)
 
     Built once per window from the applied conditions; `columns(T)` is cheap (one sparse
     mat-vec per contact and film parameter).
@@ -154,7 +167,7 @@ class TangentOperators:
                     op = term if op is None else op + term
                 if op is not None:
                     self.linear.append((i, op))
-            elif name in DRIFT_ONLY:
+            elif name in NOT_THERMAL:
                 pass  # no heat: its column stays zero
             else:
                 raise ValueError(f"no tangent operator for parameter {name!r}")

@@ -419,7 +419,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
             "correction": {
                 "values": list(c.values), "C_H": list(c.C_H), "C_C": list(c.C_C),
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
-                "band_sd": _array(c.band_sd),
+                "band_sd": _array(c.band_sd), "sensor_lag_s": c.sensor_lag_s,
             },
         }
 
@@ -440,7 +440,8 @@ def method_replay_from_json(text: str) -> MethodReplay:
         c = w["correction"]
         correction = Correction(
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
-            state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]))
+            state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]),
+            sensor_lag_s=c["sensor_lag_s"])
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
                             correction, BoundaryValues(*w["nominal"]), w["deck"],
                             w["rerun_deck"])

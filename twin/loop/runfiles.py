@@ -349,6 +349,9 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
         k for r in results.values() for w in r.windows for k in w.correction.factors
     ))
     header += [f"{k}_factor" for k in extra]
+    # the thermocouples' time constant, where a method estimates it (the estimator)
+    lagged = any(w.correction.sensor_lag_s > 0 for r in results.values() for w in r.windows)
+    header += ["sensor_lag_s"] if lagged else []
     rows = []
     for name, r in results.items():
         for w in r.windows:
@@ -366,6 +369,7 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
                     *c.C_H,
                     *c.C_C,
                     *(c.factors.get(k, float("nan")) for k in extra),
+                    *([c.sensor_lag_s if c.sensor_lag_s > 0 else float("nan")] if lagged else []),
                 ]
             )
     write_csv(path, header, rows)
