@@ -20,7 +20,7 @@ from twin.estimation.forecast import forecast_window
 from twin.estimation.method import EnsembleEstimator, EstimatorConfig
 from twin.estimation.parameters import (
     DEFAULT_PARAMETERS,
-    DRIFT_ONLY,
+    NOT_THERMAL,
     TangentOperators,
     apply_factors,
     factors_of,
@@ -31,8 +31,8 @@ from twin.loop.replay import deck_window_solver, direct_window_solver, replay_me
 from twin.loop.runfiles import band_of
 from twin.plant.emulator import synthesize, write_synth
 from twin.plant.profile import SpeedProfile
-from twin.plant.timetable import StepTable
 from twin.plant.scenario import parse_scenario
+from twin.plant.timetable import StepTable
 from twin.runs import read_run
 from twin.spindle.conditions import nominal_conditions
 
@@ -42,8 +42,10 @@ TRUE_FACTORS = {"H_front": 1.25, "H_rear": 0.85, "R_front": 1.5, "motor": 1.2, "
 
 
 def make_run(path, model, minutes=12, factors=TRUE_FACTORS, edit=None):
-    """A recorded run of the twin model with `factors` applied, 1 sample per 4 s."""
-    make_recorded_run(path, model, minutes=minutes, ambient_C=24.0, factors=factors, edit=edit)
+    """A recorded run of the twin model with `factors` applied, 1 sample per 4 s, its loads
+    following its rings every 20 s as the estimator's twin does."""
+    make_recorded_run(path, model, minutes=minutes, ambient_C=24.0, factors=factors, edit=edit,
+                      load_update_steps=5)
     return read_run(path)
 
 
@@ -119,7 +121,7 @@ def test_tangent_linear_members_match_finite_differences_of_the_fem(spindle_mode
     warm = model.thermal.transient(bc0.to_thermal_loads(), 4.0)
     for _ in range(150):
         T = warm.step(T)
-    names = tuple(n for n in DEFAULT_PARAMETERS if n not in DRIFT_ONLY)
+    names = tuple(n for n in DEFAULT_PARAMETERS if n not in NOT_THERMAL)
     eps = 0.02
     ens = Ensemble(T, np.zeros((model.n_dofs, len(names))), np.zeros(len(names)),
                    eps * np.eye(len(names)))
@@ -151,9 +153,15 @@ def synthetic(tmp_path_factory, spindle_model):
 def test_parameters_are_recovered_on_a_case_the_model_can_represent(synthetic):
     run, (est, replay, windows) = synthetic
     found = {k: float(np.exp(v)) for k, v in est.log_factors.items()}
-    # bearing heat and motor loss are seen strongly by T1..T4: within 8 % of the truth
-    for name in ("H_front", "H_rear", "motor"):
+    # bearing heat is seen strongly by T1..T4: within 8 % of the truth
+    for name in ("H_front", "H_rear"):
         assert found[name] == pytest.approx(TRUE_FACTORS[name], rel=0.08), (name, found)
+    # a run at one speed sees the motor loss and the jacket's film only together (module
+    # doc): the loss against the film within 5 %, each alone within 15 % (ensemble seeds
+    # 0–3 give 1.09–1.16 and 0.92–0.97)
+    assert found["motor"] / found["film_coolant"] == pytest.approx(1.2, rel=0.05), found
+    assert found["motor"] == pytest.approx(1.2, rel=0.15), found
+    assert found["film_coolant"] == pytest.approx(1.0, rel=0.15), found
     # nominal-start error in the sensors: open loop is far off, the filter close
     T = run.at(replay.time_s).T_C
     late = replay.time_s > 300
@@ -265,7 +273,9 @@ def test_the_deck_and_the_analysed_field_reproduce_the_reported_mean(tmp_path, s
     metal = np.vstack(forecasts)
     for k, (fc, w) in enumerate(zip(forecasts, replay.windows, strict=True)):
         c = w.correction
-        assert c.sensor_lag_s == 10.0
+        # the assumed lag until the first analysis, then the estimated one (the data have
+        # none: it falls towards the parameter's lower bound, 2 s)
+        assert c.sensor_lag_s == 10.0 if k == 0 else 2.0 <= c.sensor_lag_s < 10.0
         if readings:
             window = np.vstack([model.sensor_matrix @ c.state_C, fc])
             fc = first_order_lag(window, 4.0 * np.arange(16), c.sensor_lag_s,
@@ -442,12 +452,12 @@ def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
     speeds = [9000.0] * 5 + [0.0] * 4 + [9000.0] * 3  # rpm per minute: a 4-minute stop
     T = np.full(model.n_dofs, 24.0)
     times, temps = [0.0], [model.sensor_matrix @ T]
-    for speed in speeds:
+    for speed in np.repeat(speeds, 3):  # loads at the rings' temperatures every 20 s
         s = model.sensor_matrix @ T
         bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
                                 T_sleeves_C=(s[1], s[3]))
         loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
-        for T_step in model.thermal.transient(loads, 4.0).march(T, 15):
+        for T_step in model.thermal.transient(loads, 4.0).march(T, 5):
             times.append(times[-1] + 4.0)
             temps.append(model.sensor_matrix @ T_step)
         T = T_step
@@ -511,15 +521,15 @@ def test_on_a_plant_suite_the_estimator_beats_open_loop_and_its_band_is_calibrat
         assert 60.0 <= est["band_coverage_pct"] <= 100.0, run.stem
 
 
-def test_the_first_window_of_a_cold_start_is_rerun_before_its_analysis(tmp_path,
-                                                                        spindle_model):
+def test_a_cold_start_s_heat_follows_the_rings_or_its_first_window_is_rerun(tmp_path,
+                                                                           spindle_model):
     """An emulated cold start at 12 700 rpm whose truth has every factor at 1 and nothing
     the twin cannot express but its finer mesh and steps: its bearing heat follows the
-    rings every 20 s, and falls by about a fifth over the first minute as the oil warms.
-    The forecast of window 0 held the cold oil's heat for 60 s; re-run as the spindle did,
-    the first analysis finds the true factors and window 1 tracks the run.  Without the
-    re-run it reads the held heat as bearing heat and contact resistance 13–32 % low and
-    window 1 runs about 2 K off."""
+    rings, and falls by about a fifth over the first minute as the oil warms.  With the
+    twin's loads following its rings every 20 s (the default), or held for the window and
+    window 0 re-run so before the first analysis, that analysis finds the true factors and
+    window 1 tracks the run.  Held and not re-run, the filter reads the held cold heat as
+    bearing heat and contact resistance 13–32 % low and window 1 runs about 2 K off."""
     one = "time_s = [0.0]\nfactor = [1.0]\n"
     tables = ("bearing_heat.front", "bearing_heat.rear", "contact_resistance.front",
               "contact_resistance.rear", "motor_heat", "film.coolant", "film.housing",
@@ -532,20 +542,22 @@ def test_the_first_window_of_a_cold_start_is_rerun_before_its_analysis(tmp_path,
                            scenario=parse_scenario(toml, "s.toml")), path)
     run = read_run(path)
 
-    def first_analysis(rerun: bool) -> tuple[dict[str, float], float]:
-        est, replay, windows = estimate(run, spindle_model, sensor_lag_s=0.0,
-                                        rerun_first_window=rerun)
+    def first_analysis(**config) -> tuple[dict[str, float], float]:  # noqa: ANN003
+        est, replay, windows = estimate(run, spindle_model, sensor_lag_s=0.0, **config)
         window_1 = (replay.time_s > 60.0) & (replay.time_s <= 120.0)
         error = np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[window_1].max()
         return {k: float(np.exp(v)) for k, v in windows[1][1].items()}, float(error)
 
-    found, error = first_analysis(True)
-    for name in ("H_front", "H_rear", "R_front", "R_rear"):
-        assert found[name] == pytest.approx(1.0, abs=0.05), (name, found)
-    assert error < 0.3
-    held, error_held = first_analysis(False)
+    errors = []
+    for config in ({}, {"loads_follow_rings": False}):
+        found, error = first_analysis(**config)
+        for name in ("H_front", "H_rear", "R_front", "R_rear"):
+            assert found[name] == pytest.approx(1.0, abs=0.05), (name, found, config)
+        assert error < 0.3, config
+        errors.append(error)
+    held, error_held = first_analysis(loads_follow_rings=False, rerun_first_window=False)
     assert min(held[n] for n in ("H_front", "H_rear", "R_front", "R_rear")) < 0.9, held
-    assert error_held > 4 * error
+    assert error_held > 4 * max(errors)
 
 
 def test_the_thermocouples_lag_is_estimated_from_the_transients(tmp_path, spindle_model):
@@ -572,7 +584,7 @@ def test_the_thermocouples_lag_is_estimated_from_the_transients(tmp_path, spindl
                                scenario=parse_scenario(toml, "s.toml")), path)
         run = read_run(path)
 
-        def error_C(**config):  # noqa: ANN003
+        def error_C(run=run, **config):  # noqa: ANN001, ANN003
             est, replay, _ = estimate(run, spindle_model, **config)
             scored = replay.time_s > 60.0
             err = np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[scored]

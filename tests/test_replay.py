@@ -26,23 +26,25 @@ MINUTES = 5
 
 def make_recorded_run(
     path, model, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7,
-    seed=0, factors=None, noise_C=0.02, edit=None,
+    seed=0, factors=None, noise_C=0.02, edit=None, load_update_steps=15,
 ):
     """`factors` (twin.estimation.parameters names → multiplier) replaces heat/resistance;
     `edit(time_s, temps)` may change the measured temperatures in place before writing;
-    `model` is the SpindleModel that plays the spindle."""
+    `model` is the SpindleModel that plays the spindle; its bearing heat and contact
+    resistance are taken at its ring and sleeve temperatures every `load_update_steps`
+    4 s steps (15: held for each minute, as the paper's twin does)."""
     if factors is None:
         factors = {"H_front": heat, "H_rear": heat, "R_front": resistance}
     T = np.full(model.n_dofs, ambient_C)
     T0 = T.copy()
     times, temps, drift = [0.0], [model.sensor_matrix @ T], [0.0]
-    for _ in range(minutes):
+    for _ in range(minutes * 15 // load_update_steps):
         s = model.sensor_matrix @ T
         bc = nominal_conditions(
             model, speed_rpm, ambient_C, None, T_bearings_C=(s[0], s[2]), T_sleeves_C=(s[1], s[3])
         )
         loads = apply_factors(bc, factors).to_thermal_loads()
-        for T_step in model.thermal.transient(loads, 4.0).march(T, 15):
+        for T_step in model.thermal.transient(loads, 4.0).march(T, load_update_steps):
             times.append(times[-1] + 4.0)
             temps.append(model.sensor_matrix @ T_step)
             drift.append(1e6 * model.probe_vectors[0] @ (T_step - T0))

@@ -15,6 +15,7 @@ far less than the spread's own sampling error with N ≈ 20–40 members.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,8 +70,15 @@ def forecast_window(
     sensor_matrix,  # noqa: ANN001 - (5, n) sparse
     drift_vector_um: np.ndarray,
     steps: int,
+    stepper_at: Callable[[np.ndarray], object] | None = None,
+    update_steps: int | None = None,
 ) -> WindowForecast:
     """Advance the ensemble `steps` solver steps; log-factors are constant over the window.
+
+    With `stepper_at`, the mean's loads follow its own field: every `update_steps` solver
+    steps after the first stretch, its stepper is `stepper_at(T)` at the field reached (the
+    nominal bearing heat and contact resistance at the rings' temperatures, as the window's
+    deck takes them); the members keep `member_stepper`.
 
     The members step `substeps` solver steps at a time (backward Euler with the longer
     step): their anomalies are driven by slow parameter errors, and one multi-column solve
@@ -93,6 +101,8 @@ def forecast_window(
     d_start = float(drift_vector_um @ T)
     explicit = member_stepper.explicit
     for i in range(steps):
+        if stepper_at is not None and i > 0 and i % update_steps == 0:
+            mean_stepper = stepper_at(T)
         T = mean_stepper.step(T)
         s_mean[i] = sensor_matrix @ T
         d_mean[i] = drift_vector_um @ T

@@ -6,8 +6,10 @@ What it estimates
     contact resistance (front, rear), motor loss, the film coefficients of the coolant jacket
     and of the rotor group (rotor ends, shaft, nose, internal air), and an effective
     thermal-expansion factor (every material's α; it scales the nose drift and moves no
-    temperature, so only the recorded drift updates it).  The housing and air-gap film
-    factors are available (`EstimatorConfig.parameters`) but not estimated by default.
+    temperature, so only the recorded drift updates it), and the thermocouples' common time
+    constant (a factor on the assumed 10 s, seen only through T1..T5's readings; see
+    "Thermocouples").  The housing and air-gap film factors are available
+    (`EstimatorConfig.parameters`) but not estimated by default.
 
 Why these (sensitivity and observability study, `python -m twin.estimation.sensitivity`,
 run with the twin model itself: 30 min from a cold start, T1..T5 and the axial drift every
@@ -65,8 +67,10 @@ The filter (Evensen 2009; REFERENCE.md §7)
     if the speed changed inside that window (after its loads were fixed), that window is
     first re-run from its start field with the recorded speed from the change on (all of it
     measured before the window now starting), so neither the innovations nor the analysed
-    field carry the unforeseen input (`speed_change_s`, `_rerun`).  The first window of a
-    run is re-run too: from a cold start the rings warm by kelvins in a minute and the
+    field carry the unforeseen input (`speed_change_s`, `_rerun`).  With the loads held for
+    each window (`loads_follow_rings=False`) the first window of a run is re-run too
+    (with the default following loads its forecast already is that re-run): from a cold
+    start the rings warm by kelvins in a minute and the
     Palmgren heat falls by a fifth with the oil's viscosity, which the forecast held at
     its cold value for 60 s; the first analysis read that as bearing heat 15–25 % low and
     the second window started 1–2 K cold (suite 112233 run 8).  A re-run re-evaluates the
@@ -81,7 +85,15 @@ The filter (Evensen 2009; REFERENCE.md §7)
     (2) random walk of the log-factors (seeded draws: a replay is deterministic), spread
     capped at the prior, mean clipped to the bounds; (3) forecast of the next window
     (`forecast`): the mean by the FEM with the mean factors, members tangent-linear on one
-    factorization, stepping 20 s.  Multiplicative inflation (default 1.2) guards against
+    factorization, stepping 20 s.  The mean's nominal bearing heat and contact resistance
+    follow its own ring and sleeve temperatures every 20 s (`loads_follow_rings`, three
+    pieces per window, as a re-run takes them), the factors held: the factors are the
+    correction, the nominal values' dependence on temperature is physics the spindle obeys
+    within the minute too.  Held for 60 s instead, the first window at a new speed ran up
+    to 3.8 K warm at the front ring after a step from 3100 to 13 400 rpm on a window
+    boundary, as the cold rings' Palmgren heat was kept while they warmed, and the next
+    analysis read that as too much bearing heat (the window after ran 1.1 K cold).
+    Multiplicative inflation (default 1.2) guards against
     collapse; the bounded log-space priors against drift.  1.2 rather than 1.05 because the
     model-form error keeps the members too sure of the drift after starts, steps and stops
     (prior drift spread 0.07–0.14 µm against misfits of 0.2–0.5 µm): deformation median
@@ -94,7 +106,10 @@ Causality
 Deck, analysed state and members
     The window deck `decks/window_kkk.inp` carries the mean's loads (bearing heat and contact
     resistance in their usual commands, motor and film factors already applied to the
-    rotor/stator heat and the film coefficients).  It runs from the analysed mean field at
+    rotor/stator heat and the film coefficients), as three 20 s load steps whose bearing
+    heat and contact resistance the loop took at the twin's temperatures at each one's
+    start (`twin.loop.replay`, `Correction.loads_follow_rings`).  It runs from the
+    analysed mean field at
     60k s (the session's state, set before the deck), so deck + analysed field reproduce the
     reported twin trajectory exactly.  The members never appear in decks: each is the mean
     plus a tangent-linear anomaly, and only their spread is reported (the 90 % band).
@@ -136,10 +151,19 @@ Thermocouples (T1..T5 as reported)
     Measured (temperature accuracy, median / worst): suite 271828 99.70 / 99.11 → 99.73 /
     99.25 % (every run up or equal), the fresh suite 5150 99.71 / 99.39 → 99.77 / 99.46 %;
     the drift within ±0.02 points, the band's coverage 88.6–91.8 % (was 89.1–91.9 %).
-    Identifying each run's τ from the
-    misfit of the forecast through candidate lags (3–28 s) was tried and dropped: the
-    forecast's own errors dominate that misfit, it picked 3 s for a 16.5 s sensor and 14 s
-    for 4.5–6.5 s ones, and scored below the fixed 10 s.
+    The lag τ itself is estimated: one factor `sensor_lag` on the assumed 10 s, common to
+    T1..T5 (thermocouples of one type; prior spread 0.45 in log space, so 4–20 s are within
+    about 1.5 σ), in the ensemble like the boundary factors but moving no temperature: a
+    member reads the mean's readings plus its field anomaly plus ∂(readings)/∂φ_τ times its
+    own δφ_τ.  That derivative is a forward difference of the lag over the window, started
+    from the readings' own derivative at the window start, which is carried from window to
+    window like the readings (a thermocouple's reading remembers the lag it was read with).
+    After an analysis the readings move by the analysed change of the metal and by that
+    derivative times the analysed change of φ_τ.  At a steady speed the readings do not
+    depend on τ and it keeps its prior; starts, steps and stops identify it.  Scoring
+    candidate lags (3–28 s) by the misfit of the forecast through each had picked 3 s for
+    a 16.5 s sensor and 14 s for 4.5–6.5 s ones; in the filter, against the other factors'
+    covariance, the tests' emulated runs find 5.1 s for 5 s and 17.5 s for 18 s.
 
 Band
     Per solver step, ±1.645 σ around the mean: σ² = member variance of the sensor value +
@@ -170,6 +194,7 @@ from threadpoolctl import threadpool_limits
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import WindowFeatures
 from twin.correction.rerun import (
+    LOAD_UPDATE_STEPS,
     first_window_at_speed,
     recorded_step_speeds,
     rerun_window,
@@ -259,7 +284,12 @@ class EstimatorConfig:
     band_floor_um: float = 0.05
     """Least model-plus-noise spread of the drift band, µm."""
     rerun_first_window: bool = True
-    """Re-run the first window of a run before its analysis (the cold start; module doc)."""
+    """With loads held for each window (not `loads_follow_rings`): re-run the first window
+    of a run before its analysis (the cold start; module doc).  With the loads following
+    the rings the forecast already is that re-run."""
+    loads_follow_rings: bool = True
+    """The window's nominal bearing heat and contact resistance follow the twin's ring and
+    sleeve temperatures every 20 s (module doc); False: held at the window start."""
 
 
 @dataclass
@@ -335,7 +365,10 @@ class EnsembleEstimator:
 
         factors = factors_of(cfg.parameters, ens.log_factor_mean)
         self._lag_s = cfg.sensor_lag_s * factors.get("sensor_lag", 1.0)
-        bc = apply_factors(self._conditions_at(f.twin_state.conditions, ens.field_mean), factors)
+        def conditions_at(T: np.ndarray) -> BoundaryConditions:
+            return apply_factors(self._conditions_at(f.twin_state.conditions, T), factors)
+
+        bc = conditions_at(ens.field_mean)
         loads = bc.to_thermal_loads()
         thermal = self.model.thermal
         substeps = cfg.steps_per_window // cfg.bins_per_window
@@ -349,6 +382,10 @@ class EnsembleEstimator:
                 substeps,
                 TangentOperators(thermal, bc, cfg.parameters),
                 ens, self._sensors, self._drift_um, cfg.steps_per_window,
+                stepper_at=(lambda T: thermal.transient(conditions_at(T).to_thermal_loads(),
+                                                        cfg.step_s))
+                if cfg.loads_follow_rings else None,
+                update_steps=LOAD_UPDATE_STEPS,
             )
         extra = {k: v for k, v in factors.items()
                  if k not in BOUNDARY_VALUES and k not in OBSERVATION_ONLY}
@@ -357,7 +394,7 @@ class EnsembleEstimator:
             (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
             readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
-            sensor_lag_s=self._lag_s,
+            sensor_lag_s=self._lag_s, loads_follow_rings=cfg.loads_follow_rings,
         )
 
     # ------------------------------------------------------------------ steps
@@ -372,7 +409,8 @@ class EnsembleEstimator:
         steps = cfg.steps_per_window
         sim_C = np.asarray(f.simulated_C, float)
         changed_s = speed_change_s(f, self._forecast_speed_rpm)
-        first = cfg.rerun_first_window and first_window_at_speed(f, self._forecast_speed_rpm)
+        first = (cfg.rerun_first_window and not cfg.loads_follow_rings
+                 and first_window_at_speed(f, self._forecast_speed_rpm))
         if changed_s is not None or first:
             # the speed changed inside the window just ended, after its loads were fixed:
             # that window is re-run with the speed it really had (all measured before now)

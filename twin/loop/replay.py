@@ -312,7 +312,17 @@ def replay_method(
                 band = np.full((n_steps, 6), np.nan)
             band[k * STEPS_PER_WINDOW : (k + 1) * STEPS_PER_WINDOW] = corr.band_sd
         last = _WindowRun(T, start, k, bc, corr, thermal_factors)
-        steps, deck = solver(bc, corr, T, start, k)
+        if corr.loads_follow_rings:
+            # the correction's values as factors on the nominal values at the window's
+            # start field, re-applied every LOAD_UPDATE_STEPS at the twin's own temperatures
+            at_start = conditions(speed, ambient, coolant, model.sensor_matrix @ T)
+            steps, deck = _follow_rings(
+                model, solver, last, np.full(STEPS_PER_WINDOW, speed),
+                np.asarray(correction_factors(corr.values, BoundaryValues(
+                    at_start.H_front, at_start.H_rear, at_start.R_front, at_start.R_rear))),
+                conditions)
+        else:
+            steps, deck = solver(bc, corr, T, start, k)
         start_T = model.sensor_matrix @ T
         T = steps[-1]
         sl = slice(k * STEPS_PER_WINDOW, (k + 1) * STEPS_PER_WINDOW)
@@ -372,8 +382,22 @@ def _rerun(model: SpindleModel, solver: WindowSolver, last: _WindowRun,
     """Window k−1 (`last`) re-run with the speed recorded in it (module doc): the fields
     after each step (15, n) and the decks of its stretches as one text (None without decks).
     `features` are window k's (the recorded speed up to its start), `factors` each value's
-    correction factor of window k−1 (held through a stop); each piece gets the nominal
-    conditions at its speed and its own starting temperatures, times those factors."""
+    correction factor of window k−1 (held through a stop)."""
+    return _follow_rings(model, solver, last,
+                         recorded_step_speeds(features, STEPS_PER_WINDOW, STEP_S), factors,
+                         conditions)
+
+
+def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
+                  speeds: np.ndarray, factors: np.ndarray,
+                  conditions: Callable[..., BoundaryConditions]
+                  ) -> tuple[np.ndarray, str | None]:
+    """`window` solved from its start field with the speed of each solver step `speeds`,
+    in pieces of constant speed and at most LOAD_UPDATE_STEPS (`twin.correction.rerun`):
+    each piece gets the nominal conditions at its speed and its own starting temperatures,
+    times `factors` (the four values') and the window's model-form factors.  Returns the
+    fields after each step (steps, n) and the pieces' decks as one text (None without)."""
+    last = window
     bc0 = last.bc
     decks: list[str] = []
 
@@ -389,9 +413,7 @@ def _rerun(model: SpindleModel, solver: WindowSolver, last: _WindowRun,
             decks.append(deck)
         return steps
 
-    fields = rerun_window(last.T_start, last.start_s,
-                          recorded_step_speeds(features, STEPS_PER_WINDOW, STEP_S), STEP_S,
-                          advance)
+    fields = rerun_window(last.T_start, last.start_s, speeds, STEP_S, advance)
     return fields, ("".join(decks) if decks else None)
 
 
@@ -420,6 +442,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
                 "values": list(c.values), "C_H": list(c.C_H), "C_C": list(c.C_C),
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
                 "band_sd": _array(c.band_sd), "sensor_lag_s": c.sensor_lag_s,
+                "loads_follow_rings": c.loads_follow_rings,
             },
         }
 
@@ -441,7 +464,7 @@ def method_replay_from_json(text: str) -> MethodReplay:
         correction = Correction(
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
             state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]),
-            sensor_lag_s=c["sensor_lag_s"])
+            sensor_lag_s=c["sensor_lag_s"], loads_follow_rings=c["loads_follow_rings"])
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
                             correction, BoundaryValues(*w["nominal"]), w["deck"],
                             w["rerun_deck"])
