@@ -10,6 +10,12 @@ window starts:
       → window deck (apdl_like) → 15 backward-Euler steps of 4 s in the persistent session
       → T1..T5 and the nose drift per step (probes), fields at the window end
 
+A correction with `loads_follow_rings` (the estimator's) gives its values as factors on
+the nominal values at the window's start field: the deck is then three load steps of 20 s,
+each with the nominal bearing heat and contact resistance at the twin's own ring and sleeve
+temperatures at its start times those factors (`_follow_rings`, the same pieces as a
+re-run below).  The others' values hold for the whole window, as the paper sets them.
+
 The temperature state carries over from window to window.  A stop (speed 0) is an
 ordinary window: no bearing or motor heat, the twin cools; each value's correction factor
 is held through the stop and resumes at the restart (`WindowFeatures.previous_factors`).
@@ -397,23 +403,22 @@ def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
     each piece gets the nominal conditions at its speed and its own starting temperatures,
     times `factors` (the four values') and the window's model-form factors.  Returns the
     fields after each step (steps, n) and the pieces' decks as one text (None without)."""
-    last = window
-    bc0 = last.bc
+    ambient, coolant = window.bc.ambient_C, window.bc.coolant_C
     decks: list[str] = []
 
     def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
         # the nominal loads at this piece's own temperatures (they follow the rings every
         # LOAD_UPDATE_STEPS), times the window's correction and model-form factors
-        bc = conditions(speed, bc0.ambient_C, bc0.coolant_C, model.sensor_matrix @ T)
-        if last.thermal_factors:
-            bc = bc.scaled(last.thermal_factors)
+        bc = conditions(speed, ambient, coolant, model.sensor_matrix @ T)
+        if window.thermal_factors:
+            bc = bc.scaled(window.thermal_factors)
         corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front, bc.R_rear])))
-        steps, deck = solver(bc, corr, T, start_s, last.window, n_steps=n)
+        steps, deck = solver(bc, corr, T, start_s, window.window, n_steps=n)
         if deck is not None:
             decks.append(deck)
         return steps
 
-    fields = rerun_window(last.T_start, last.start_s, speeds, STEP_S, advance)
+    fields = rerun_window(window.T_start, window.start_s, speeds, STEP_S, advance)
     return fields, ("".join(decks) if decks else None)
 
 
