@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "c89f963de33d643019d62ce6e7fe850b889a64fdbcda00b00908ea3a2c06c7d1"
+BUNDLED_MODEL_SHA256 = "8202b9cd672a7d27462329eb56800697dc00c72969951338f81b62a858ea7d76"
 
 
 def _make_model():

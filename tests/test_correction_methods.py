@@ -20,10 +20,10 @@ TRUE_HEAT = np.array([1.10, 0.90])  # truth / nominal
 TRUE_RES = np.array([1.30, 0.80])
 
 
-def _measured(seed=0, noise=0.05):
+def _measured(seed=0, noise=0.05, heat=TRUE_HEAT, res=TRUE_RES):
     t = np.arange(0, 1801, 2.0)
-    H = PLANT.nominal_heat_W_m3(SPEED) * TRUE_HEAT
-    R = PLANT.nominal_resistance_m2K_W(SPEED) * TRUE_RES
+    H = PLANT.nominal_heat_W_m3(SPEED) * heat
+    R = PLANT.nominal_resistance_m2K_W(SPEED) * res
     T = PLANT.simulate(t, SPEED, AMBIENT, H, R)
     return t, T + np.random.default_rng(seed).normal(0, noise, T.shape)
 
@@ -32,8 +32,9 @@ def _nominal():
     return BoundaryValues(*PLANT.nominal_heat_W_m3(SPEED), *PLANT.nominal_resistance_m2K_W(SPEED))
 
 
-def _twin(method, t_meas, T_meas, windows=30):
-    """Window-by-window twin of the plant driven by `method`; returns values and errors."""
+def _twin(method, t_meas, T_meas, windows=30, heat=TRUE_HEAT, res=TRUE_RES):
+    """Window-by-window twin of the plant driven by `method`; returns the values as factors
+    on nominal per window and the mean |error| of T1..T5 against the truth after 600 s."""
     nominal = _nominal()
     prev = nominal
     sim_t, sim_T = [0.0], [np.full(5, AMBIENT)]
@@ -52,8 +53,8 @@ def _twin(method, t_meas, T_meas, windows=30):
         sim_t += list(steps[1:])
         sim_T += list(T[1:])
     sim_t, sim_T = np.array(sim_t), np.array(sim_T)
-    truth = PLANT.simulate(sim_t, SPEED, AMBIENT, PLANT.nominal_heat_W_m3(SPEED) * TRUE_HEAT,
-                           PLANT.nominal_resistance_m2K_W(SPEED) * TRUE_RES)
+    truth = PLANT.simulate(sim_t, SPEED, AMBIENT, PLANT.nominal_heat_W_m3(SPEED) * heat,
+                           PLANT.nominal_resistance_m2K_W(SPEED) * res)
     late = sim_t > 600
     return np.array(history), np.abs(sim_T - truth)[late].mean(axis=0)
 
@@ -147,7 +148,7 @@ class _ConstantCorrection:
 
 
 def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_sleeve():
-    from twin.correction.methods import ANCHOR_GAINS, ratio_anchor
+    from twin.correction.methods import ANCHOR_LAW, ratio_anchor
 
     t, T = _measured()
     T = T.copy()
@@ -169,8 +170,7 @@ def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_
     on_sleeve = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto][:, [0, 1, 3, 3, 4]],
                                t[upto], sim[upto][:, [0, 1, 3, 3, 4]], nominal, previous,
                                previous_factors=(1.05, 1.05, 1.05, 1.05))
-    with_gains = RatioCorrection(gains=ANCHOR_GAINS)
-    assert anchor == pytest.approx(np.array(with_gains.correct(on_sleeve).values), rel=1e-12)
+    assert anchor == pytest.approx(np.array(ANCHOR_LAW.correct(on_sleeve).values), rel=1e-12)
     # the networks correct the anchor (× 1.2 here) where their inputs exist; the rear
     # bearing's networks never saw a sleeve for a ring, the anchor stands there
     method = make_corrector("bpnn", model=_ConstantCorrection())
@@ -236,7 +236,7 @@ def test_paper_literal_law_is_worse_in_closed_loop():
 
 
 def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
-    from twin.correction.methods import ANCHOR_GAINS, ratio_anchor
+    from twin.correction.methods import ANCHOR_LAW, ratio_anchor
 
     t, T = _measured()
     T = T.copy()
@@ -254,9 +254,10 @@ def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
     g = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], absent, t[upto], sim[upto],
                        nominal, previous, previous_factors=factors)
     anchor = ratio_anchor(f, np.array(factors))
-    # the ratio law reads T4 at 300 s as now: the Eq. 5 pressure factor of the whole warm-up
-    # lands on the rear resistance in this one window
-    law = RatioCorrection(gains=ANCHOR_GAINS)  # the anchor's exponents
+    # the anchor's law reads T4 at 300 s as now: a ring-to-sleeve drop the twin's moving
+    # sleeve cannot match lands on the rear resistance in this one window (in the `ratio`
+    # method, the Eq. 5 pressure factor of the whole warm-up as well)
+    law = ANCHOR_LAW
     stale = np.array(law.correct(f).values)
     assert stale[3] / anchor[3] < 0.9
     # the anchor holds what the dead sleeve would correct, as for a sensor never recorded;
@@ -292,3 +293,73 @@ def test_anchored_inputs_are_relative_to_the_twins_rise_and_drop():
     drop_error = (level[ring] - level[sleeve]) - (level_sim[ring] - level_sim[sleeve])
     assert once["resistance_front"][0, 2] == pytest.approx(
         drop_error / (level_sim[ring] - level_sim[sleeve]), rel=1e-9)
+
+
+class _AnchorOnly:
+    """A stand-in anchored model whose networks all answer 0: bpnn is its anchor."""
+
+    anchored = True
+
+    def predict(self, output, x, anchor=None):
+        return np.asarray(anchor, dtype=float)
+
+
+def test_anchor_closes_a_doubled_rear_contact_under_a_heat_surge():
+    """Closed loop on the lumped plant from a cold start, the rear bearing's heat 1.5× and
+    its contact resistance 2× nominal (suite 7070 run 9's truth, rounded).  In the first
+    windows the heat correction is large, and the ring-to-sleeve drop is heat flux ×
+    resistance: what the heat change explains must come out of the drop ratio before the
+    per-window clip, else a drop 3× the twin's (clip 1.25) over a heat change of 1.5 moves
+    the resistance *down*, away from the truth (the law the `ratio` method keeps)."""
+    from twin.correction.methods import ANCHOR_GAINS
+
+    heat, res = np.array([1.0, 1.5]), np.array([1.0, 2.0])
+    t, T = _measured(heat=heat, res=res)
+    values, err = _twin(make_corrector("bpnn", model=_AnchorOnly()), t, T, heat=heat, res=res)
+    rear = values[:, 3] / res[1]
+    # the first correction moves the resistance towards the truth, by the guard's full
+    # step (1.25); within 10 % of it after five windows, and it stays near it
+    assert rear[1] == pytest.approx(1.25 / res[1], rel=1e-9)
+    assert abs(rear[5] - 1) < 0.1
+    assert rear[-10:].mean() == pytest.approx(1.0, abs=0.05)
+    assert np.all(np.abs(rear[-10:] - 1) < 0.15)
+    assert values[-10:, 1].mean() == pytest.approx(heat[1], rel=0.03)
+    assert err[2:4].max() < 0.08  # T3, T4 after 10 min, K
+    # clipped before the heat share (the `ratio` method's order), the first correction
+    # lowers the doubled resistance to 0.6× nominal and the rear twin runs 2× further off
+    clip_first = RatioCorrection(gains=ANCHOR_GAINS)
+    old_values, old_err = _twin(clip_first, t, T, heat=heat, res=res)
+    assert old_values[1, 3] < 0.7
+    assert np.all(old_err[2:4] > 2 * err[2:4])
+
+
+def test_anchor_counts_the_contact_pressure_change_once():
+    """The loop evaluates the nominal resistance every window with Eq. 4/5 at the twin's own
+    ring and sleeve temperatures.  A twin that matches the measurement exactly while its
+    rings warm ahead of the sleeves (the fit tightens, R falls) has that fall in its new
+    nominal value already: the anchor keeps its factor on it (the ratio law leaves a value
+    that matches unchanged), where applying the measured Eq. 5 change as well would lower
+    the resistance by the same fall a second time."""
+    from twin.correction.formulas import ContactFit, contact_pressure_factor
+    from twin.correction.methods import ANCHOR_GAINS, ratio_anchor
+
+    t = np.arange(0, 121, 2.0)
+    T = PLANT.simulate(t, SPEED, AMBIENT, np.array(_nominal()[:2]), np.array(_nominal()[2:]))
+    start = 60.0  # the first minute: the rings warm by kelvins, their sleeves hardly
+    seen = t <= start
+    cold = np.array(_nominal())
+    # Eq. 5 of the twin's (= the measured) rings and sleeves, as the loop's nominal values
+    fits = (ContactFit(), ContactFit(fit_radius_m=0.0425))
+    now = T[seen][-1] - T[0]
+    fall = np.array([float(contact_pressure_factor(now[r], now[r + 1], fit))
+                     for r, fit in zip((0, 2), fits, strict=True)])
+    assert np.all(fall < 0.98)  # the rings run ahead of their sleeves: R fell
+    nominal = BoundaryValues(*cold[:2], *(cold[2:] * fall))
+    factors = np.array([1.1, 0.9, 1.3, 0.8])
+    previous = BoundaryValues(*(cold * factors))
+    f = WindowFeatures(1, start, SPEED, AMBIENT, t[seen], T[seen], t[seen], T[seen], nominal,
+                       previous, previous_factors=tuple(factors))
+    anchor = ratio_anchor(f, factors) / np.array(nominal)
+    assert anchor == pytest.approx(factors, rel=1e-12)
+    with_eq5 = np.array(RatioCorrection(gains=ANCHOR_GAINS).correct(f).values) / np.array(nominal)
+    assert np.all(with_eq5[2:] < 0.99 * factors[2:])

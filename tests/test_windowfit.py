@@ -74,8 +74,8 @@ def test_training_passes_are_seeded_and_targets_are_the_fit(run, spindle_model):
 def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, spindle_model):
     # driven by its anchor, the window fit's twin runs exactly as the loop runs `bpnn` with
     # networks that output 0 and no re-run (the fit does not re-run): the anchored design
-    # reproduces the ratio law (with the anchor's exponents)
-    from twin.correction.methods import ANCHOR_GAINS, BpnnCorrection, RatioCorrection
+    # reproduces the ratio law (the anchor's, `ANCHOR_LAW`)
+    from twin.correction.methods import ANCHOR_LAW, BpnnCorrection
     from twin.correction.modelfile import CorrectionModel
     from twin.correction.network import ANCHORED, TrainedNet
 
@@ -86,8 +86,7 @@ def test_anchor_chain_of_the_fit_is_the_ratio_law_with_a_network_of_zero(run, sp
             for o in ("heat_front", "heat_rear", "resistance_front", "resistance_rear")}
     zero = BpnnCorrection(CorrectionModel(nets), rerun_missed_speed=False)
     bpnn = replay_method(run, spindle_model, zero, keep_fields=False)
-    ratio = replay_method(run, spindle_model, RatioCorrection(gains=ANCHOR_GAINS),
-                          keep_fields=False)
+    ratio = replay_method(run, spindle_model, ANCHOR_LAW, keep_fields=False)
     fit = WindowFit(run, spindle_model, drive="anchor")
     replay_method(run, spindle_model, fit, keep_fields=False)
     used = np.array([list(w.correction.values) for w in bpnn.windows])
