@@ -595,3 +595,22 @@ def test_the_thermocouples_lag_is_estimated_from_the_transients(tmp_path, spindl
         assert lo < found_s < hi, (lag_s, found_s)
         _, error_fixed = error_C(parameters=held)
         assert error < 0.9 * error_fixed, (lag_s, error, error_fixed)
+
+
+def test_the_lag_is_held_where_no_transient_shows_it(tmp_path, spindle_model):
+    """A constant-speed run of the twin model with instant sensors: the start's fast rise
+    moves the lag from the assumed 10 s towards none in the first windows; once the rise
+    is slow the readings tell the lag only as a level (τ·dT/dt), which would let it stand
+    in for other errors, and it is held.  Without the hold it kept moving every window (on
+    suite 24680 run 1 it crept from 22 s to its bound of 40 s over a 40-min run)."""
+    run = make_run(tmp_path / "steady.csv", spindle_model, minutes=12)
+
+    def lags(**config):  # noqa: ANN003
+        return [c.sensor_lag_s for c, _ in estimate(run, spindle_model, **config)[2]]
+
+    held = lags()
+    assert held[0] == 10.0 and held[1] < 6.0  # the start shows the sensors are fast
+    late = held[4:]
+    assert late == [late[0]] * len(late)
+    free = lags(lag_update_min_C=0.0)[4:]
+    assert len(set(free)) > 3
