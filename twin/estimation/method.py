@@ -436,7 +436,8 @@ class EnsembleEstimator:
         if len(read_t) != steps:  # the loop's history must hold the whole window
             raise ValueError(f"window {f.window}: expected {steps} simulated steps, "
                              f"got {len(read_t)}")
-        reads, slope = self._window_readings(sim_t, sim_C, with_slope=True)
+        reads = self._window_readings(sim_t, sim_C)
+        slope = self._readings_lag_slope(sim_t, sim_C, reads)
         read = reads[1:]
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
@@ -504,24 +505,31 @@ class EnsembleEstimator:
             self._readings_slope_C = slope[-1]
         return Ensemble.from_stacked(mean, anomalies, n)
 
-    def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray,
-                         with_slope: bool = False):  # noqa: ANN201
-        """T1..T5's readings over the window just ended, its start and steps (the last
-        steps + 1 rows of `time_s`, `sensors_C`), from their readings at its start: the
-        metal at the sensor points through the window's lag, starting from the field the
-        window started from (the analysed one, not the row the loop's history holds there).
-        `with_slope`: also their derivative by the lag's log-factor (same shape), by a
-        forward difference that carries the start readings' own derivative."""
+    def _window_metal(self, time_s: np.ndarray, sensors_C: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """The metal at the sensor points over the window just ended, its start and steps
+        (the last steps + 1 rows of `time_s`, `sensors_C`), the start taken from the field
+        the window started from (the analysed one, not the row the loop's history holds
+        there); and those rows' times, s."""
         rows = slice(len(time_s) - self.config.steps_per_window - 1, len(time_s))
         metal = np.array(sensors_C[rows], float)
         metal[0] = self._sensors @ self._window[0]
-        reads = first_order_lag(metal, time_s[rows], self._lag_s, self._readings_C)
-        if not with_slope:
-            return reads
-        eps = LAG_STEP
-        moved = first_order_lag(metal, time_s[rows], self._lag_s * np.exp(eps),
-                                self._readings_C + eps * self._readings_slope_C)
-        return reads, (moved - reads) / eps
+        return metal, np.asarray(time_s[rows], float)
+
+    def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray) -> np.ndarray:
+        """T1..T5's readings over the window just ended (rows as `_window_metal`): its
+        metal through the window's lag, from their readings at its start."""
+        metal, t = self._window_metal(time_s, sensors_C)
+        return first_order_lag(metal, t, self._lag_s, self._readings_C)
+
+    def _readings_lag_slope(self, time_s: np.ndarray, sensors_C: np.ndarray,
+                            readings_C: np.ndarray) -> np.ndarray:
+        """∂(`readings_C`, the window's readings)/∂(the lag's log-factor), same shape: a
+        forward difference that carries the start readings' own derivative."""
+        metal, t = self._window_metal(time_s, sensors_C)
+        moved = first_order_lag(metal, t, self._lag_s * np.exp(LAG_STEP),
+                                self._readings_C + LAG_STEP * self._readings_slope_C)
+        return (moved - readings_C) / LAG_STEP
 
     def _conditions_at(self, bc: BoundaryConditions, field_C: np.ndarray) -> BoundaryConditions:
         """The loop's nominal conditions with the bearing heat and contact resistance taken
