@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin.correction.rerun import LOAD_UPDATE_STEPS
 from twin.estimation.ensemble import Ensemble
 from twin.estimation.parameters import TangentOperators
 
@@ -71,7 +72,7 @@ def forecast_window(
     drift_vector_um: np.ndarray,
     steps: int,
     stepper_at: Callable[[np.ndarray], object] | None = None,
-    update_steps: int | None = None,
+    update_steps: int = LOAD_UPDATE_STEPS,
 ) -> WindowForecast:
     """Advance the ensemble `steps` solver steps; log-factors are constant over the window.
 

@@ -200,7 +200,6 @@ from threadpoolctl import threadpool_limits
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import WindowFeatures
 from twin.correction.rerun import (
-    LOAD_UPDATE_STEPS,
     first_window_at_speed,
     recorded_step_speeds,
     rerun_window,
@@ -396,7 +395,6 @@ class EnsembleEstimator:
                 stepper_at=(lambda T: thermal.transient(conditions_at(T).to_thermal_loads(),
                                                         cfg.step_s))
                 if cfg.loads_follow_rings else None,
-                update_steps=LOAD_UPDATE_STEPS,
             )
         extra = {k: v for k, v in factors.items()
                  if k not in BOUNDARY_VALUES and k not in OBSERVATION_ONLY}
