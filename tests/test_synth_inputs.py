@@ -89,6 +89,10 @@ def test_design_example_scenario_parses(tmp_path):
     ("\n[sensors]\nplacement_mm = -1\n", 3, "sensors.placement_mm", "greater than or equal"),
     ("[motor_heat]\ntime_s = [0]\nfactor = [0]\n", 3, "motor_heat.factor.0", "greater than 0"),
     ("[material]\nexpansion = 3\n", 2, "material.expansion", "less than or equal to 2"),
+    # a boolean or a quoted number is a slip, not a factor (lax parsing read true as 1.0)
+    ("[motor_heat]\ntime_s = [0]\nfactor = [true]\n", 3, "motor_heat.factor.0",
+     "valid number"),
+    ("[sensors]\nlag_s = \"8\"\n", 2, "sensors.lag_s", "valid number"),
 ])
 def test_bad_scenarios(text, row, column, words):
     with pytest.raises(InputError) as info:

@@ -72,8 +72,10 @@ def sensor_column(name: str) -> str:
 
 
 class _Strict(BaseModel):
-    # inf and nan are no times, factors or temperatures (TOML spells them `inf`, `nan`)
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    # inf and nan are no times, factors or temperatures (TOML spells them `inf`, `nan`);
+    # strict: TOML has typed values, so `true` or "1.2" where a number belongs is a slip
+    # (lax parsing would read them as 1.0 and 1.2)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 Times = Annotated[list[Annotated[float, Field(ge=0.0)]], Field(min_length=1)]
