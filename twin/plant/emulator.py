@@ -218,9 +218,11 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         model = SpindleModel.load(size_factor=scenario.model.size_factor)
     spec = model.spec
     limit = spec.spindle.max_speed_rpm
-    if np.max(speed.values) > limit:
-        raise InputError(f"speed {np.max(speed.values):g} rpm exceeds the spindle's limit "
-                         f"{limit:g} rpm", file=profile_name, column="speed_rpm")
+    fastest = int(np.argmax(speed.values))
+    if speed.values[fastest] > limit:
+        raise InputError(f"speed {speed.values[fastest]:g} rpm exceeds the spindle's limit "
+                         f"{limit:g} rpm", file=profile_name, column="speed_rpm",
+                         row=None if profile is None else profile.row_of(fastest))
 
     # the first two streams are those of the runs before model-form error existed
     truth_seed, noise_seed, form_seed, place_seed = np.random.SeedSequence(seed).spawn(4)

@@ -23,6 +23,13 @@ from twin.runs.table import parse_cell
 class SpeedProfile:
     speed_rpm: StepTable
     ambient_C: StepTable | None = None
+    rows: tuple[int, ...] = ()
+    """The file line of each step (so a check made later, the spindle's speed limit, can
+    name it); empty for a profile not read from a file."""
+
+    def row_of(self, step: int) -> int | None:
+        """The file line of step `step`, or None."""
+        return self.rows[step] if step < len(self.rows) else None
 
 
 def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
@@ -73,4 +80,5 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
             raise InputError(f"ambient {values[k, 2]:g} °C is outside -30..60 °C", file=file,
                              row=number, column="ambient_C")
     ambient = StepTable(values[:, 0], values[:, 2]) if len(wanted) == 3 else None
-    return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient)
+    return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient,
+                        tuple(number for number, _ in rows))
