@@ -200,3 +200,43 @@ def test_apdl_like_help(args):
     result = CliRunner().invoke(apdl_app, [*args, "--help"])
     assert result.exit_code == 0, result.output
     assert "Usage: " in result.output
+
+
+def test_synth_profile_over_the_speed_limit_names_its_row(tmp_path):
+    profile = tmp_path / "p.csv"
+    profile.write_text("time_s,speed_rpm\n0,6000\n60,99000\n120,6000\n")
+    result = CliRunner().invoke(app, [
+        "synth", "--profile", str(profile), "--minutes", "3", "--ambient", "25", "--seed", "1",
+        "--out", str(tmp_path / "run.csv"), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{profile}, row 3, column 'speed_rpm'" in result.output
+    assert "15000 rpm" in result.output and "Traceback" not in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.csv"]
+
+
+@pytest.mark.parametrize("address", ["notanaddress", "tcp://127.0.0.1:port", "tcp://"])
+def test_replay_refuses_a_malformed_dask_address_before_any_work(address, tmp_path):
+    run = tmp_path / "run.csv"
+    run.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C\n0,0,20,20,20,20,20,20\n")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", str(run), "--out", str(out), "--dask", address,
+                                      "--methods", "ratio", "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert "Invalid value for '--dask'" in result.output and address in result.output
+    assert "internal error" not in result.output
+    assert not out.exists()
+
+
+def test_an_unreachable_dask_scheduler_is_bad_input_naming_the_option(monkeypatch):
+    import dask.distributed
+
+    from twin.loop import batch
+
+    def refuse(address, timeout):  # noqa: ANN001, ANN202 - stands in for Client
+        raise OSError(f"Timed out trying to connect to {address} after {timeout}")
+
+    monkeypatch.setattr(dask.distributed, "Client", refuse)
+    job = batch.ReplayJob("run.csv", "out", ("ratio",), None, "none")
+    with pytest.raises(InputError) as info:
+        list(batch._execute([job], 1, "tcp://127.0.0.1:1", None, None))
+    assert info.value.column == "--dask" and "tcp://127.0.0.1:1" in str(info.value)

@@ -98,6 +98,22 @@ def method_list(text: str) -> str:
     return ",".join(dict.fromkeys(methods))
 
 
+def dask_address(address: str | None) -> str | None:
+    """typer callback of `--dask`: a scheduler address distributed can connect to
+    (`tcp://HOST:PORT`, `tls://...`), checked before any work instead of failing as an
+    internal error once the runs are read."""
+    if address is None:
+        return None
+    from distributed.comm import get_address_host_port
+
+    try:
+        get_address_host_port(address)
+    except (ValueError, TypeError) as exc:
+        raise typer.BadParameter(f"{address!r} is not a scheduler address such as "
+                                 f"tcp://127.0.0.1:8786 ({exc})") from None
+    return address
+
+
 def between(low: float, high: float = math.inf) -> Callable[[float], float]:
     """typer callback: the value must lie strictly between `low` and `high` (typer's own
     `min`/`max` bounds are closed)."""

@@ -11,6 +11,7 @@ from twin.cli.inputs import (
     bundled_runs,
     bundled_runs_dir,
     checked_model,
+    dask_address,
     expand_run_folders,
     method_list,
 )
@@ -31,7 +32,7 @@ def replay(
     ),
     jobs: int = typer.Option(1, "--jobs", min=1, max=256, help="local worker processes"),
     dask: str | None = typer.Option(
-        None, "--dask", help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
+        None, "--dask", callback=dask_address, help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     ),
     snapshots: Snapshots = typer.Option(
         Snapshots.END, "--snapshots", help="field pictures: none, at the end, every window"

@@ -150,7 +150,12 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
 
-        with Client(dask_address, timeout="20s") as client:
+        try:
+            client = Client(dask_address, timeout="20s")
+        except OSError as exc:  # nothing listens there: the address given is wrong
+            raise InputError(f"cannot reach the dask scheduler at {dask_address} ({exc})",
+                             column="--dask") from None
+        with client:
             futures = client.map(run_job, todo, pure=False)
             for fut in dask_completed(futures):
                 outcome = fut.result()
