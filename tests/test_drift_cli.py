@@ -130,3 +130,15 @@ def test_drift_group_is_listed_with_its_commands():
     assert result.exit_code == 0
     for name in ("fit", "predict", "report", "select"):
         assert name in result.output
+
+
+@pytest.mark.parametrize("command", ["fit", "select"])
+def test_a_target_must_be_a_displacement_column(machine, tmp_path, command):
+    # a temperature named as target is also a sensor: the model read it back (RMSE 0.00)
+    _, data, _ = machine
+    result = run(command, str(data), "--target", "drift_um,A_C",
+                 "--out", str(tmp_path / ("m.safetensors" if command == "fit" else "s.json")))
+    assert result.exit_code == 2, result.output
+    assert "column '--target'" in result.output and "'A_C'" in result.output
+    assert "_um" in result.output and "Traceback" not in result.output
+    assert list(tmp_path.iterdir()) == []

@@ -25,9 +25,17 @@ drift_app = typer.Typer(
 
 
 def _targets(text: str) -> list[str]:
+    from twin.drift.data import DISPLACEMENT_SUFFIX
+
     names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
     if not names:
         raise InputError("name at least one displacement column", column="--target")
+    for name in names:
+        # any other column (a temperature) would also be read as a sensor: the model
+        # would predict it from itself
+        if not name.endswith(DISPLACEMENT_SUFFIX):
+            raise InputError(f"{name!r} is not a displacement column (a name ending in "
+                             f"{DISPLACEMENT_SUFFIX})", column="--target")
     return names
 
 
