@@ -240,3 +240,13 @@ def test_an_unreachable_dask_scheduler_is_bad_input_naming_the_option(monkeypatc
     with pytest.raises(InputError) as info:
         list(batch._execute([job], 1, "tcp://127.0.0.1:1", None, None))
     assert info.value.column == "--dask" and "tcp://127.0.0.1:1" in str(info.value)
+
+
+def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
+    # R² printed to 16 digits, and nothing said that the gate had zeroed every network
+    result = CliRunner().invoke(app, ["model-info", str(_bundled_model())])
+    assert result.exit_code == 0, result.output
+    assert "heat_front" in result.output and "R² 0.10" in result.output
+    assert "R² 0.0958" not in result.output
+    assert "networks kept by the closed-loop gate: none (bpnn gives the anchor)" in result.output
+    assert "anchor 99.35 %" in result.output

@@ -17,4 +17,16 @@ def model_info(model: Path = typer.Argument(..., help="Correction model file."))
                f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}, "
                f"targets {meta.get('targets', 'ratio')}")
     for output, r2 in (meta.get("r2") or {}).items():
-        typer.echo(f"  {output:18s} R² {r2.get('value')}  factor R² {r2.get('factor')}")
+        typer.echo(f"  {output:18s} R² {_r2(r2.get('value'))}  factor R² {_r2(r2.get('factor'))}")
+    if "networks_kept" in meta:
+        # the R² above are the networks'; a network the gate left out is zeroed and bpnn
+        # gives the anchor (the ratio law) in its place, whatever its R²
+        kept = ", ".join(meta["networks_kept"]) or "none (bpnn gives the anchor)"
+        scores = meta.get("held_out_temperature_accuracy_pct") or {}
+        typer.echo(f"networks kept by the closed-loop gate: {kept}"
+                   + ("; temperature accuracy on its held-out and gate runs: " if scores else "")
+                   + ", ".join(f"{group} {pct:.2f} %" for group, pct in scores.items()))
+
+
+def _r2(value: float | None) -> str:
+    return "—" if value is None else f"{value:.2f}"
