@@ -1,6 +1,7 @@
 """The `apdl-like` console script (also `python -m apdl_like`).
 
     apdl-like run DECK --out DIR       params.json, result_NNN.vtu, log.txt
+                  [--spindle]        on the reference spindle (a replay's window decks)
     apdl-like export-cdb --out FILE    the default spindle mesh as an ANSYS archive
 
 Bad input (an `ApdlError`, or any `twin.errors.InputError`) prints one line and exits 2;
@@ -39,6 +40,10 @@ def run(
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
     strict: bool = typer.Option(False, "--strict", help="An unknown or unsupported command "
                                                         "is an error (exit 2), not a warning."),
+    spindle: bool = typer.Option(False, "--spindle", help="Start with the reference spindle "
+                                 "loaded as the twin loads it (nodes, elements, materials, "
+                                 "components, contact real sets 101..): the database a "
+                                 "replay's decks/window_kkk.inp run on."),
 ) -> None:
     """Run a deck: DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt and
     the files the deck writes (/OUT, *CFOPEN)."""
@@ -49,7 +54,8 @@ def run(
     if not deck.is_file():
         raise ApdlError("deck not found", file=str(deck))
     check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
-    session = Session(base_dir=deck.parent, strict=strict)
+    session = _spindle_session(deck.parent, strict) if spindle else Session(
+        base_dir=deck.parent, strict=strict)
     stopped: InputError | None = None
     try:
         session.run_file(deck)
@@ -70,6 +76,20 @@ def run(
     if not quiet:
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
                    f"{len(written)} files to {out}")
+
+
+def _spindle_session(base_dir: Path, strict: bool):  # noqa: ANN202 - a Session
+    """A session holding the reference spindle as the twin's loop builds it
+    (`twin.loop.replay.deck_window_solver`)."""
+    from apdl_like.session import Session
+    from twin.spindle.model import SpindleModel
+
+    model = SpindleModel.load()
+    session = Session.from_mesh(model.mesh, model.materials, order=model.order,
+                                T_ref_C=model.elastic.T_ref, base_dir=base_dir,
+                                thermal=model.thermal)
+    session.state.strict = strict
+    return session
 
 
 @app.command("export-cdb")

@@ -77,8 +77,15 @@ def _num(x: float) -> str:
     return repr(float(x))
 
 
-def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
-    """The APDL text of one window."""
+def window_deck(loads: LoadSet, layout: DeckLayout,
+                start_temperature_C: float | None = None) -> str:
+    """The APDL text of one window.
+
+    start_temperature_C  the uniform field a run's first window (start 0 s) starts from,
+                         written as TUNIF so that the deck runs alone (`apdl-like run
+                         --spindle`); None: the session's (a later window restarts from the
+                         field its session carries)
+    """
     for name in loads.heat_generation:
         if name not in layout.regions:
             raise ValueError(f"heat generation on unknown region {name!r}")
@@ -92,7 +99,9 @@ def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
     out = [
         f"! spindle twin, window {loads.window}: t = {loads.start_s:g} .. {end:g} s, "
         f"{loads.n_steps} steps of {loads.dt_s:g} s",
-        "! loads only: runs in a session that holds the spindle model (apdl_like.Session)",
+        "! loads only: runs in a session that holds the spindle model (apdl_like.Session;",
+        "! alone: apdl-like run DECK --spindle, window 0 or a deck that /INPUTs the windows",
+        "! in order, as a later window restarts from the field its session carries)",
     ]
     if loads.contact_resistance:
         out.append("/PREP7")
@@ -105,6 +114,8 @@ def window_deck(loads: LoadSet, layout: DeckLayout) -> str:
         f"WINDOW = {loads.window}",
         f"T_START = {_num(loads.start_s)}",
         "ANTYPE,TRANS,REST" if loads.start_s > 0.0 else "ANTYPE,TRANS",
+        *([f"TUNIF,{_num(start_temperature_C)}   ! C, the uniform start field"]
+          if start_temperature_C is not None and loads.start_s == 0.0 else []),
         "TIMINT,ON",
         "KBC,1                 ! loads held over the window (stepped)",
         f"DELTIM,{_num(loads.dt_s)}",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -277,3 +278,35 @@ def test_cli_bad_input_is_exit_2_with_the_field(runs_dir, tmp_path):
     assert result.exit_code == 2 and "--time" in result.output
     result = invoke("report", str(tmp_path / "nothing"))
     assert result.exit_code == 2
+
+
+def test_a_replays_window_decks_run_alone_on_the_spindle(replayed, tmp_path):
+    # `apdl-like run decks/window_000.inp` stopped at its first line (no contact real set
+    # 101: the decks hold loads only) and nothing said how to run them
+    import meshio
+
+    from apdl_like.cli import app as apdl_app
+
+    run_dir = replayed / "hot_9000"
+    decks = shutil.copytree(run_dir / "decks", tmp_path / "decks")
+    fields = sorted((run_dir / "fields").glob("ratio_t*.vtu"))
+
+    def run_deck(deck, out):
+        return CliRunner().invoke(apdl_app, ["run", str(deck), "--spindle", "--out", str(out),
+                                             "--quiet"])
+
+    def temperature(vtu, name):
+        return meshio.read(vtu).point_data[name]
+
+    result = run_deck(decks / "window_000.inp", tmp_path / "w0")
+    assert result.exit_code == 0, result.output
+    np.testing.assert_array_equal(temperature(tmp_path / "w0" / "result_001.vtu", "TEMP"),
+                                  temperature(fields[0], "temperature_C"))
+    # later windows restart from the field the run carried: run in order, they give it
+    (decks / "chain.inp").write_text("".join(f"/INPUT,window_{k:03d},inp\n" for k in range(3)))
+    result = run_deck(decks / "chain.inp", tmp_path / "chain")
+    assert result.exit_code == 0, result.output
+    np.testing.assert_array_equal(temperature(tmp_path / "chain" / "result_003.vtu", "TEMP"),
+                                  temperature(fields[2], "temperature_C"))
+    alone = run_deck(decks / "window_001.inp", tmp_path / "w1")
+    assert alone.exit_code == 2 and "no previous solution" in alone.output

@@ -179,7 +179,10 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
             convection=loads.convection,
             contact_resistance=loads.contact_resistance,
         )
-        deck = window_deck(load_set, session.layout)
+        # a run's first window starts from a uniform field: the deck says which, so that
+        # it runs alone too
+        deck = window_deck(load_set, session.layout,
+                           start_temperature_C=float(T[0]) if start_s == 0.0 else None)
         return session.advance(T, start_s, deck, file=f"window_{window:03d}.inp"), deck
 
     return solve
