@@ -21,6 +21,7 @@ import typer
 from twin.errors import InputError, report_errors
 from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
+from twin.paths import regular_file_info
 
 app = typer.Typer(
     name="apdl-like",
@@ -45,14 +46,14 @@ def run(
                                  "components, contact real sets 101..): the database a "
                                  "replay's decks/window_kkk.inp run on."),
 ) -> None:
-    """Run a deck: DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt and
-    the files the deck writes (/OUT, *CFOPEN)."""
-    from apdl_like.errors import ApdlError
+    """Run a deck statement by statement, as MAPDL does.
+
+    Writes DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt
+    and the files the deck writes (/OUT, *CFOPEN), inside DIR only."""
     from apdl_like.outputs import write_outputs
     from apdl_like.session import Session
 
-    if not deck.is_file():
-        raise ApdlError("deck not found", file=str(deck))
+    regular_file_info(deck, use="read deck")  # a folder, a fifo, nothing there: say which
     check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
     session = _spindle_session(deck.parent, strict) if spindle else Session(
         base_dir=deck.parent, strict=strict)

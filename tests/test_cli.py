@@ -250,3 +250,39 @@ def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     assert "R² 0.0958" not in result.output
     assert "networks kept by the closed-loop gate: none (bpnn gives the anchor)" in result.output
     assert "anchor 99.35 %" in result.output
+
+
+def test_apdl_like_run_says_why_a_deck_cannot_be_read(tmp_path):
+    # a folder given as DECK was reported as "deck not found"
+    from apdl_like.cli import app as apdl_app
+
+    folder = tmp_path / "decks"
+    folder.mkdir()
+    for deck, words in ((folder, "is a folder, not a file"),
+                        (tmp_path / "absent.inp", "No such file or directory")):
+        result = CliRunner().invoke(apdl_app, ["run", str(deck), "--out", str(tmp_path / "o")])
+        assert result.exit_code == 2, result.output
+        assert f"{deck}: " in result.output and words in result.output
+        assert not (tmp_path / "o").exists()
+
+
+def _commands(command, path):
+    yield path, command
+    for name, sub in getattr(command, "commands", {}).items():
+        yield from _commands(sub, f"{path} {name}")
+
+
+def test_help_paragraphs_fit_an_80_column_terminal():
+    # typer keeps the line breaks of a help text's later paragraphs: a longer line wrapped
+    # on its own and left a stub line ("(loss curves, R²" / "of both configurations")
+    import inspect
+
+    from apdl_like.cli import app as apdl_app
+
+    long = []
+    for root, name in ((app, "twin"), (apdl_app, "apdl-like")):
+        for path, command in _commands(typer.main.get_command(root), name):
+            paragraphs = inspect.cleandoc(command.help or "").split("\n\n")[1:]
+            long += [(path, line) for p in paragraphs for line in p.split("\n")
+                     if len(line) > 77]
+    assert long == []

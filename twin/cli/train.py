@@ -37,8 +37,8 @@ def train(
 ) -> None:
     """Train the 6-10-1 heat and 6-12-1 contact-resistance networks of both bearings.
 
-    Writes MODEL and, beside it, MODEL.report.json and MODEL.report.html (loss curves, R²
-    of both configurations, predicted vs target).
+    Writes MODEL and, beside it, MODEL.report.json and MODEL.report.html
+    (loss curves, R² of both configurations, predicted vs target).
     """
     from twin.correction.modelfile import save_model
     from twin.correction.network import DEFAULT, PAPER
