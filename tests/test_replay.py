@@ -310,3 +310,16 @@ def test_a_replays_window_decks_run_alone_on_the_spindle(replayed, tmp_path):
                                   temperature(fields[2], "temperature_C"))
     alone = run_deck(decks / "window_001.inp", tmp_path / "w1")
     assert alone.exit_code == 2 and "no previous solution" in alone.output
+
+
+def test_report_names_an_unreadable_run_folder_and_exits_2(replayed, tmp_path):
+    # it wrote the report without that run, said only "wrote report.html" and exited 0
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    accuracy = folder / "hot_9000" / "accuracy.json"
+    accuracy.write_text('{"run": "hot_9000", "methods": {')  # cut short
+    result = invoke("report", str(folder))
+    assert result.exit_code == 2, result.output
+    assert f"error: {accuracy}: unreadable accuracy.json" in result.output
+    assert (folder / "report.html").is_file()
+    summary = json.loads((folder / "summary.json").read_text())
+    assert [f["run"] for f in summary["failed"]] == ["hot_9000"]

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import typer
 
-from twin.errors import InputError
+from twin.errors import EXIT_INPUT_ERROR, InputError
 
 
 def report(out: Path = typer.Argument(..., help="a replay output folder")) -> None:
@@ -17,3 +18,10 @@ def report(out: Path = typer.Argument(..., help="a replay output folder")) -> No
         raise InputError("not a replay folder (no <run>/accuracy.json inside)", file=str(out))
     path = build_report(out)
     typer.echo(f"wrote {path}")
+    # runs the report leaves out (an unreadable accuracy.json, a run that failed in the
+    # replay): named as `twin replay` names them, and exit 2 as it does
+    failed = json.loads((out / "summary.json").read_text(encoding="utf-8"))["failed"]
+    for failure in failed:
+        typer.echo(f"error: {failure['error']}", err=True)
+    if failed:
+        raise typer.Exit(EXIT_INPUT_ERROR)
