@@ -127,3 +127,32 @@ def test_p2_elements_agree_with_the_default_p1_run(spindle_model):
     assert np.abs(a.sensors_C[-1] - b.sensors_C[-1]).max() < 0.3
     assert b.disp_z_um[-1] == pytest.approx(a.disp_z_um[-1], rel=0.05)
     assert b.max_temperature_region in BEARING_OR_ROTOR
+
+
+def test_simulate_again_into_a_folder_leaves_nothing_of_the_earlier_run(tmp_path, monkeypatch):
+    # a 2-min run after a 3-min one left step_00045.vtu of the 3-min run in fields/; an
+    # interrupted run left the earlier summary.json beside its own new files
+    from twin.cli import app
+    from twin.spindle import output
+
+    out = tmp_path / "run"
+    (tmp_path / "run").mkdir()
+    (out / "notes.txt").write_text("mine")  # not simulate's: stays
+
+    def simulate_cli(minutes):
+        return CliRunner().invoke(app, ["simulate", "--speed", "6000", "--minutes", minutes,
+                                        "--ambient", "24", "--out", str(out), "--quiet"])
+
+    assert simulate_cli("3").exit_code == 0
+    assert simulate_cli("2").exit_code == 0
+    assert sorted(p.name for p in (out / "fields").iterdir()) == [
+        "step_00000.vtu", "step_00015.vtu", "step_00030.vtu"]
+    assert json.loads((out / "summary.json").read_text())["minutes"] == 2.0
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(output, "write_fields", interrupted)
+    assert simulate_cli("1").exit_code == 130
+    assert not (out / "summary.json").exists()  # no earlier run's summary that looks current
+    assert (out / "notes.txt").read_text() == "mine"

@@ -1,6 +1,7 @@
 """Files of an open-loop run: keypoints.csv, fields.pvd + fields/*.vtu, summary.json.
 
-Every file is written atomically (`twin.io.atomic`).
+Every file is written atomically (`twin.io.atomic`); what an earlier run wrote there goes
+first, and summary.json comes last, so an interrupted run leaves no summary.
 keypoints.csv has the columns of a recorded run (time_s, speed_rpm, ambient_C,
 T1_C..T5_C, disp_z_um, disp_r_um), so a simulated run can be replayed like a measured one.
 The .vtu files are those of every field file (`twin.io.vtk`): temperature_C,
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import io
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -93,6 +95,15 @@ def write_simulation(model: SpindleModel, result: SimulationResult, out_dir: str
     """Write keypoints.csv, fields (if kept and `fields`) and summary.json; return summary."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    # an earlier run's files go first: its later field steps would stand beside this run's,
+    # and summary.json, written last, would look current beside a run interrupted here
+    (out_dir / "summary.json").unlink(missing_ok=True)
+    (out_dir / "fields.pvd").unlink(missing_ok=True)
+    fields_dir = out_dir / "fields"
+    if fields_dir.is_symlink() or fields_dir.is_file():
+        fields_dir.unlink()
+    elif fields_dir.is_dir():
+        shutil.rmtree(fields_dir)
     write_text(out_dir / "keypoints.csv", keypoints_csv(result))
     if fields and result.fields:
         write_fields(model, result, out_dir)
