@@ -203,3 +203,12 @@ def test_parquet_hard_error_names_row(tmp_path):
     path = tmp_path / "neg.parquet"
     write_run(path, cols)
     expect_error(path, 5, "speed_rpm", "negative speed")
+
+
+@pytest.mark.parametrize("separator", [";", "\t"])
+def test_a_run_separated_otherwise_than_by_commas_is_named_so(tmp_path, separator):
+    # a logger's semicolon export read as one column: "column 'time_s': missing required
+    # column", with time_s right there in the header
+    text = csv_text(warmup(), "# a: b\n").replace(",", separator)
+    err = expect_error(write(tmp_path, text), 2, None, "one column")
+    assert repr(separator) in err.reason and "comma" in err.reason

@@ -120,6 +120,7 @@ def test_speed_profile(tmp_path):
     ("time_s,speed_rpm\n0,-1\n", 2, "speed_rpm"),
     ("time_s,speed_rpm,ambient_C\n0,9000,298\n", 2, "ambient_C"),
     ("time_s,speed_rpm\n", 1, None),
+    ("# from the logger\ntime_s;speed_rpm\n0;9000\n", 2, None),  # not comma-separated
 ])
 def test_bad_speed_profiles(tmp_path, text, row, column):
     path = tmp_path / "p.csv"

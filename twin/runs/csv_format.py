@@ -58,6 +58,7 @@ def read_csv_table(path: str | os.PathLike[str],
 
     if header is None:
         raise InputError("empty file: no header row and no data", file=file)
+    check_comma_separated(header, file, header_line)
     for position, name in enumerate(header, start=1):
         if not name:
             raise InputError(f"header field {position} is empty", file=file, row=header_line)
@@ -85,6 +86,18 @@ def read_csv_table(path: str | os.PathLike[str],
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored)
+
+
+def check_comma_separated(header: list[str], file: str, line: int) -> None:
+    """Refuse a header that is one column holding `;` or tabs: a logger's export with
+    another separator (often with decimal commas), which would otherwise read as one
+    column and fail as a missing `time_s`."""
+    if len(header) == 1:
+        for separator in (";", "\t"):
+            if separator in header[0]:
+                raise InputError(f"the header is one column holding {separator!r}: the file is "
+                                 f"separated by {separator!r}; write it comma-separated, with "
+                                 "decimal points", file=file, row=line)
 
 
 def csv_records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
