@@ -286,3 +286,19 @@ def test_help_paragraphs_fit_an_80_column_terminal():
             long += [(path, line) for p in paragraphs for line in p.split("\n")
                      if len(line) > 77]
     assert long == []
+
+
+def test_replay_names_both_runs_that_would_share_a_folder(tmp_path):
+    # "two runs share the output folder name 'run'" named neither file
+    header = "time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C\n"
+    runs = []
+    for folder in ("monday", "tuesday"):
+        (tmp_path / folder).mkdir()
+        runs.append(tmp_path / folder / "run.csv")
+        runs[-1].write_text(header + "0,0,20,20,20,20,20,20\n")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", *map(str, runs), "--out", str(out),
+                                      "--methods", "ratio", "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{runs[0]}, {runs[1]}" in result.output and "'run'" in result.output
+    assert not out.exists()

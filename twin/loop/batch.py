@@ -94,8 +94,6 @@ def replay_batch(
     in this process (not used by worker processes or dask).
     """
     out_root = Path(out_root)
-    out_root.mkdir(parents=True, exist_ok=True)
-    remove_orphans(out_root)
     result = BatchResult()
     named: list[tuple[str, str]] = []
     for path in runs:
@@ -105,9 +103,12 @@ def replay_batch(
             result.failed.append({"error": str(exc), "kind": "input", "run": Path(path).stem,
                                   "path": str(path)})
     names = [n for _, n in named]
-    dupes = {n for n in names if names.count(n) > 1}
-    if dupes:
-        raise InputError(f"two runs share the output folder name {sorted(dupes)[0]!r}")
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:  # refused before anything is written
+        raise InputError(f"two runs share the output folder name {dupes[0]!r}",
+                         file=", ".join(p for p, n in named if n == dupes[0]))
+    out_root.mkdir(parents=True, exist_ok=True)
+    remove_orphans(out_root)
     todo: list[ReplayJob] = []
     for path, name in named:
         if resume:
