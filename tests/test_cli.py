@@ -302,3 +302,12 @@ def test_replay_names_both_runs_that_would_share_a_folder(tmp_path):
     assert result.exit_code == 2, result.output
     assert f"{runs[0]}, {runs[1]}" in result.output and "'run'" in result.output
     assert not out.exists()
+
+
+def test_train_refuses_a_model_file_not_named_safetensors(tmp_path):
+    # `--out model.txt` trained for minutes and wrote model.txt, model.txt.report.json...
+    out = tmp_path / "model.txt"
+    result = CliRunner().invoke(app, ["train", str(tmp_path / "run.csv"), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert f"{out}, column '--out'" in result.output and ".safetensors" in result.output
+    assert list(tmp_path.iterdir()) == []

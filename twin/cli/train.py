@@ -54,6 +54,9 @@ def train(
 
     gate_runs = list(gate_runs or [])
     check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
+    if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
+        raise InputError("the model file must end in .safetensors", file=str(out),
+                         column="--out")
     spindle = SpindleModel.load()  # the networks train on that spindle
     simulator = training_simulator(targets, spindle=spindle)
     sets, recorded = [], {}
