@@ -18,7 +18,7 @@ from pathlib import Path
 
 import typer
 
-from twin.errors import InputError, report_errors
+from twin.errors import InputError, report_errors, run_console_script
 from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
 from twin.paths import regular_file_info
@@ -132,7 +132,7 @@ def export_cdb(
 
 def main() -> None:
     send_warnings_to_log()
-    app(prog_name="apdl-like")
+    run_console_script(app, "apdl-like")
 
 
 if __name__ == "__main__":

@@ -311,3 +311,37 @@ def test_train_refuses_a_model_file_not_named_safetensors(tmp_path):
     assert result.exit_code == 2, result.output
     assert f"{out}, column '--out'" in result.output and ".safetensors" in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("argv", "first_words", "command"), [
+    (["twin", "replay", "--out", "OUT", "--methods", "magic"],
+     "error: Invalid value for '--methods': unknown method 'magic'", "twin replay"),
+    (["twin", "replay", "--out", "OUT", "--jobs", "0"], "error: Invalid value for '--jobs'",
+     "twin replay"),
+    (["twin", "drift", "fit", "DATA.csv", "--out", "M.safetensors"],
+     "error: Missing option '--target'", "twin drift fit"),
+    (["apdl-like", "run", "DECK.inp"], "error: Missing option '--out'", "apdl-like run"),
+    (["twin", "simulate", "--speeed", "9000"], "error: No such option: --speeed",
+     "twin simulate"),
+])
+def test_a_bad_option_is_one_line_on_the_console(argv, first_words, command, tmp_path):
+    # click's usage block and rich's box wrapped the message over several lines, unlike
+    # every other bad input ("error: file, row, column: what"): one line, exit 2
+    module = "apdl_like.cli" if argv[0] == "apdl-like" else "twin.cli"
+    code = f"import sys\nfrom {module} import main\nsys.argv = {argv!r}\nmain()"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(first_words), done.stderr
+    assert done.stderr.count("\n") == 1 and done.stdout == ""
+    assert done.stderr.rstrip().endswith(f"see '{command} --help'"), done.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_and_no_arguments_still_show_the_help():
+    code = "import sys\nfrom twin.cli import main\nsys.argv = {!r}\nmain()"
+    for argv, status in ((["twin"], 2), (["twin", "drift"], 2), (["twin", "replay", "--help"], 0)):
+        done = subprocess.run([sys.executable, "-c", code.format(argv)], capture_output=True,
+                              text=True, timeout=120)
+        assert done.returncode == status, done.stderr
+        assert "Usage: " in done.stdout + done.stderr

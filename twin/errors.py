@@ -92,3 +92,31 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
             raise Exit(EXIT_INTERNAL_ERROR) from None
 
     return wrapper
+
+
+def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
+    """Run a typer app as its console script, with a usage error (an option value out of
+    its choices or bounds, a missing or unknown option) told like every other bad input:
+    one line, `error: what; see 'COMMAND --help'`, exit 2.  Left to click and rich, it was
+    a usage block and a box that wraps the message over several lines."""
+    from typer import Abort
+
+    try:
+        code = app(prog_name=prog_name, standalone_mode=False)
+    except Abort:
+        print("aborted", file=sys.stderr)
+        sys.exit(EXIT_INTERNAL_ERROR)
+    except Exception as exc:  # noqa: BLE001 - click's errors, vendored or not, told here
+        if type(exc).__name__ == "NoArgsIsHelpError":  # as typer's rich_format_error tells it
+            app(prog_name=prog_name)  # nothing ran: the help, as typer prints it (exit 2)
+            return
+        format_message = getattr(exc, "format_message", None)
+        if format_message is None:
+            print(f"internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+            sys.exit(EXIT_INTERNAL_ERROR)
+        context = getattr(exc, "ctx", None)
+        hint = f"; see '{context.command_path} --help'" if context is not None else ""
+        message = " ".join(format_message().split()).rstrip(".")
+        print(f"error: {message}{hint}", file=sys.stderr)
+        sys.exit(getattr(exc, "exit_code", EXIT_INPUT_ERROR))
+    sys.exit(code if isinstance(code, int) else 0)

@@ -23,7 +23,7 @@ from twin.cli.simulate import simulate_command
 from twin.cli.snapshot import snapshot
 from twin.cli.synth import synth
 from twin.cli.train import train
-from twin.errors import report_errors
+from twin.errors import report_errors, run_console_script
 from twin.log import send_warnings_to_log
 
 COMMANDS = (
@@ -62,7 +62,7 @@ app = build_app()
 def main() -> None:
     send_warnings_to_log()
     try:
-        app(prog_name="twin")
+        run_console_script(app, "twin")
     finally:
         # the process ends now: the interpreter's last garbage collections would walk every
         # object the run left (0.1-0.2 s after a replay), yet exiting frees them all anyway
