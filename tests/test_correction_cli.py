@@ -121,3 +121,32 @@ def test_train_bad_run_exits_2(tmp_path, monkeypatch):
     result = _invoke(["train", str(bad), "--out", str(tmp_path / "m.safetensors")])
     assert result.exit_code == 2
     assert "bad.csv" in result.output
+
+
+def test_runs_are_told_apart_by_their_files_not_their_name_lines(runs, tmp_path):
+    # a logger writes the same `# name:` into every file: the runs were one "run" to the
+    # held-out split and the model said "1 runs"
+    from twin.runs import read_run
+
+    for path in runs:
+        run = read_run(path)
+        cols = {"time_s": run.time_s, "speed_rpm": run.speed_rpm, "ambient_C": run.ambient_C,
+                **{f"T{j + 1}_C": run.T_C[:, j] for j in range(5)}}
+        write_run(path, cols, {"name": "machine 3"})
+    out = tmp_path / "m.safetensors"
+    result = _invoke(["train", *map(str, runs), "--out", str(out), "--epochs", "5",
+                      "--paper-config", "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert load_model(out).metadata["training_runs"] == ["run_11000", "run_6000", "run_8000"]
+
+
+def test_two_runs_of_one_file_name_are_refused_naming_both(runs, tmp_path):
+    other = tmp_path / "other"
+    other.mkdir()
+    twin_file = other / runs[0].name
+    twin_file.write_bytes(runs[0].read_bytes())
+    out = tmp_path / "m.safetensors"
+    result = _invoke(["train", *map(str, runs), str(twin_file), "--out", str(out),
+                      "--paper-config", "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{runs[0]}, {twin_file}" in result.output and not out.exists()

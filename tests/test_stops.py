@@ -154,7 +154,9 @@ def test_replay_and_quality_handle_a_stop(stop_run, tmp_path):
 @pytest.mark.slow
 def test_training_on_a_run_with_a_stop(stop_run, tmp_path):
     out = tmp_path / "m.safetensors"
-    result = invoke("train", str(stop_run), str(stop_run), "--out", str(out), "--epochs", "20",
+    again = tmp_path / "stop_again.csv"  # a second run (one file twice is refused: one name)
+    again.write_bytes(stop_run.read_bytes())
+    result = invoke("train", str(stop_run), str(again), "--out", str(out), "--epochs", "20",
                     "--quiet")
     assert result.exit_code == 0, result.output
     assert out.exists()

@@ -48,6 +48,7 @@ def train(
     from twin.correction.training_data import run_curves
     from twin.errors import InputError
     from twin.io.destinations import check_out_file
+    from twin.loop.runfiles import check_distinct_names, run_name
     from twin.loop.training import gate_networks, training_simulator
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
@@ -57,12 +58,16 @@ def train(
     if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
         raise InputError("the model file must end in .safetensors", file=str(out),
                          column="--out")
+    named = [(str(path), run_name(path)) for path in runs]
+    check_distinct_names(named)
     spindle = SpindleModel.load()  # the networks train on that spindle
     simulator = training_simulator(targets, spindle=spindle)
     sets, recorded = [], {}
-    for path in runs:
+    for path, (_, name) in zip(runs, named, strict=True):
+        # known by its file name: the held-out split is by run
         run = read_run(path, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
-        recorded[str(run.name)] = run
+        run = dataclasses.replace(run, name=name)
+        recorded[name] = run
         if not quiet:
             typer.echo(f"simulating {path.name} …", err=True)
         sets.extend(samples_for(curves) for curves in run_curves(run, simulator))

@@ -17,7 +17,13 @@ from twin.errors import InputError
 from twin.io.atomic import write_json
 from twin.loop.folders import folder_lock, remove_orphans
 from twin.loop.overlap import ForkedTask
-from twin.loop.runfiles import is_done, replay_run_to_dir, resume_token, run_name
+from twin.loop.runfiles import (
+    check_distinct_names,
+    is_done,
+    replay_run_to_dir,
+    resume_token,
+    run_name,
+)
 from twin.loop.summary import collect_summary, read_accuracy
 
 
@@ -103,10 +109,7 @@ def replay_batch(
             result.failed.append({"error": str(exc), "kind": "input", "run": Path(path).stem,
                                   "path": str(path)})
     names = [n for _, n in named]
-    dupes = sorted({n for n in names if names.count(n) > 1})
-    if dupes:  # refused before anything is written
-        raise InputError(f"two runs share the output folder name {dupes[0]!r}",
-                         file=", ".join(p for p, n in named if n == dupes[0]))
+    check_distinct_names(named)  # refused before anything is written
     out_root.mkdir(parents=True, exist_ok=True)
     remove_orphans(out_root)
     todo: list[ReplayJob] = []

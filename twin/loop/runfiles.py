@@ -63,6 +63,17 @@ def run_name(path: str | Path) -> str:
     return name
 
 
+def check_distinct_names(named: Sequence[tuple[str, str]]) -> None:
+    """Refuse two runs of one name ((path, `run_name`) pairs), naming both files: a run is
+    known by its file name (its folder under DIR, its place in a training split), not by
+    a `# name:` line, which a logger may write alike into every file."""
+    names = [name for _, name in named]
+    shared = sorted({name for name in names if names.count(name) > 1})
+    if shared:
+        raise InputError(f"two runs share the name {shared[0]!r} (their file name)",
+                         file=", ".join(path for path, name in named if name == shared[0]))
+
+
 def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None,
                  assimilate_drift: bool = True) -> dict:
     """What must match for a finished run folder to be reused by --resume."""
