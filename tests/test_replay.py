@@ -323,3 +323,15 @@ def test_report_names_an_unreadable_run_folder_and_exits_2(replayed, tmp_path):
     assert (folder / "report.html").is_file()
     summary = json.loads((folder / "summary.json").read_text())
     assert [f["run"] for f in summary["failed"]] == ["hot_9000"]
+
+
+def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
+    # quality.json (and the snapshots' titles) took the run's `# name:` line while
+    # accuracy.json, summary.json and the folder took the file name
+    run = tmp_path / "monday.csv"
+    run.write_text("# name: machine 3\n" + (runs_dir / "hot_9000.csv").read_text())
+    out = tmp_path / "out"
+    assert replay(run, out=out, methods="open_loop").exit_code == 0
+    quality = json.loads((out / "monday" / "quality.json").read_text())
+    accuracy = json.loads((out / "monday" / "accuracy.json").read_text())
+    assert quality["run"] == accuracy["run"] == "monday"

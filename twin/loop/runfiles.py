@@ -159,6 +159,7 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
 
     model = spindle if spindle is not None else SpindleModel.load()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
+    run = replace(run, name=run_name(run_path))  # as its folder and accuracy.json know it
     token = resume_token(run_path, methods, model_path, assimilate_drift)
     config = EstimatorConfig(assimilate_drift=assimilate_drift)
     correctors = [
