@@ -335,3 +335,26 @@ def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
     quality = json.loads((out / "monday" / "quality.json").read_text())
     accuracy = json.loads((out / "monday" / "accuracy.json").read_text())
     assert quality["run"] == accuracy["run"] == "monday"
+
+
+def test_an_unreadable_run_is_named_and_the_batch_goes_on(runs_dir, tmp_path, monkeypatch):
+    # as root, chmod 000 does not stop a read: the permission error is raised here instead
+    from pathlib import Path
+
+    locked = tmp_path / "locked.csv"
+    locked.write_bytes((runs_dir / "hot_9000.csv").read_bytes())
+    read_bytes = Path.read_bytes
+
+    def refuse_locked(path):
+        if path == locked:
+            raise PermissionError(13, "Permission denied", str(path))
+        return read_bytes(path)
+
+    monkeypatch.setattr(Path, "read_bytes", refuse_locked)
+    out = tmp_path / "out"
+    result = replay(locked, runs_dir / "hot_9000.csv", out=out, methods="open_loop")
+    assert result.exit_code == 2, result.output
+    assert f"{locked}: cannot read file: Permission denied" in result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert [f["run"] for f in summary["failed"]] == ["locked"]
+    assert [r["run"] for r in summary["runs"]] == ["hot_9000"]
