@@ -50,7 +50,7 @@ def run(
 
     Writes DIR/params.json, DIR/result_NNN.vtu per solved load step, DIR/log.txt
     and the files the deck writes (/OUT, *CFOPEN), inside DIR only."""
-    from apdl_like.outputs import write_outputs
+    from apdl_like.outputs import output_names, write_outputs
     from apdl_like.session import Session
 
     regular_file_info(deck, use="read deck")  # a folder, a fifo, nothing there: say which
@@ -69,8 +69,9 @@ def run(
         if not quiet:
             for warning in session.state.listing.warnings:
                 typer.echo(warning, err=True)
-    for name in session.state.listing.files:  # the files the deck wrote, same checks
-        check_out_file(out / name, inputs=[deck])
+    read = [deck, *session.state.inputs]  # with --out the deck's folder, /OUT,sub,inp
+    for name in output_names(session.state):  # would replace the sub.inp /INPUT read
+        check_out_file(out / name, inputs=read)
     written = write_outputs(session.state, out)
     if stopped is not None:
         raise stopped

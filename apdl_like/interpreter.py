@@ -250,6 +250,7 @@ def _input(session: SessionState, st: Statement, depth: int) -> None:
     if not target.is_file():
         raise st.error(f"/INPUT file {name!r} not found in {str(base)!r}")
     shown = str(Path(st.file).parent / name) if st.file and not st.file.startswith("<") else name
+    session.inputs.append(target)
     execute(session, read_deck(target, shown), depth + 1)
 
 

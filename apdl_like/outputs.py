@@ -64,6 +64,17 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
     write_vtu(path, mesh)
 
 
+def result_name(step: int) -> str:
+    """The file of solved load step `step` (0-based) inside the output folder."""
+    return f"result_{step + 1:03d}.vtu"
+
+
+def output_names(session: SessionState) -> list[str]:
+    """The files `write_outputs` writes, by their names inside the output folder."""
+    return ["params.json", *(result_name(i) for i in range(len(session.solution.results))),
+            "log.txt", *sorted(session.listing.files)]
+
+
 def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     """params.json, result_NNN.vtu (one per solved load step), log.txt and the files the deck
     wrote (/OUT, *CFOPEN; names checked when the deck opened them) under `out_dir`."""
@@ -73,7 +84,7 @@ def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     write_text(params, json.dumps(session.scalar_parameters(), indent=2, sort_keys=True) + "\n")
     written.append(params)
     for i in range(len(session.solution.results)):
-        path = out / f"result_{i + 1:03d}.vtu"
+        path = out / result_name(i)
         write_result_vtu(session, i, path)
         written.append(path)
     log = out / "log.txt"

@@ -13,9 +13,10 @@
     listing   `Listing`: the run's log, warnings and the files the deck writes (/OUT,
               *CFOPEN), kept in memory until the CLI writes them inside --out
     saved     SAVE/RESUME: named copies of the database and parameters, in memory
-    processor, base_dir, strict, record_only, recorded_solves
-              the deck context: processor commands, /INPUT folder, unknown commands as
-              errors (--strict), the solve-recording mode of `Session.read_window_deck`
+    processor, base_dir, inputs, strict, record_only, recorded_solves
+              the deck context: processor commands, /INPUT folder and the files /INPUT
+              read, unknown commands as errors (--strict), the solve-recording mode of
+              `Session.read_window_deck`
 
 Command handlers take a `SessionState`; nothing here imports the commands or the session.
 """
@@ -170,6 +171,7 @@ class SessionState:
     saved: dict[str, tuple[Database, dict]] = field(default_factory=dict)
     processor: str = "BEGIN"
     base_dir: Path | None = None
+    inputs: list[Path] = field(default_factory=list)  # files /INPUT read: no output replaces one
     strict: bool = False  # an unknown command is an error, not a warning
     # /POST26 variables: number -> (name, times s, values); FSUM's last total heat, W
     variables: dict[int, tuple[str, np.ndarray, np.ndarray]] = field(default_factory=dict)

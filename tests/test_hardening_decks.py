@@ -55,3 +55,22 @@ def test_amesh_in_a_loop_stops_at_the_model_element_cap(tmp_path):
     with pytest.raises(ApdlError, match="more than 500000 elements") as info:
         Session(base_dir=tmp_path).run_text(deck, "deck.inp")
     assert info.value.line == 6
+
+
+@pytest.mark.parametrize("written", ["/OUT,sub,inp\n*VWRITE,X\n(F8.2)\n/OUT\n",
+                                     "*CFOPEN,sub,inp\n*CFWRITE,X = 2\n*CFCLOS\n"])
+def test_a_deck_does_not_write_over_a_file_it_read_by_input(tmp_path, written):
+    # with --out the deck's folder, /OUT,sub,inp replaced the sub.inp the deck had just read
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app
+
+    sub = tmp_path / "sub.inp"
+    sub.write_text("X = 1\n")
+    deck = tmp_path / "main.inp"
+    deck.write_text("/INPUT,sub,inp\n" + written)
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path)])
+    assert result.exit_code == 2, result.output
+    assert f"{sub}, column '--out': is also an input" in result.output
+    assert sub.read_text() == "X = 1\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["main.inp", "sub.inp"]
