@@ -358,3 +358,25 @@ def test_an_unreadable_run_is_named_and_the_batch_goes_on(runs_dir, tmp_path, mo
     summary = json.loads((out / "summary.json").read_text())
     assert [f["run"] for f in summary["failed"]] == ["locked"]
     assert [r["run"] for r in summary["runs"]] == ["hot_9000"]
+
+
+def test_snapshot_tells_a_time_outside_the_run_from_an_internal_error(runs_dir, tmp_path,
+                                                                       monkeypatch):
+    # every ValueError of the replay was reported as bad input naming --time (exit 2)
+    from twin.loop import replay as loop_replay
+
+    out = tmp_path / "t.png"
+    args = ("snapshot", str(runs_dir / "hot_9000.csv"), "--out", str(out), "--method",
+            "open_loop", "--time")
+    late = CliRunner().invoke(app, [*args, "400"])
+    assert late.exit_code == 2, late.output
+    assert "column '--time'" in late.output and "(0, 300] s" in late.output
+
+    def broken(*args, **kwargs):
+        raise ValueError("a window at t = 0 starts from a uniform temperature (TUNIF)")
+
+    monkeypatch.setattr(loop_replay, "replay_method", broken)
+    inside = CliRunner().invoke(app, [*args, "120"])
+    assert inside.exit_code == 1, inside.output
+    assert "internal error: ValueError" in inside.output and "--time" not in inside.output
+    assert not out.exists()

@@ -22,7 +22,7 @@ def snapshot(
 ) -> None:
     """Headless picture of the twin's field at a time of a recorded run."""
     from twin.correction.methods import make_corrector
-    from twin.loop.replay import replay_method
+    from twin.loop.replay import check_field_time, replay_method
     from twin.loop.snapshot import render_snapshot
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
@@ -35,15 +35,16 @@ def snapshot(
     spindle = SpindleModel.load()
     recorded = read_run(run, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
     try:
-        r = replay_method(
-            recorded,
-            spindle,
-            make_corrector(method_name, model_path, spindle=spindle),
-            keep_fields=False,
-            field_at_s=time_s,
-        )
-    except ValueError as exc:
+        check_field_time(recorded, time_s)
+    except ValueError as exc:  # only this: any other ValueError is an internal error
         raise InputError(str(exc), file=str(run), column="--time") from None
+    r = replay_method(
+        recorded,
+        spindle,
+        make_corrector(method_name, model_path, spindle=spindle),
+        keep_fields=False,
+        field_at_s=time_s,
+    )
     ((t, T),) = r.fields.items()
     render_snapshot(
         spindle,

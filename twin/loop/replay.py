@@ -193,6 +193,13 @@ def n_windows(run: RecordedRun) -> int:
     return int(np.floor(run.duration_s / WINDOW_S + 1e-9))
 
 
+def check_field_time(run: RecordedRun, time_s: float) -> None:
+    """ValueError unless a field at `time_s` lies in the span a replay of `run` solves."""
+    span_s = n_windows(run) * WINDOW_S
+    if not 0.0 < time_s <= span_s:
+        raise ValueError(f"time {time_s:g} s is outside the replayed span (0, {span_s:g}] s")
+
+
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
     T0 = np.where(first.valid_T[0], first.T_C[0], np.nan)
@@ -222,10 +229,7 @@ def replay_method(
         raise ValueError(f"{run.name}: a replay needs at least two 60 s windows of data")
     field_step = None
     if field_at_s is not None:
-        if not (0.0 < field_at_s <= windows * WINDOW_S):
-            raise ValueError(
-                f"time {field_at_s:g} s is outside the replayed span (0, {windows * WINDOW_S:g}] s"
-            )
+        check_field_time(run, field_at_s)
         field_step = max(1, int(round(field_at_s / STEP_S)))  # 1-based solver step
         windows = int(np.ceil(field_step / STEPS_PER_WINDOW))
     T0 = initial_temperature_C(run)
