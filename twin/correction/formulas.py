@@ -220,6 +220,33 @@ def resistance_second_correction(first_m2K_W: ArrayLike, C_C: ArrayLike) -> np.n
     return np.asarray(first_m2K_W, dtype=float) * np.asarray(C_C, dtype=float)
 
 
+def series_resistance_correction(
+    resistance_m2K_W: float, C_C: float, metal_m2K_W: float, noise_log_step: float,
+    limits: tuple[float, float],
+) -> float:
+    """Eq. 6 for a drop that also crosses metal in series with the contact: R + R_m is
+    scaled by the part of the drop ratio C_C beyond its noise, R alone by the rest  [m²K/W].
+
+    Eq. 6 (R'' = C_C · R') takes the ring-to-sleeve drop as proportional to R.  Between
+    the sensors it is heat flux × (R + R_m), R_m the conduction of the metal between them
+    and the contact, so d log(drop) = R/(R + R_m) · d log R and Eq. 6 closes only that
+    share of a resistance's log error per window.  Scaling R + R_m by the drop ratio is
+    Newton's step on it, but it also multiplies the ratio's noise by (R + R_m)/R; so a
+    ratio within `noise_log_step` of 1 (|log C_C| ≤ it: the drop's noise over the drop)
+    moves R as Eq. 6 does, and only the part beyond goes through R + R_m:
+
+        R_n = R' · C_n,   R'' = (R_n + R_m) · C_C / C_n − R_m,   C_n = C_C clipped to e^±noise
+
+    The step R''/R' is kept within `limits`; R_m = 0 or an infinite noise step is Eq. 6.
+    """
+    log_ratio = float(np.log(C_C))
+    noise = float(np.clip(log_ratio, -noise_log_step, noise_log_step))
+    within_noise = float(resistance_m2K_W) * float(np.exp(noise))
+    beyond = float(np.exp(log_ratio - noise))
+    new = (within_noise + metal_m2K_W) * beyond - metal_m2K_W
+    return float(np.clip(new, limits[0] * resistance_m2K_W, limits[1] * resistance_m2K_W))
+
+
 def limit_to_nominal(
     value: ArrayLike, nominal: ArrayLike, guards: RatioGuards = DEFAULT_GUARDS
 ) -> np.ndarray:

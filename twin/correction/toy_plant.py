@@ -6,8 +6,12 @@ heat H [W/m³] and ring/sleeve contact resistance R [m²K/W] enter exactly as in
 the corrections and networks can be exercised on curves with a known truth.
 
 Nodes and conductances (W/K): ring -(A_c/R)- sleeve -(G_sh)- housing -(G_ha)- ambient,
-sleeve -(G_sa)- ambient; the motor loss heats the housing.  Magnitudes are chosen so that a
-run at 9000 rpm rises about 6 K at the front ring in 30 min, like the paper's Table 1.
+sleeve -(G_sa)- ambient; the motor loss heats the housing.  `contact_metal_W_K` puts the
+metal between the sensors and the contact in series with it (ring -(1/(R/A_c + 1/G_m))-
+sleeve): the ring-to-sleeve drop is then inelastic to R, d log drop = G_m/(G_m + A_c/R) ·
+d log R, as on the spindle, where the sensors sit millimetres from the contact.
+Magnitudes are chosen so that a run at 9000 rpm rises about 6 K at the front ring in
+30 min, like the paper's Table 1.
 Backward Euler, so the result does not depend on stability limits of the step.
 """
 
@@ -30,6 +34,9 @@ class ToyPlant:
     sleeve_ambient_W_K: tuple[float, float] = (1.5, 1.0)
     housing_ambient_W_K: float = 12.0
     motor_loss_W_per_krpm: float = 4.0
+    contact_metal_W_K: tuple[float, float] | None = None
+    """Conductance of the metal in series with each contact (front, rear); None: the drop
+    is all contact."""
 
     def nominal_heat_W_m3(self, speed_rpm: ArrayLike) -> np.ndarray:
         """Front and rear bearing heat (N, 2) growing with speed like Palmgren's n·M."""
@@ -73,7 +80,10 @@ class ToyPlant:
                 G[c, a] -= g
 
             for k, (ring, sleeve) in enumerate(((0, 1), (2, 3))):
-                link(ring, sleeve, self.contact_area_m2[k] / res[i, k])
+                g_contact = self.contact_area_m2[k] / res[i, k]
+                if self.contact_metal_W_K is not None:  # in series: resistances add
+                    g_contact = 1.0 / (1.0 / g_contact + 1.0 / self.contact_metal_W_K[k])
+                link(ring, sleeve, g_contact)
                 link(sleeve, 4, self.sleeve_housing_W_K[k])
                 G[sleeve, sleeve] += self.sleeve_ambient_W_K[k]
                 b[sleeve] += self.sleeve_ambient_W_K[k] * amb[i]
