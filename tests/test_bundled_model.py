@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "8202b9cd672a7d27462329eb56800697dc00c72969951338f81b62a858ea7d76"
+BUNDLED_MODEL_SHA256 = "2dbb8d32b0eb5a034ed2b2940b30591d7ad13c9ad8d4331bf4e10398673959cb"
 
 
 def _make_model():
