@@ -11,11 +11,12 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from bench.child import run_measured
 
 ROOT = Path(__file__).resolve().parent.parent
 RUN = ROOT / "examples" / "runs" / "spindle_9000rpm_30min.csv"
@@ -24,22 +25,19 @@ METHODS = "open_loop,ratio,bpnn"
 
 
 def _cli(*args: str) -> tuple[float, float]:
-    """Wall time (s) and peak RSS (MB) of `twin ARGS` in a fresh process."""
+    """Wall time (s, imports included, interpreter start-up not) and peak RSS (MB, the
+    process's own: `bench.child`) of `twin ARGS` in a fresh process."""
     code = (
-        "import resource, sys, time; t = time.perf_counter()\n"
+        "import sys, time; t = time.perf_counter()\n"
         "from twin.cli import app\n"
         "try:\n    app(sys.argv[1:], prog_name='twin')\nexcept SystemExit as e:\n"
         "    assert not e.code, e.code\n"
-        "print('BENCH', time.perf_counter() - t, "
-        "resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)\n"
+        "print('BENCH', time.perf_counter() - t)\n"
     )
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true"}
-    out = subprocess.run(
-        [sys.executable, "-c", code, *args], capture_output=True, text=True, env=env, check=True
-    )
-    line = [x for x in out.stdout.splitlines() if x.startswith("BENCH")][-1]
-    wall, rss = map(float, line.split()[1:])
-    return wall, rss
+    stdout, usage = run_measured([sys.executable, "-c", code, *args], env)
+    line = [x for x in stdout.splitlines() if x.startswith("BENCH")][-1]
+    return float(line.split()[1]), usage.rss_MB
 
 
 def _replay(runs: list[str], out: Path, *extra: str) -> tuple[float, float]:

@@ -3,7 +3,7 @@
 What a user waits for: `twin replay RUN --out DIR --snapshots none --quiet --methods
 open_loop,ratio,bpnn` in a fresh interpreter, imports, model load, solve and every output
 (fields, CSVs, plots, summary, report) included.  Each of `repeats` runs is a child process
-whose own resource usage (`os.wait4`) gives
+whose own resource usage (`os.wait4`, from a minimal spawner: `bench.child`) gives
 
     wall_s    elapsed time, start of the process to its exit
     cpu_s     user + system CPU time of the child and of the helpers it forks (the
@@ -38,9 +38,10 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from collections import defaultdict
 from pathlib import Path
+
+from bench.child import run_measured
 
 ROOT = Path(__file__).resolve().parent.parent
 RUN = ROOT / "examples" / "runs" / "spindle_9000rpm_30min.csv"
@@ -66,19 +67,8 @@ def _env(pycache: Path) -> dict[str, str]:
 
 def cold_replay(out: Path, env: dict[str, str]) -> dict[str, float]:
     """Wall and CPU seconds and peak RSS (MB) of one cold `twin replay` into `out`."""
-    with tempfile.TemporaryFile() as stderr:  # a file, not a pipe: a full pipe would block
-        t0 = time.perf_counter()
-        child = subprocess.Popen(_command(out), env=env, stdout=subprocess.DEVNULL,
-                                 stderr=stderr)
-        _, status, usage = os.wait4(child.pid, 0)
-        wall = time.perf_counter() - t0
-        child.returncode = os.waitstatus_to_exitcode(status)
-        if child.returncode:
-            stderr.seek(0)
-            raise RuntimeError(f"twin replay exited {child.returncode}: "
-                               f"{stderr.read().decode(errors='replace')[-2000:]}")
-    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
-            "rss_MB": usage.ru_maxrss / 1024}
+    _, usage = run_measured(_command(out), env)
+    return {"wall_s": usage.wall_s, "cpu_s": usage.cpu_s, "rss_MB": usage.rss_MB}
 
 
 def parse_importtime(text: str) -> list[tuple[int, str, float, float]]:
