@@ -4,7 +4,6 @@ own, not the memory of the process that started it."""
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 
 import pytest
@@ -23,13 +22,11 @@ def test_a_child_measures_its_own_peak_not_its_parents() -> None:
     hog = bytearray(400 * 2**20)
     hog[::4096] = b"y" * len(hog[::4096])  # this process now holds 400 MB more
     env = dict(os.environ)
-    # started straight from here, the child's peak starts at this process's (the defect)
-    child = subprocess.Popen([sys.executable, "-c", "pass"], env=env)
-    _, _, direct = os.wait4(child.pid, 0)
+    # started straight from here (subprocess + os.wait4), a bare interpreter measured
+    # > 400 MB on this machine's kernel: its peak started at this process's
     stdout, small = run_measured([sys.executable, "-c", "pass"], env)
     _, big = run_measured([sys.executable, "-c", _alloc(200)], env)
     del hog
-    assert direct.ru_maxrss / 1024 > 400  # what the bench used to report
     assert small.rss_MB < 60, small  # a bare interpreter: some 10-20 MB
     assert 200 < big.rss_MB < 280, big  # its own 200 MB and the interpreter
     assert small.wall_s > 0 and small.cpu_s > 0 and stdout == ""
