@@ -345,3 +345,13 @@ def test_help_and_no_arguments_still_show_the_help():
                               text=True, timeout=120)
         assert done.returncode == status, done.stderr
         assert "Usage: " in done.stdout + done.stderr
+
+
+def test_synth_creates_the_run_file_folder_as_every_other_out_does(tmp_path):
+    # replay, simulate, train and drift create a missing --out folder; synth refused it
+    out = tmp_path / "new" / "deeper" / "run.csv"
+    result = CliRunner().invoke(app, [
+        "synth", "--speed", "9000", "--minutes", "2", "--ambient", "25", "--seed", "1",
+        "--out", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.parent.iterdir()) == ["run.csv", "run.truth.csv"]

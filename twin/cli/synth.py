@@ -96,8 +96,6 @@ def synth(
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError("the run must be written as .csv or .parquet", file=str(out),
                          column="--out")
-    if not out.parent.is_dir():
-        raise InputError("output folder does not exist", file=str(out.parent), column="--out")
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
     run = synthesize(
         speed_rpm=speed,
