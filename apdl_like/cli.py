@@ -82,14 +82,11 @@ def run(
 
 def _spindle_session(base_dir: Path, strict: bool):  # noqa: ANN202 - a Session
     """A session holding the reference spindle as the twin's loop builds it
-    (`twin.loop.replay.deck_window_solver`)."""
-    from apdl_like.session import Session
+    (`twin.loop.replay.spindle_session`)."""
+    from twin.loop.replay import spindle_session
     from twin.spindle.model import SpindleModel
 
-    model = SpindleModel.load()
-    session = Session.from_mesh(model.mesh, model.materials, order=model.order,
-                                T_ref_C=model.elastic.T_ref, base_dir=base_dir,
-                                thermal=model.thermal)
+    session = spindle_session(SpindleModel.load(), base_dir=base_dir)
     session.state.strict = strict
     return session
 

@@ -50,6 +50,7 @@ import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -140,6 +141,22 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
     return solve
 
 
+def spindle_session(model: SpindleModel, base_dir: str | Path | None = None):  # noqa: ANN201
+    """An APDL-like session (`apdl_like.Session`) holding `model`'s mesh, materials and
+    contact real sets: the database every window deck runs on (the loop's, and
+    `apdl-like run --spindle`'s)."""
+    from apdl_like.session import Session
+
+    return Session.from_mesh(
+        model.mesh,
+        model.materials,
+        order=model.order,
+        T_ref_C=model.elastic.T_ref,
+        base_dir=base_dir,
+        thermal=model.thermal,  # adopt the assembled operators: nothing re-assembled
+    )
+
+
 def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # noqa: ANN001
     """Solve each window through its APDL-like deck in one persistent session.
 
@@ -148,17 +165,10 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
     The temperature state is handed in explicitly, so one session serves every method.
     """
     from apdl_like.loadset import LoadSet
-    from apdl_like.session import Session
     from apdl_like.writer import window_deck
 
     if session is None:
-        session = Session.from_mesh(
-            model.mesh,
-            model.materials,
-            order=model.order,
-            T_ref_C=model.elastic.T_ref,
-            thermal=model.thermal,  # adopt the assembled operators: nothing re-assembled
-        )
+        session = spindle_session(model)
 
     def solve(
         bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int,
