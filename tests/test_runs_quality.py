@@ -108,6 +108,47 @@ def test_spikes_replaced(tmp_path):
     assert kinds(run) == {"spike"}
 
 
+def coarse_load_change(n=151, dt=4.0):
+    """T1/T3 as `twin simulate` writes them at 0.25 Hz: a fast warm-up whose bearing load
+    drops at 60 s (first-order responses, closed form), so the rings turn sharply there."""
+    cols = warmup(n=n, dt=dt)
+    t = cols["time_s"]
+    for name, amp, low in (("T1_C", 16.0, 11.0), ("T3_C", 13.0, 9.0)):
+        at_60 = amp * (1.0 - np.exp(-60.0 / 20.0))
+        cols[name] = 22.0 + np.where(t <= 60.0, amp * (1.0 - np.exp(-t / 20.0)),
+                                     low + (at_60 - low) * np.exp(-(t - 60.0) / 10.0))
+        cols[name] += 2.0 * (1.0 - np.exp(-t / 400.0))  # the housing's slow warm-up
+    return cols
+
+
+def test_a_sharp_turn_at_coarse_sampling_is_not_a_spike(tmp_path):
+    # the 11-sample median spans 40 s at 0.25 Hz: the samples just before the turn stand
+    # 0.5-1.3 K off it, yet they continue the warm-up before them
+    run = read_run(write(tmp_path, csv_text(coarse_load_change())))
+    assert run.quality == []
+    np.testing.assert_allclose(run.T_C[:, 0], coarse_load_change()["T1_C"], atol=1e-4)
+
+
+def test_spikes_at_coarse_sampling_are_still_spikes(tmp_path):
+    cols = coarse_load_change()
+    clean = cols["T1_C"].copy()
+    cols["T1_C"][[14, 60, 61]] += [3.0, -4.0, -3.5]  # one at the turn, one of two samples
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert one(run, "spike", "T1_C")["rows"] == [16, 62, 63]
+    assert kinds(run) == {"spike"}
+    assert np.abs(run.T_C[[60, 61], 0] - clean[[60, 61]]).max() < 0.05
+
+
+def test_twin_simulate_output_reads_without_spikes(tmp_path, spindle_model):
+    # `twin simulate` writes 4 s steps whose loads change at each 60 s window: its own
+    # keypoints.csv is a clean run (disp_r_um is not a run column: ignored, and said so)
+    from twin.spindle import simulate
+    from twin.spindle.output import keypoints_csv
+
+    run = read_run(write(tmp_path, keypoints_csv(simulate(spindle_model, 15000.0, 5.0, 22.0))))
+    assert {(f["column"], f["kind"]) for f in run.quality} == {("disp_r_um", "ignored_column")}
+
+
 def test_speed_steps_are_not_spikes(tmp_path):
     cols = warmup()
     cols["speed_rpm"][150:] = 12000.0
