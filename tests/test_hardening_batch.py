@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import shutil
+import signal
+import time
 from pathlib import Path
 
 import pytest
 
 from tests.test_runs_reader import csv_text, warmup
 from twin.loop.batch import replay_batch
-from twin.loop.folders import LOCK_FILE, remove_orphans, replaced_folder
+from twin.loop.folders import LOCK_FILE, folder_lock, remove_orphans, replaced_folder
 from twin.loop.report import build_report
 from twin.loop.summary import collect_summary
 
@@ -68,11 +71,11 @@ def test_defect4_run_folder_replaced_as_a_whole(tmp_path):
         (staging / "decks" / "window_001.inp").write_text("new")
         assert (target / "decks" / "window_099.inp").exists()  # old result intact until done
     assert sorted(p.name for p in (target / "decks").iterdir()) == ["window_001.inp"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == [LOCK_FILE, "run"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]  # the lock's file went too
     with pytest.raises(RuntimeError), replaced_folder(target) as staging:
         (staging / "x").write_text("half")
         raise RuntimeError("killed half-way")
-    assert [p.name for p in tmp_path.iterdir()] == [LOCK_FILE]
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_defect8_report_treats_run_names_as_names(replayed, tmp_path):
@@ -148,6 +151,66 @@ def test_defect15_orphans_of_a_killed_run_removed_by_the_next(tmp_path):
     assert not any(p.exists() for p in orphans)
     assert not (tmp_path / f".run.{dead}.12345678.partial").exists()
     assert live.exists() and keep.exists()
+
+
+def test_a_replay_leaves_no_lock_file(replayed, runs, tmp_path):
+    assert not (replayed / LOCK_FILE).exists()
+    out = copy_of(replayed, tmp_path)
+    build_report(out)  # `twin report DIR` takes the lock too
+    assert sorted(p.name for p in out.iterdir()) == ["a", "b", "report.html", "summary.json"]
+
+
+def _hold_folder_lock(out: str, held: str) -> None:
+    with folder_lock(Path(out)):
+        Path(held).write_text("held")
+        time.sleep(60)
+
+
+def test_a_killed_holders_lock_neither_blocks_nor_stays(tmp_path):
+    out, held = tmp_path / "out", tmp_path / "held"
+    child = multiprocessing.get_context("spawn").Process(target=_hold_folder_lock,
+                                                          args=(str(out), str(held)))
+    child.start()
+    try:
+        for _ in range(600):
+            if held.exists() or not child.is_alive():
+                break
+            time.sleep(0.05)
+        assert (out / LOCK_FILE).exists()
+        os.kill(child.pid, signal.SIGKILL)  # killed inside its turn: the file stays behind
+    finally:
+        child.join(30)
+    assert (out / LOCK_FILE).exists()
+    taken = time.monotonic()
+    with folder_lock(out):
+        pass
+    assert time.monotonic() - taken < 5.0  # the kernel ended the dead holder's lock
+    assert not (out / LOCK_FILE).exists()  # and the next turn removed its file
+
+
+def _count_under_lock(out: str, turns: int) -> None:
+    counter = Path(out) / "counter"
+    for _ in range(turns):
+        with folder_lock(Path(out)):
+            n = int(counter.read_text())
+            time.sleep(0.001)  # widen the read-modify-write a lost update needs
+            counter.write_text(str(n + 1))
+
+
+def test_the_lock_excludes_although_its_file_is_removed_every_turn(tmp_path):
+    # each turn unlinks the file it locked: a waiter on the old file must not share a turn
+    # with one that created the next file (a lost update would show in the count)
+    (tmp_path / "counter").write_text("0")
+    ctx = multiprocessing.get_context("fork")
+    workers = [ctx.Process(target=_count_under_lock, args=(str(tmp_path), 150))
+               for _ in range(3)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(120)
+    assert [w.exitcode for w in workers] == [0, 0, 0]
+    assert (tmp_path / "counter").read_text() == "450"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["counter"]
 
 
 def test_summary_keeps_earlier_failures_until_the_run_is_retried(replayed, tmp_path):

@@ -324,7 +324,7 @@ case("replay --out fifo", O, "bad", names="pipe")(
 case("replay --out = its own input", O, "bad", names="run.csv")(
     lambda d: replay(d, put(d, "run.csv", base_run()), out="run.csv"))
 case("replay --out a folder holding the run", O, "ok",
-     outs=["out/run", "out/report.html", "out/summary.json", "out/.twin.lock"])(
+     outs=["out/run", "out/report.html", "out/summary.json"])(
     lambda d: replay(d, put(d, "out/run.csv", base_run())))
 case("train RUN --out RUN", O, "bad", names="run.csv")(
     lambda d: [*TWIN, "train", put(d, "run.csv", base_run()), "--out", str(d / "run.csv"),

@@ -4,7 +4,8 @@ Several batches may write into one DIR at once, and a batch may be killed at any
 The rules that keep DIR consistent:
 - every file is written atomically (temporary name `.name.PID.HEX.suffix`, then renamed);
 - a run folder is built under a staging name and swapped in whole (`replaced_folder`);
-- the swap and summary.json's rebuild happen under DIR's lock (`folder_lock`);
+- the swap and summary.json's rebuild happen under DIR's lock (`folder_lock`), whose
+  file is removed at the end of each turn;
 - the next batch into DIR removes what a killed one left (`remove_orphans`).
 """
 
@@ -13,7 +14,7 @@ from __future__ import annotations
 import os
 import shutil
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 from filelock import FileLock
@@ -23,11 +24,26 @@ from twin.io.atomic import is_orphan, is_temporary, temporary_name
 LOCK_FILE = ".twin.lock"
 
 
-def folder_lock(out_root: Path) -> FileLock:
-    """The lock of an output folder: batches writing into one DIR take turns at the moments
-    they change shared state (a run folder swapped in, summary.json rewritten)."""
+@contextmanager
+def folder_lock(out_root: Path) -> Iterator[None]:
+    """Hold the lock of an output folder: batches writing into one DIR take turns at the
+    moments they change shared state (a run folder swapped in, summary.json rewritten).
+
+    The lock is the kernel's `flock` on `DIR/.twin.lock`, so a killed holder's lock ends
+    with its process.  The file is unlinked while still held, as the last act of the turn,
+    so no stray file stays in DIR after a run: a waiter that locked the unlinked file sees
+    it has no name left and takes the lock again on a new one (filelock checks `st_nlink`),
+    and nothing shared is touched between the unlink and the release.  A killed run's file
+    goes with the next turn taken in DIR.
+    """
     out_root.mkdir(parents=True, exist_ok=True)
-    return FileLock(out_root / LOCK_FILE)
+    path = out_root / LOCK_FILE
+    with FileLock(path):
+        try:
+            yield
+        finally:
+            with suppress(OSError):  # (Windows refuses to unlink an open file: it stays)
+                path.unlink()
 
 
 @contextmanager
