@@ -175,3 +175,31 @@ def test_a_folder_without_runs_is_a_clear_input_error(tmp_path):
     assert result.exit_code == 2
     assert str(empty) in result.output and "no recorded runs" in result.output
     assert (empty / "notes.txt").read_text() == "no runs here"
+
+
+def test_a_suite_into_a_folder_of_an_older_suite_is_refused_naming_the_stale_runs(tmp_path):
+    """`twin replay DIR` takes every run in DIR: a second suite written beside an older
+    one would be replayed mixed with it."""
+    out = tmp_path / "suite"
+    assert invoke("synth", "--suite", 2, "--seed", 1, "--minutes", 2, "--rate", 0.2,
+                  "--out", out, "--quiet").exit_code == 0
+    (out / "notes.txt").write_text("mine")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    result = invoke("synth", "--suite", 1, "--seed", 2, "--minutes", 2, "--rate", 0.2,
+                    "--out", out, "--quiet")
+    assert result.exit_code == 2, result.output
+    line = result.output.strip()
+    assert "\n" not in line and "Traceback" not in line
+    assert "8 run file(s)" in line and "suite1_001.csv" in line and "--overwrite" in line
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # nothing touched
+
+    # the same suite again needs no flag; --overwrite leaves only the new suite's runs
+    assert invoke("synth", "--suite", 2, "--seed", 1, "--minutes", 2, "--rate", 0.2,
+                  "--out", out, "--quiet").exit_code == 0
+    result = invoke("synth", "--suite", 1, "--seed", 2, "--minutes", 2, "--rate", 0.2,
+                    "--out", out, "--overwrite", "--quiet")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == [
+        "notes.txt", "suite2_001.csv", "suite2_001.profile.csv", "suite2_001.scenario.toml",
+        "suite2_001.truth.csv"]
+    assert (out / "notes.txt").read_text() == "mine"

@@ -66,6 +66,13 @@ def runs_in(folder: Path) -> list[Path]:
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
 
 
+def run_files_in(folder: Path) -> list[Path]:
+    """Every file of recorded runs in `folder`, sorted by name: the runs `runs_in` finds
+    and the truth, profile and scenario files `twin synth` writes beside them."""
+    return sorted(p for p in folder.iterdir() if p.is_file() and (
+        p.suffix in (".csv", ".parquet") or p.name.endswith(".scenario.toml")))
+
+
 def expand_run_folders(paths: list[Path]) -> list[Path]:
     """Each folder among `paths` replaced by the runs in it (`runs_in`); files kept."""
     out: list[Path] = []

@@ -15,7 +15,8 @@ and --out RUN.csv.  A suite: --suite N --seed S [--minutes M] --out DIR
 draws N scenarios (speed steps and stops, ambient, coolant, every truth
 factor below, sensor faults) and writes per run NAME.csv, NAME.truth.csv,
 NAME.scenario.toml and NAME.profile.csv; each scenario's header gives the
-command that reproduces its run byte for byte.
+command that reproduces its run byte for byte.  Other runs already in DIR
+are refused (--overwrite removes them).
 
 Scenario TOML (--scenario): every table is time_s plus values, linear in
 time; anything left out takes a seeded default.
@@ -58,6 +59,9 @@ def synth(
     coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
                                          "at the start, °C (default: the ambient, as the "
                                          "nominal model assumes)."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="With --suite: remove the "
+                                   "runs already in the --out folder that this suite does "
+                                   "not write (without it they are an error)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     from twin.io.destinations import check_out_file
@@ -72,7 +76,8 @@ def synth(
     if suite is not None:
         _synth_suite(suite, seed, 40.0 if minutes is None else minutes, rate, out,
                      given={"--speed": speed, "--profile": profile, "--scenario": scenario,
-                            "--ambient": ambient, "--coolant": coolant}, quiet=quiet)
+                            "--ambient": ambient, "--coolant": coolant},
+                     overwrite=overwrite, quiet=quiet)
         return
     if (speed is None) == (profile is None):
         raise InputError("give exactly one of --speed and --profile (or --suite)",
@@ -122,13 +127,17 @@ synth.__doc__ = SYNTH_HELP
 
 
 def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
-                 given: dict[str, object], quiet: bool) -> None:
-    """`--suite N`: draw N cases and write each one's four files into the folder `out`."""
+                 given: dict[str, object], overwrite: bool, quiet: bool) -> None:
+    """`--suite N`: draw N cases and write each one's four files into the folder `out`.
+
+    Runs already in `out` that this suite does not write (an older suite's) are refused,
+    or removed first with `overwrite`: a later `twin replay out` would mix them in."""
     import time
 
+    from twin.cli.inputs import run_files_in
     from twin.io.destinations import check_out_dir
     from twin.plant.scenario import Scenario
-    from twin.plant.suite import draw_suite, write_case
+    from twin.plant.suite import case_files, draw_suite, write_case
     from twin.spindle import SpindleModel
 
     clash = next((name for name, value in given.items() if value is not None), None)
@@ -140,6 +149,17 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     model = SpindleModel.load(size_factor=Scenario().model.size_factor)
     limit = model.spec.spindle.max_speed_rpm
     cases = draw_suite(n, seed, minutes, max_speed_rpm=limit, rate_hz=rate)
+    written = {name for case in cases for name in case_files(case.name).values()}
+    stale = [p for p in run_files_in(out) if p.name not in written] if out.is_dir() else []
+    if stale and not overwrite:
+        listed = ", ".join(p.name for p in stale[:3]) + (
+            f", … and {len(stale) - 3} more" if len(stale) > 3 else "")
+        raise InputError(f"holds {len(stale)} run file(s) this suite does not write "
+                         f"({listed}), which 'twin replay {out}' would mix with the new "
+                         "runs; write into an empty folder or pass --overwrite to remove "
+                         "them", file=str(out), column="--out")
+    for path in stale:  # first: a suite stopped half-way leaves only its own runs
+        path.unlink()
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     for k, case in enumerate(cases, start=1):

@@ -255,8 +255,14 @@ def write_case(case: SuiteCase, out_dir: Path, model=None) -> dict[str, Path]:  
     from twin.io.atomic import write_text
     from twin.plant.emulator import write_synth
 
-    out_dir = Path(out_dir)
-    profile = write_text(out_dir / f"{case.name}.profile.csv", profile_text(case))
-    scenario = write_text(out_dir / f"{case.name}.scenario.toml", scenario_text(case))
-    run, truth = write_synth(synthesize_case(case, model), out_dir / f"{case.name}.csv")
+    files = {kind: Path(out_dir) / name for kind, name in case_files(case.name).items()}
+    profile = write_text(files["profile"], profile_text(case))
+    scenario = write_text(files["scenario"], scenario_text(case))
+    run, truth = write_synth(synthesize_case(case, model), files["run"])
     return {"run": run, "truth": truth, "scenario": scenario, "profile": profile}
+
+
+def case_files(name: str) -> dict[str, str]:
+    """The names of the four files a suite's case `name` is written as, by kind."""
+    return {"run": f"{name}.csv", "truth": f"{name}.truth.csv",
+            "scenario": f"{name}.scenario.toml", "profile": f"{name}.profile.csv"}
