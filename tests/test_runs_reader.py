@@ -141,7 +141,12 @@ def test_empty_file(tmp_path):
 def test_time_going_back(tmp_path):
     cols = warmup()
     cols["time_s"][50] = 10.0
-    expect_error(write(tmp_path, csv_text(cols)), 52, "time_s", "time goes back")
+    err = expect_error(write(tmp_path, csv_text(cols)), 52, "time_s", "time goes back")
+    assert "from 49 s (line 51) to 10 s" in err.reason  # the CSV's editor lines
+    path = tmp_path / "back.parquet"
+    write_run(path, cols)
+    err = expect_error(path, 51, "time_s", "time goes back")
+    assert "from 49 s (row 50) to 10 s" in err.reason  # a Parquet file has rows, no lines
 
 
 def test_too_short_for_two_windows(tmp_path):

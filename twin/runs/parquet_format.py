@@ -88,7 +88,7 @@ def read_parquet_table(path: str | os.PathLike[str],
     ignored = [name for name in table.column_names if not keep(name)]
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.arange(1, table.num_rows + 1, dtype=np.int64),
-                    ignored_columns=ignored)
+                    ignored_columns=ignored, row_unit="row")
 
 
 def write_parquet_table(

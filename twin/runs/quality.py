@@ -110,7 +110,7 @@ def drop_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
     kept = RawTable(file=table.file, metadata=table.metadata,
                     columns={n: v[keep] for n, v in table.columns.items()},
                     rows=table.rows[keep], header_row=table.header_row,
-                    ignored_columns=table.ignored_columns)
+                    ignored_columns=table.ignored_columns, row_unit=table.row_unit)
     time = table.columns[TIME]
     spans = [(float(time[a] - time[0]), float(time[b] - time[0])) for a, b in _runs(repeated)]
     found = finding(TIME, "repeated_rows", "dropped (exact copies of earlier rows)",

@@ -204,7 +204,8 @@ def check_replayable(columns: Mapping[str, np.ndarray], file: str,
     run is written: whatever `twin synth` writes, replay reads)."""
     n = len(next(iter(columns.values())))
     table = RawTable(file=file, metadata={}, rows=np.arange(1, n + 1),
-                     columns={k: np.asarray(v, dtype=float) for k, v in columns.items()})
+                     columns={k: np.asarray(v, dtype=float) for k, v in columns.items()},
+                     row_unit="row")
     run_from_table(table, max_speed_rpm=max_speed_rpm)
 
 

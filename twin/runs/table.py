@@ -21,7 +21,8 @@ class RawTable:
     """Columns of one recorded run exactly as stored in its file.
 
     `rows[i]` is the 1-based line number of sample i in a CSV file (as an editor shows
-    it), or the 1-based data-row number in a Parquet file.  Missing values are NaN.
+    it), or the 1-based data-row number in a Parquet file; `row_unit` says which ("line"
+    or "row") where a message names one.  Missing values are NaN.
     """
 
     file: str
@@ -30,6 +31,7 @@ class RawTable:
     rows: np.ndarray
     header_row: int | None = None
     ignored_columns: list[str] = field(default_factory=list)
+    row_unit: str = "line"
 
     @property
     def n_samples(self) -> int:

@@ -50,7 +50,8 @@ def check_structure(table: RawTable) -> None:
     if back.size:
         i = int(back[0])
         raise InputError(
-            f"time goes back from {time[i]:g} s (line {table.rows[i]}) to {time[i + 1]:g} s; "
+            f"time goes back from {time[i]:g} s ({table.row_unit} {table.rows[i]}) to "
+            f"{time[i + 1]:g} s; "
             "samples must be in time order", file=table.file, row=int(table.rows[i + 1]),
             column=TIME)
 
