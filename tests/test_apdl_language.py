@@ -102,6 +102,11 @@ def test_nested_loops():
     ("/PREP7\nMP,KXX,1,-5\n", 2, "KXX must be positive"),
     ("/PREP7\nET,1,SOLID999\n", 2, "not supported"),
     ("/SOLU\nANTYPE,STATIC\nTIME,1\n", 3, "never solved"),
+    ("/SOLU\nANTYPE,TRANS,REST\n", 2, r"^deck.inp:2: ANTYPE: REST \(restart\): no "
+     r"previous solution in this run to continue from; restarting from another run's "
+     r"files \(.rdb, .Rnnn\) is not supported: /INPUT the deck that solves it first"),
+    ("/PREP7\nANTYPE,,RESTART\n", 2, r"RESTART \(restart\): no previous solution"),
+    ("/SOLU\nANTYPE,4,REST,1\n", 2, "chosen load step or substep .fields 3-4"),
     ("/INPUT,../secret,inp\n", 1, "outside the deck's folder"),
     ("*IF,1,EQ,1,:LABEL\n", 1, "GO labels are not supported"),
     ("A = 'text'\nB = A + 1\n", 2, "A is a character parameter"),

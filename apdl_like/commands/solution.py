@@ -35,8 +35,17 @@ def antype(s: SessionState, c: Call) -> None:
         s.solution.fresh_start = True
         s.solution.new_analysis = True
         settings.time = None
+    elif c.given(3) or c.given(4):
+        raise ApdlError("a restart at a chosen load step or substep (fields 3-4, LDSTEP, "
+                        "SUBSTEP) is not supported; leave them empty to continue from the "
+                        "last solution of this run")
     elif not s.solution.results and s.solution.temperature is None and not s.record_only:
-        raise ApdlError("ANTYPE,,REST: there is no previous solution to continue from")
+        # MAPDL restarts from the files of an earlier run (Jobname.rdb, .Rnnn); here the
+        # state lives in the session only, so that run has to be part of this one
+        raise ApdlError(f"{status} (restart): no previous solution in this run to "
+                        "continue from; restarting from another run's files (.rdb, .Rnnn) "
+                        "is not supported: /INPUT the deck that solves it first, in the "
+                        "same run")
     else:
         s.solution.fresh_start = False
         s.solution.new_analysis = False
