@@ -217,3 +217,10 @@ def test_a_run_separated_otherwise_than_by_commas_is_named_so(tmp_path, separato
     text = csv_text(warmup(), "# a: b\n").replace(",", separator)
     err = expect_error(write(tmp_path, text), 2, None, "one column")
     assert repr(separator) in err.reason and "comma" in err.reason
+
+
+def test_a_folder_given_as_a_run_is_named_a_folder(tmp_path):
+    # `twin snapshot DIR`: it said "unknown run format ''"
+    with pytest.raises(InputError, match="is a folder, not a run file") as info:
+        read_run(tmp_path)
+    assert info.value.file == str(tmp_path)

@@ -74,10 +74,15 @@ def run_files_in(folder: Path) -> list[Path]:
 
 
 def expand_run_folders(paths: list[Path]) -> list[Path]:
-    """Each folder among `paths` replaced by the runs in it (`runs_in`); files kept."""
+    """Each folder among `paths` replaced by the runs in it (`runs_in`); files kept.  A
+    folder without runs is an InputError (a mistyped folder would otherwise go unseen)."""
     out: list[Path] = []
     for path in paths:
-        out.extend(runs_in(path) if path.is_dir() else [path])
+        found = runs_in(path) if path.is_dir() else [path]
+        if not found:
+            raise InputError("no recorded runs (CSV/Parquet) found in this folder",
+                             file=str(path))
+        out.extend(found)
     return out
 
 

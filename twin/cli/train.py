@@ -11,7 +11,8 @@ from twin.loop.target_rules import TargetRule
 
 
 def train(
-    runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on."),
+    runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on; "
+                                      "a folder stands for the runs in it, as in replay."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
     epochs: int = typer.Option(5000, "--epochs", min=1, help="Maximum Rprop epochs."),
     seed: int = typer.Option(0, "--seed", min=0, help="Seed of the 80/20 split and the weights."),
@@ -30,8 +31,9 @@ def train(
     ),
     gate_runs: list[Path] = typer.Option(
         None, "--gate-runs",
-        help="A recorded run that the closed-loop check of the default networks replays "
-        "besides the held-out runs; never trained on (repeat the option for more).",
+        help="A recorded run (or a folder of runs) that the closed-loop check of the "
+        "default networks replays besides the held-out runs; never trained on (repeat the "
+        "option for more).",
     ),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
@@ -40,6 +42,7 @@ def train(
     Writes MODEL and, beside it, MODEL.report.json and MODEL.report.html
     (loss curves, R² of both configurations, predicted vs target).
     """
+    from twin.cli.inputs import expand_run_folders
     from twin.correction.modelfile import save_model
     from twin.correction.network import DEFAULT, PAPER
     from twin.correction.report import report_paths, write_report
@@ -53,7 +56,7 @@ def train(
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
 
-    gate_runs = list(gate_runs or [])
+    runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
     check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
     if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
         raise InputError("the model file must end in .safetensors", file=str(out),

@@ -24,6 +24,7 @@ from twin.correction.network import (
     train_network,
 )
 from twin.correction.samples import SampleSet
+from twin.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -65,7 +66,8 @@ def train_model(
     """Train the four networks with one shared 80/20 split drawn from `seed`: whole runs are
     held out (`split_by_run`) when the samples come from two runs or more."""
     if len(samples) < 5:
-        raise ValueError(f"too few training samples ({len(samples)}); need at least 5")
+        raise InputError(f"too few training samples ({len(samples)} windows); need at least "
+                         "5: give more or longer runs")
     if config.anchored and samples.anchors is None:
         raise ValueError("the anchored networks need samples with the ratio-law anchor "
                          "(window-fit targets, `--targets fit`)")
@@ -88,7 +90,10 @@ def train_model(
                   & np.isfinite(reference) & (y > 0))
         train, test = (rows[usable[rows]] for rows in split)
         if len(train) < 2:
-            raise ValueError(f"too few running samples for {output} ({len(train)})")
+            # the runs' data, not the code, falls short: bad input (exit 2), said so
+            raise InputError(f"too few usable windows (bearing running, sensors valid) to "
+                             f"train {output} on ({len(train)} in the training split of "
+                             f"{len(set(samples.run))} run(s)): give more or longer runs")
         anchor = reference if config.anchored else None
         net, history = train_network(
             x, y, train, test, config=config, hidden=HIDDEN_SIZES[kind_of(output)],

@@ -148,6 +148,8 @@ def read_table(path: str | os.PathLike[str],
     """
     file = Path(path)
     reader = _READERS.get(file.suffix.lower())
+    if reader is None and file.is_dir():  # said as it is, not as a format named ''
+        raise InputError("is a folder, not a run file (CSV or Parquet)", file=str(path))
     if reader is None:
         raise InputError(f"unknown run format {file.suffix!r}; expected .csv or .parquet",
                          file=str(path))
