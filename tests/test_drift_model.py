@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from tests.drift_synthetic import synthetic_columns, write_csv
 from twin.drift.data import read_drift_data
@@ -161,3 +162,19 @@ def test_bp_fit_is_repeatable_for_a_seed(data_file):
     assert a.keys() == b.keys()
     for key in a:
         np.testing.assert_array_equal(a[key], b[key])
+
+
+def test_the_two_kinds_of_model_file_are_named_where_the_other_is_expected(ridge_model,
+                                                                          tmp_path):
+    # both are .safetensors; each said only "not a spindle-twin ... model" of the other
+    from twin.cli import app
+    from twin.correction.modelfile import load_model
+    from twin.data import bundled_path
+
+    drift = save_drift_model(ridge_model, tmp_path / "drift.safetensors")
+    with pytest.raises(InputError, match="is a drift model .twin drift fit., not a correction"):
+        load_model(drift)
+    with pytest.raises(InputError, match="is a correction model .twin train., not a drift"):
+        load_drift_model(bundled_path("correction_model.safetensors"))
+    result = CliRunner().invoke(app, ["model-info", str(drift)])
+    assert result.exit_code == 2 and "twin drift predict" in result.output

@@ -42,6 +42,9 @@ from twin.paths import read_input_bytes
 FORMAT = "spindle-twin-correction"
 VERSION = 1
 METADATA_KEY = "spindle_twin"
+DRIFT_METADATA_KEY = "spindle_twin_drift"
+"""`twin.drift.modelfile`'s key, to name a drift model given where a correction model is
+expected (spelt here: the drift package stays unloaded by replay)."""
 PARTS = ("hidden_weight", "hidden_bias", "output_weight", "output_bias",
          "x_offset", "x_scale", "y_offset", "y_scale")
 
@@ -150,6 +153,11 @@ def load_model(path: str | Path) -> CorrectionModel:
     try:
         meta = json.loads(header.get("__metadata__", {})[METADATA_KEY])
     except (KeyError, TypeError, AttributeError, json.JSONDecodeError, RecursionError):
+        metadata = header.get("__metadata__") if isinstance(header, dict) else None
+        if isinstance(metadata, dict) and DRIFT_METADATA_KEY in metadata:
+            raise InputError("is a drift model (twin drift fit), not a correction model: "
+                             "use it with 'twin drift predict' or 'twin drift report'",
+                             file=str(path)) from None
         raise InputError(
             f"no '{METADATA_KEY}' metadata: not a spindle-twin correction model", file=str(path)
         ) from None

@@ -53,6 +53,17 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
     return write_bytes(path, data)
 
 
+def _is_correction_model(raw: bytes) -> bool:
+    """Whether the safetensors bytes carry `twin.correction.modelfile`'s metadata key."""
+    from twin.correction.modelfile import METADATA_KEY as CORRECTION_KEY
+
+    try:
+        header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
+        return CORRECTION_KEY in header["__metadata__"]
+    except (ValueError, KeyError, TypeError, UnicodeDecodeError):
+        return False
+
+
 def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
     """Read and check a drift model file; any problem raises InputError naming the file."""
     from safetensors import SafetensorError
@@ -68,6 +79,10 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
         header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
         doc = json.loads(header["__metadata__"][METADATA_KEY])
     except (SafetensorError, ValueError, KeyError, TypeError, UnicodeDecodeError):
+        if _is_correction_model(raw):
+            raise InputError("is a correction model (twin train), not a drift model: use it "
+                             "with 'twin replay --model' or 'twin model-info'",
+                             file=file) from None
         raise InputError("not a spindle-twin drift model file (safetensors with "
                          f"'{METADATA_KEY}' metadata)", file=file) from None
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
