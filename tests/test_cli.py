@@ -355,3 +355,18 @@ def test_synth_creates_the_run_file_folder_as_every_other_out_does(tmp_path):
         "--out", str(out), "--quiet"])
     assert result.exit_code == 0, result.output
     assert sorted(p.name for p in out.parent.iterdir()) == ["run.csv", "run.truth.csv"]
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda p: None, "missing: no such folder"),
+    (lambda p: p.write_text("time_s\n"),
+     "missing: is a file; a replay folder (twin replay --out DIR) is expected"),
+    (lambda p: p.mkdir(), "missing: not a replay folder (no <run>/accuracy.json inside)"),
+])
+def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    make(tmp_path / "missing")
+    result = CliRunner().invoke(app, ["report", "missing"])
+    assert result.exit_code == 2 and result.output == f"error: {message}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == (
+        [] if message.endswith("no such folder") else ["missing"])

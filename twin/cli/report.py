@@ -14,7 +14,12 @@ def report(out: Path = typer.Argument(..., help="a replay output folder")) -> No
     """Rebuild DIR/report.html and DIR/summary.json from a replay folder."""
     from twin.loop.report import build_report
 
-    if not out.is_dir() or not any(out.glob("*/accuracy.json")):
+    if not out.exists():
+        raise InputError("no such folder", file=str(out))
+    if not out.is_dir():
+        raise InputError("is a file; a replay folder (twin replay --out DIR) is expected",
+                         file=str(out))
+    if not any(out.glob("*/accuracy.json")):
         raise InputError("not a replay folder (no <run>/accuracy.json inside)", file=str(out))
     path = build_report(out)
     typer.echo(f"wrote {path}")
