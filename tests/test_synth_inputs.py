@@ -102,6 +102,32 @@ def test_bad_scenarios(text, row, column, words):
     assert words in info.value.reason
 
 
+def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
+    # a spike at 99999 s in a 5-min run landed on its last sample; a late dropout vanished
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    path = tmp_path / "late.toml"
+    path.write_text('[faults]\nspikes = [{sensor = "T1", time_s = 300, size = 6.0},\n'
+                    '          {sensor = "T2", time_s = 99999, size = 6.0}]\n')
+    assert len(load_scenario(path).faults.spikes) == 2  # the run's length is not known here
+    load_scenario(path, duration_s=99999.0)
+    with pytest.raises(InputError, match=r"spike at 99999 s is after the run's end \(300 s\)"
+                       ) as info:
+        load_scenario(path, duration_s=300.0)
+    assert (info.value.row, info.value.column) == (2, "faults.spikes.1.time_s")
+    path.write_text('[faults]\ndropouts = [{sensor = "T3", start_s = 400, end_s = 460}]\n')
+    with pytest.raises(InputError, match="dropout from 400 s is after the run's end"):
+        load_scenario(path, duration_s=300.0)
+    out = tmp_path / "run.csv"
+    result = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "5",
+                                      "--ambient", "22", "--seed", "1", "--scenario", str(path),
+                                      "--out", str(out)])
+    assert result.exit_code == 2 and "faults.dropouts.0.start_s" in result.output
+    assert not out.exists()
+
+
 def test_speed_profile(tmp_path):
     path = tmp_path / "p.csv"
     path.write_text("# warm-up then full speed\ntime_s,speed_rpm,ambient_C\n0,6000,24\n"

@@ -106,7 +106,8 @@ def synth(
         speed_rpm=speed,
         profile=None if profile is None else read_speed_profile(profile),
         minutes=minutes, ambient_C=ambient, seed=seed,
-        scenario=load_scenario(scenario), rate_hz=rate, coolant_C=coolant,
+        scenario=load_scenario(scenario, duration_s=60.0 * minutes), rate_hz=rate,
+        coolant_C=coolant,
         scenario_name=None if scenario is None else str(scenario),
         profile_name=None if profile is None else str(profile),
     )

@@ -274,9 +274,26 @@ def dump_scenario(scenario: Scenario, header: str = "") -> str:
     return comments + tomli_w.dumps(data)
 
 
-def load_scenario(path: str | os.PathLike[str] | None) -> Scenario:
-    """Read a scenario file (None: every default)."""
+def load_scenario(path: str | os.PathLike[str] | None,
+                  duration_s: float | None = None) -> Scenario:
+    """Read a scenario file (None: every default); with `duration_s`, a spike or dropout
+    the run never reaches is an error (a spike was put on the last sample)."""
     if path is None:
         return Scenario()
-    return parse_scenario(read_input_text(path, column="--scenario", max_bytes=2**20),
-                          str(path))
+    text = read_input_text(path, column="--scenario", max_bytes=2**20)
+    scenario = parse_scenario(text, str(path))
+    if duration_s is not None:
+        _check_fault_times(scenario.faults, duration_s, text, str(path))
+    return scenario
+
+
+def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) -> None:
+    """InputError naming the first spike or dropout that starts after the run's end."""
+    late = [(("faults", "spikes", k, "time_s"), f"spike at {spike.time_s:g} s")
+            for k, spike in enumerate(faults.spikes) if spike.time_s > duration_s]
+    late += [(("faults", "dropouts", k, "start_s"), f"dropout from {drop.start_s:g} s")
+             for k, drop in enumerate(faults.dropouts) if drop.start_s > duration_s]
+    if late:
+        loc, what = late[0]
+        raise InputError(f"{what} is after the run's end ({duration_s:g} s)", file=file,
+                         row=_line_of(text, loc), column=".".join(map(str, loc)))
