@@ -370,3 +370,22 @@ def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monk
     assert result.exit_code == 2 and result.output == f"error: {message}\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == (
         [] if message.endswith("no such folder") else ["missing"])
+
+
+@pytest.mark.parametrize("command", [
+    ["simulate", "--out", "OUT"],
+    ["synth", "--minutes", "3", "--seed", "1", "--out", "OUT.csv"],
+])
+@pytest.mark.parametrize("options, option, words", [
+    (["--speed", "20000", "--ambient", "25"], "--speed", "exceeds the spindle's limit"),
+    (["--speed", "9000", "--ambient", "25", "--coolant", "90"], "--coolant", "got 90"),
+])
+def test_an_impossible_operating_point_names_the_option(command, options, option, words,
+                                                         tmp_path, monkeypatch):
+    # simulate named the run column ('speed_rpm'), which its user never typed
+    monkeypatch.chdir(tmp_path)
+    argv = [*command, *options] + (["--minutes", "3"] if command[0] == "simulate" else [])
+    result = CliRunner().invoke(app, argv)
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"error: column '{option}': ") and words in result.output
+    assert list(tmp_path.iterdir()) == []

@@ -10,11 +10,15 @@ import math
 from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from twin.data import bundled_path
 from twin.errors import InputError
+
+if TYPE_CHECKING:
+    from twin.spindle.spec import SpindleSpec
 
 
 class Method(StrEnum):
@@ -64,6 +68,19 @@ def runs_in(folder: Path) -> list[Path]:
     runs = sorted(p for p in folder.iterdir()
                   if p.suffix in (".csv", ".parquet") and p.is_file())
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
+
+
+def check_operating_options(spec: SpindleSpec, speed: float, ambient: float,
+                            coolant: float | None) -> None:
+    """`check_operating_point` for a command's options: its errors name the option the
+    user typed (`--speed`), not the run column (`speed_rpm`)."""
+    from twin.spindle.conditions import check_operating_point
+
+    try:
+        check_operating_point(spec, speed, ambient, coolant)
+    except InputError as exc:
+        option = f"--{exc.column.split('_')[0]}" if exc.column else None
+        raise InputError(exc.reason, column=option) from None
 
 
 def run_files_in(folder: Path) -> list[Path]:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between
+from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between, check_operating_options
 
 
 def simulate_command(
@@ -35,7 +35,6 @@ def simulate_command(
     from twin.io.destinations import check_out_dir
     from twin.runs.schema import MAX_DURATION_S
     from twin.spindle import SpindleModel, simulate, write_simulation
-    from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
 
     if minutes > MAX_DURATION_S / 60.0:
@@ -44,7 +43,7 @@ def simulate_command(
     check_out_dir(out, inputs=[spec],
                   owned=["keypoints.csv", "fields.pvd", "fields", "summary.json"])
     # validate the operating point before the (slower) model build
-    check_operating_point(load_spec(spec), speed, ambient, coolant)
+    check_operating_options(load_spec(spec), speed, ambient, coolant)
     model = SpindleModel.load(spec, size_factor=size_factor)
     every = field_every if field_every > 0 else minutes * 60.0
     result = simulate(model, speed, minutes, ambient, coolant, field_every_s=every)

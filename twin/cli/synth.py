@@ -64,13 +64,13 @@ def synth(
                                    "not write (without it they are an error)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
+    from twin.cli.inputs import check_operating_options
     from twin.io.destinations import check_out_file
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
     from twin.plant.scenario import load_scenario
     from twin.runs import check_replayable
     from twin.runs.validate import FAHRENHEIT_AIR_RANGE_C
-    from twin.spindle.conditions import check_operating_point
     from twin.spindle.spec import load_spec
 
     if suite is not None:
@@ -94,10 +94,7 @@ def synth(
     if coolant is not None and not coolant < fahrenheit:
         raise InputError(f"coolant must be below {fahrenheit:g} °C (replay reads warmer "
                          f"coolant as Fahrenheit), got {coolant:g}", column="--coolant")
-    try:
-        check_operating_point(load_spec(None), speed or 0.0, ambient, coolant)
-    except InputError as exc:
-        raise InputError(exc.reason, column=f"--{exc.column.split('_')[0]}") from None
+    check_operating_options(load_spec(None), speed or 0.0, ambient, coolant)
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError("the run must be written as .csv or .parquet", file=str(out),
                          column="--out")
