@@ -252,6 +252,17 @@ def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     assert "anchor 99.37 %" in result.output
 
 
+def test_model_info_names_no_option_it_does_not_have(tmp_path, monkeypatch):
+    # MODEL is model-info's argument: the error named a '--model' option the user never gave
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["model-info", "absent.safetensors"])
+    assert result.exit_code == 2
+    assert result.output == ("error: absent.safetensors: cannot read file: No such file or "
+                             "directory\n")
+    result = CliRunner().invoke(app, ["replay", "--model", "absent.safetensors", "--out", "o"])
+    assert result.exit_code == 2 and "column '--model'" in result.output
+
+
 def test_apdl_like_run_says_why_a_deck_cannot_be_read(tmp_path):
     # a folder given as DECK was reported as "deck not found"
     from apdl_like.cli import app as apdl_app

@@ -11,7 +11,7 @@ def model_info(model: Path = typer.Argument(..., help="Correction model file."))
     """Check a correction model file and print what it was trained on and how well."""
     from twin.correction.modelfile import load_model
 
-    m = load_model(model)
+    m = load_model(model, option=None)  # an argument, not --model
     meta = m.metadata
     typer.echo(f"{model}: {meta.get('config')} configuration, {meta.get('samples')} samples, "
                f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}, "

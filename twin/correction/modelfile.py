@@ -137,13 +137,14 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
     return path
 
 
-def load_model(path: str | Path) -> CorrectionModel:
-    """Read and check a model file; any problem raises InputError naming the file."""
+def load_model(path: str | Path, option: str | None = "--model") -> CorrectionModel:
+    """Read and check a model file; any problem raises InputError naming the file (and
+    `option`, the command-line option that gave it, if any)."""
     from safetensors import SafetensorError
     from safetensors.numpy import load
 
     path = Path(path)
-    raw = read_input_bytes(path, column="--model", max_bytes=64 * 2**20)
+    raw = read_input_bytes(path, column=option, max_bytes=64 * 2**20)
     try:
         tensors = load(raw)
         header_len = int.from_bytes(raw[:8], "little")
