@@ -156,3 +156,16 @@ def test_simulate_again_into_a_folder_leaves_nothing_of_the_earlier_run(tmp_path
     assert simulate_cli("1").exit_code == 130
     assert not (out / "summary.json").exists()  # no earlier run's summary that looks current
     assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_simulate_says_the_duration_it_ran(tmp_path):
+    # whole 4 s steps: 0.1 min runs 2 steps (8 s), and the line said "0.1 min"
+    from twin.cli import app
+
+    out = tmp_path / "run"
+    result = CliRunner().invoke(app, ["simulate", "--speed", "6000", "--minutes", "0.1",
+                                      "--ambient", "24", "--field-every", "0", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith(f"6000 rpm, {8 / 60:g} min: ")
+    rows = list(csv.DictReader(open(out / "keypoints.csv")))
+    assert [r["time_s"] for r in rows] == ["0", "4", "8"]

@@ -12,7 +12,8 @@ from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between, check_ope
 def simulate_command(
     speed: float = typer.Option(..., "--speed", help="Spindle speed, rpm."),
     minutes: float = typer.Option(..., "--minutes", callback=between(0.0),
-                                  help="Duration, minutes."),
+                                  help="Duration, minutes (rounded up to whole 4 s "
+                                  "steps)."),
     ambient: float = typer.Option(..., "--ambient", help="Ambient temperature, °C."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
     coolant: float | None = typer.Option(
@@ -23,7 +24,8 @@ def simulate_command(
                                       callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
                                       help="Mesh size multiplier."),
     field_every: float = typer.Option(
-        60.0, "--field-every", min=0.0, help="Seconds between field snapshots (0: only the end)."
+        60.0, "--field-every", min=0.0, help="Seconds between field snapshots, to the "
+        "nearest whole 4 s step (0: only the end)."
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
@@ -51,7 +53,7 @@ def simulate_command(
     if not quiet:
         where = info["max_temperature_at"]
         typer.echo(
-            f"{speed:g} rpm, {minutes:g} min: max {info['max_temperature_C']:.2f} °C in "
+            f"{speed:g} rpm, {info['minutes']:g} min: max {info['max_temperature_C']:.2f} °C in "
             f"{where['region']}, nose drift axial {info['nose_drift_um']['axial']:.2f} µm, "
             f"radial {info['nose_drift_um']['radial']:.2f} µm -> {out}"
         )
