@@ -314,8 +314,13 @@ case("synth --profile P --out P", O, "bad", names="p.csv")(lambda d: [
     "3", "--ambient", "25", "--seed", "1", "--out", str(d / "p.csv"), "--quiet"])
 case("synth --out existing regular file (overwrite)", O, "ok", outs=["old.csv", "old.truth.csv"])(
     lambda d: _synth(put(d, "old.csv", "x")))
-case("synth --out in a missing folder", O, "bad", names="missing")(
+case("synth --out in a missing folder (created, as replay creates its own)", O, "ok",
+     outs=["missing"])(
     lambda d: _synth(str(d / "missing" / "r.csv")))
+case("synth --suite into a folder of another suite's runs", O, "bad", names="old_001.csv")(
+    lambda d: put(d, "suite/old_001.csv", base_run()) and [
+        *TWIN, "synth", "--suite", "1", "--seed", "1", "--minutes", "2", "--rate", "0.2",
+        "--out", str(d / "suite"), "--quiet"])
 case("replay --out existing file", O, "bad", names="file")(
     lambda d: replay(d, put(d, "run.csv", base_run()), out="file")
     if put(d, "file", "keep") else None)
@@ -655,7 +660,8 @@ def _report_corrupt(d: Path) -> list[str]:
     return [*TWIN, "report", str(d / "out")]
 
 
-case("report with a corrupt accuracy.json", B, "ok", outs=["out"])(_report_corrupt)
+case("report with a corrupt accuracy.json (named, exit 2)", B, "bad", outs=["out"],
+     names="accuracy.json")(_report_corrupt)
 
 
 def _resume_corrupt(d: Path) -> list[str]:
