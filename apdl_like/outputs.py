@@ -8,6 +8,7 @@ stress) plus SEQV; NaN marks nodes outside the elements.  Every file is written 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -69,6 +70,10 @@ def result_name(step: int) -> str:
     return f"result_{step + 1:03d}.vtu"
 
 
+RESULT_FILE = re.compile(r"result_\d{3,}\.vtu")
+"""The names `result_name` gives."""
+
+
 def output_names(session: SessionState) -> list[str]:
     """The files `write_outputs` writes, by their names inside the output folder."""
     return ["params.json", *(result_name(i) for i in range(len(session.solution.results))),
@@ -77,7 +82,8 @@ def output_names(session: SessionState) -> list[str]:
 
 def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
     """params.json, result_NNN.vtu (one per solved load step), log.txt and the files the deck
-    wrote (/OUT, *CFOPEN; names checked when the deck opened them) under `out_dir`."""
+    wrote (/OUT, *CFOPEN; names checked when the deck opened them) under `out_dir`, and
+    remove the result files an earlier run left there beyond this run's load steps."""
     out = Path(out_dir)
     written = []
     params = out / "params.json"
@@ -94,4 +100,9 @@ def write_outputs(session: SessionState, out_dir: str | Path) -> list[Path]:
         path = out / name
         write_text(path, "".join(line + "\n" for line in lines))
         written.append(path)
+    # result_*.vtu are this command's names (a deck may not write one): those an earlier
+    # run into `out` left beyond this run's load steps would pass for this run's results
+    for stale in sorted(set(out.glob("result_*.vtu")) - set(written)):
+        if RESULT_FILE.fullmatch(stale.name) and stale.is_file():
+            stale.unlink()
     return written

@@ -151,3 +151,23 @@ def test_defect1_apdl_outputs_refuse_special_files_and_inputs(tmp_path, fifo):
     assert result.exit_code == 2 and is_fifo(fifo)
     result = run_cli(apdl_app, ["run", deck, "--out", deck])
     assert result.exit_code == 2 and deck.read_text() == "A = 1\n"
+
+
+def test_apdl_run_leaves_no_result_of_an_earlier_run_beyond_its_own_steps(tmp_path):
+    # a 2-step deck then a 1-step deck into one DIR: result_002.vtu stayed, as if the
+    # second run had solved two load steps
+    steps = ("/PREP7\nET,1,PLANE55\nMP,KXX,1,50\nN,1,0,0\nN,2,1,0\nN,3,1,1\nN,4,0,1\n"
+             "E,1,2,3,4\nFINISH\n/SOLU\nANTYPE,STATIC\nD,1,TEMP,20\nD,2,TEMP,20\n"
+             "D,3,TEMP,{t}\nD,4,TEMP,{t}\n")
+    two = tmp_path / "two.inp"
+    two.write_text(steps.format(t=30) + "SOLVE\n" + "D,3,TEMP,40\nD,4,TEMP,40\nSOLVE\n")
+    one = tmp_path / "one.inp"
+    one.write_text(steps.format(t=50) + "SOLVE\n")
+    out = tmp_path / "out"
+    (out / "notes").mkdir(parents=True)
+    (out / "result_notes.txt").write_text("mine")  # not a result file: kept
+    assert run_cli(apdl_app, ["run", two, "--out", out, "--quiet"]).exit_code == 0
+    assert (out / "result_002.vtu").exists()
+    assert run_cli(apdl_app, ["run", one, "--out", out, "--quiet"]).exit_code == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "log.txt", "notes", "params.json", "result_001.vtu", "result_notes.txt"]
