@@ -196,6 +196,18 @@ def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path
     assert bad.read_bytes() == before  # input never modified
 
 
+def test_the_progress_keeps_run_names_whole_beside_a_long_failure(runs_dir, tmp_path):
+    # a failed run's message took the line and cut the names ("spindle_9… done")
+    bad = tmp_path / ("a_logger_export_with_a_long_name_" + "x" * 20 + ".csv")
+    bad.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C\n0,9000,25,25,25,25,25\n")
+    result = invoke("replay", str(bad), str(runs_dir / "hot_9000.csv"), "--out",
+                    str(tmp_path / "out"), "--methods", "open_loop", "--snapshots", "none")
+    assert result.exit_code == 2
+    lines = result.output.splitlines()
+    assert any(line.startswith("hot_9000 ") and " done" in line for line in lines), lines
+    assert any(line.startswith(bad.stem + " failed") for line in lines), lines
+
+
 def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_path):
     out = tmp_path / "out"
     runs = [runs_dir / "hot_9000.csv", runs_dir / "hot_12000.csv"]

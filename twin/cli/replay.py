@@ -62,6 +62,7 @@ def replay(
     console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.table import Column
 
     # the first run's figures are drawn by a child forked now, which loads matplotlib on
     # the idle core while this process imports the solver (a batch run by worker processes
@@ -69,10 +70,14 @@ def replay(
     in_this_process = not dask and (jobs <= 1 or len(paths) <= 1)
     # redrawn when a run finishes, not by rich's refresh thread: a process running no other
     # thread may fork (twin.loop.overlap)
+    # the run names keep their width: a failed run's long status is what gets cut (it is
+    # printed whole after the bar)
+    names = Column(no_wrap=True, min_width=min(60, max(len(Path(p).stem) for p in paths)))
     with run_plotter(fork=in_this_process) as plotter, Progress(
-        TextColumn("{task.description}"),
+        TextColumn("{task.description}", table_column=names),
         BarColumn(),
-        TextColumn("{task.fields[status]}"),
+        TextColumn("{task.fields[status]}",
+                   table_column=Column(no_wrap=True, overflow="ellipsis")),
         TimeElapsedColumn(),
         console=console,
         disable=quiet,
