@@ -96,7 +96,9 @@ def _spindle_session(base_dir: Path, strict: bool):  # noqa: ANN202 - a Session
 def export_cdb(
     out: Path = typer.Option(..., "--out", help="The archive to write (.cdb)."),
     mesh: Path = typer.Option(None, "--mesh", help="A gmsh .msh instead of the default "
-                                                   "spindle mesh (materials then omitted)."),
+                                                   "spindle mesh (materials then omitted; "
+                                                   "a spindle mesh's contact faces are kept "
+                                                   "apart, as in the default)."),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
     """Write the default spindle mesh as an ANSYS archive (NBLOCK, EBLOCK, CMBLOCK)."""
@@ -105,19 +107,20 @@ def export_cdb(
 
     check_out_file(out, inputs=[mesh])
 
+    from twin.spindle.spec import load_spec
+
+    spec = load_spec()
     if mesh is None:
         from twin.spindle.model import DEFAULT_MESH_PATH, fem_material
-        from twin.spindle.spec import load_spec
 
-        spec = load_spec()
         axi = AxiMesh.from_msh(DEFAULT_MESH_PATH, interfaces=spec.interfaces())
         materials = {region: fem_material(spec, region) for region in spec.regions}
         title = spec.spindle.name
     else:
         if not mesh.is_file():
             raise InputError("mesh file not found", file=str(mesh))
-        try:
-            axi = AxiMesh.from_msh(mesh)
+        try:  # a spindle mesh (`twin mesh`) keeps its contact faces apart, as the default
+            axi = AxiMesh.from_msh(mesh, interfaces=spec.interfaces(), present_only=True)
         except ValueError as exc:
             raise InputError(str(exc), file=str(mesh)) from None
         materials, title = None, mesh.stem

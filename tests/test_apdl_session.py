@@ -167,6 +167,45 @@ def test_export_cdb_reads_back_with_mapdl_archive(tmp_path):
         archive.node_components)
 
 
+def test_export_cdb_of_a_spindle_msh_keeps_its_contact_faces_apart(tmp_path):
+    # `--mesh` glued the contact interfaces (CONTACT_FRONT, not _A/_B; 20 nodes fewer)
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app
+    from twin.spindle.model import DEFAULT_MESH_PATH
+
+    def components(path):
+        return sorted(line.split(",")[1] for line in path.read_text().splitlines()
+                      if line.upper().startswith("CMBLOCK"))
+
+    default, given = tmp_path / "default.cdb", tmp_path / "given.cdb"
+    for out, extra in ((default, []), (given, ["--mesh", str(DEFAULT_MESH_PATH)])):
+        result = CliRunner().invoke(app, ["export-cdb", "--out", str(out), *extra])
+        assert result.exit_code == 0, result.output
+    assert components(given) == components(default)
+    assert "CONTACT_FRONT_A" in components(given) and "CONTACT_REAR_B" in components(given)
+    nodes = [CliRunner().invoke(app, ["export-cdb", "--out", str(tmp_path / "x.cdb"),
+                                      *extra]).output.split(": ")[1].split(",")[0]
+             for extra in ([], ["--mesh", str(DEFAULT_MESH_PATH)])]
+    assert nodes[0] == nodes[1]
+
+
+@pytest.mark.parametrize("text", ["$MeshFormat\n", "garbage\n"])
+def test_export_cdb_of_a_file_that_is_no_mesh_exits_2(text, tmp_path):
+    # meshio failed with IndexError, or exited the process itself (exit 1)
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app
+
+    bad = tmp_path / "bad.msh"
+    bad.write_text(text)
+    result = CliRunner().invoke(app, ["export-cdb", "--out", str(tmp_path / "x.cdb"),
+                                      "--mesh", str(bad)])
+    assert result.exit_code == 2
+    assert result.output.startswith(f"error: {bad}: not a readable gmsh mesh (")
+    assert result.output.count("\n") == 1 and not (tmp_path / "x.cdb").exists()
+
+
 def test_input_of_a_cdb_written_by_mapdl_archive(tmp_path):
     """mapdl-archive writes triangles as SHELL181; the deck redefines the type as PLANE55
     axisymmetric and solves the hollow-cylinder log profile."""

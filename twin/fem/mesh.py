@@ -287,9 +287,13 @@ class AxiMesh:
         )
 
     @classmethod
-    def from_meshio(cls, mesh, interfaces: Iterable[str] = ()) -> AxiMesh:  # noqa: ANN001
-        """Build from a meshio.Mesh with gmsh physical groups (2-D regions, 1-D lines)."""
+    def from_meshio(cls, mesh, interfaces: Iterable[str] = (),  # noqa: ANN001
+                    present_only: bool = False) -> AxiMesh:
+        """Build from a meshio.Mesh with gmsh physical groups (2-D regions, 1-D lines);
+        with `present_only`, the `interfaces` the mesh has no line group of are left out."""
         names = {(int(tag), int(dim)): name for name, (tag, dim) in mesh.field_data.items()}
+        if present_only:
+            interfaces = [n for n in interfaces if n in names.values()]
         phys = mesh.cell_data.get("gmsh:physical")
         if phys is None:
             raise ValueError("mesh has no gmsh physical groups")
@@ -317,18 +321,26 @@ class AxiMesh:
         )
 
     @classmethod
-    def from_msh(cls, path: str | Path, interfaces: Iterable[str] = ()) -> AxiMesh:
-        """Read a gmsh .msh file (physical groups name regions, boundaries, interfaces)."""
+    def from_msh(cls, path: str | Path, interfaces: Iterable[str] = (),
+                 present_only: bool = False) -> AxiMesh:
+        """Read a gmsh .msh file (physical groups name regions, boundaries, interfaces;
+        `present_only` as in `from_meshio`)."""
         import meshio
 
         # meshio's gmsh reader prints to stdout (a bare newline for our files), which would
         # end up in the output of `twin synth --quiet` and of pipes; keep it for the log
         captured = io.StringIO()
-        with contextlib.redirect_stdout(captured):
-            mesh = meshio.read(str(path))
+        with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+            try:
+                mesh = meshio.read(str(path))
+            except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio's parsers fail in
+                # many types (IndexError on a cut-short file) and exit on a file no reader
+                # takes: a file that is not a mesh is bad input
+                reason = " ".join(captured.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+                raise ValueError(f"not a readable gmsh mesh ({reason})") from None
         if captured.getvalue().strip():
             logging.getLogger(__name__).info("meshio: %s", captured.getvalue().strip())
-        return cls.from_meshio(mesh, interfaces)
+        return cls.from_meshio(mesh, interfaces, present_only)
 
     @classmethod
     def structured(
