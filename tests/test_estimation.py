@@ -65,6 +65,30 @@ def estimate(run, model, **config):
     return est, replay, windows
 
 
+def cold_start_run(path, speed_rpm, minutes, sensors, factors=None):  # noqa: ANN001, ANN201
+    """An emulated cold start at one speed whose truth has every factor at 1 but `factors`
+    ({scenario table: factor}) and nothing the twin cannot express but its finer mesh and
+    steps; `sensors` is the scenario's [sensors] body."""
+    tables = ("bearing_heat.front", "bearing_heat.rear", "contact_resistance.front",
+              "contact_resistance.rear", "motor_heat", "film.coolant", "film.housing",
+              "film.air_gap", "film.rotor")
+    factors = factors or {}
+    toml = "".join(f"[{k}]\ntime_s = [0.0]\nfactor = [{factors.get(k, 1.0)}]\n"
+                   for k in tables)
+    toml += f"[material]\nconductivity = 1.0\nexpansion = 1.0\n[sensors]\n{sensors}"
+    write_synth(synthesize(minutes=minutes, ambient_C=24.0, seed=3, speed_rpm=speed_rpm,
+                           scenario=parse_scenario(toml, "s.toml")), path)
+    return read_run(path)
+
+
+def first_analysis(run, model, **config) -> tuple[dict[str, float], float]:  # noqa: ANN001, ANN003
+    """The factors the first analysis finds, and the largest error of T1..T5 in window 1, K."""
+    _, replay, windows = estimate(run, model, **config)
+    window_1 = (replay.time_s > 60.0) & (replay.time_s <= 120.0)
+    error = np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[window_1].max()
+    return {k: float(np.exp(v)) for k, v in windows[1][1].items()}, float(error)
+
+
 # ------------------------------------------------------------------ analysis step
 def test_etkf_equals_the_kalman_update_on_a_linear_gaussian_problem():
     rng = np.random.default_rng(3)
@@ -594,32 +618,17 @@ def test_a_cold_start_s_heat_follows_the_rings_or_its_first_window_is_rerun(tmp_
     window 0 re-run so before the first analysis, that analysis finds the true factors and
     window 1 tracks the run.  Held and not re-run, the filter reads the held cold heat as
     bearing heat and contact resistance 13–32 % low and window 1 runs about 2 K off."""
-    one = "time_s = [0.0]\nfactor = [1.0]\n"
-    tables = ("bearing_heat.front", "bearing_heat.rear", "contact_resistance.front",
-              "contact_resistance.rear", "motor_heat", "film.coolant", "film.housing",
-              "film.air_gap", "film.rotor")
-    toml = "".join(f"[{k}]\n{one}" for k in tables) + (
-        "[material]\nconductivity = 1.0\nexpansion = 1.0\n"
-        "[sensors]\nlag_s = 0.0\nnoise_C = 0.01\nnoise_um = 0.01\nplacement_mm = 0.0\n")
-    path = tmp_path / "cold.csv"
-    write_synth(synthesize(minutes=4, ambient_C=24.0, seed=3, speed_rpm=12700.0,
-                           scenario=parse_scenario(toml, "s.toml")), path)
-    run = read_run(path)
-
-    def first_analysis(**config) -> tuple[dict[str, float], float]:  # noqa: ANN003
-        est, replay, windows = estimate(run, spindle_model, sensor_lag_s=0.0, **config)
-        window_1 = (replay.time_s > 60.0) & (replay.time_s <= 120.0)
-        error = np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[window_1].max()
-        return {k: float(np.exp(v)) for k, v in windows[1][1].items()}, float(error)
-
+    run = cold_start_run(tmp_path / "cold.csv", 12700.0, 4, "lag_s = 0.0\nnoise_C = 0.01\n"
+                         "noise_um = 0.01\nplacement_mm = 0.0\n")
     errors = []
     for config in ({}, {"loads_follow_rings": False}):
-        found, error = first_analysis(**config)
+        found, error = first_analysis(run, spindle_model, sensor_lag_s=0.0, **config)
         for name in ("H_front", "H_rear", "R_front", "R_rear"):
             assert found[name] == pytest.approx(1.0, abs=0.05), (name, found, config)
         assert error < 0.3, config
         errors.append(error)
-    held, error_held = first_analysis(loads_follow_rings=False, rerun_first_window=False)
+    held, error_held = first_analysis(run, spindle_model, sensor_lag_s=0.0,
+                                      loads_follow_rings=False, rerun_first_window=False)
     assert min(held[n] for n in ("H_front", "H_rear", "R_front", "R_rear")) < 0.9, held
     assert error_held > 4 * max(errors)
 
@@ -636,27 +645,12 @@ def test_the_first_analysis_is_iterated_where_a_cold_start_is_far_from_the_prior
     Gauss–Newton steps) the first analysis finds the rear heat closer and leaves the others
     near 1 (R_rear 1.00× and 0.90×), and window 1 stays within 0.32 K (plain 1.49 and
     1.69 K)."""
-    one = "time_s = [0.0]\nfactor = [1.0]\n"
-    tables = ("bearing_heat.front", "contact_resistance.front", "contact_resistance.rear",
-              "motor_heat", "film.coolant", "film.housing", "film.air_gap", "film.rotor")
-    toml = "".join(f"[{k}]\n{one}" for k in tables) + (
-        f"[bearing_heat.rear]\ntime_s = [0.0]\nfactor = [{rear_heat}]\n"
-        "[material]\nconductivity = 1.0\nexpansion = 1.0\n"
-        "[sensors]\nlag_s = 10.0\nnoise_C = 0.02\nnoise_um = 0.02\nplacement_mm = 0.0\n")
-    path = tmp_path / "cold.csv"
-    write_synth(synthesize(minutes=3, ambient_C=24.0, seed=3, speed_rpm=13500.0,
-                           scenario=parse_scenario(toml, "s.toml")), path)
-    run = read_run(path)
-
-    def first_analysis(**config) -> tuple[dict[str, float], float]:  # noqa: ANN003
-        _, replay, windows = estimate(run, spindle_model, **config)
-        window_1 = (replay.time_s > 60.0) & (replay.time_s <= 120.0)
-        error = np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[window_1].max()
-        return {k: float(np.exp(v)) for k, v in windows[1][1].items()}, float(error)
-
+    run = cold_start_run(tmp_path / "cold.csv", 13500.0, 3, "lag_s = 10.0\nnoise_C = 0.02\n"
+                         "noise_um = 0.02\nplacement_mm = 0.0\n",
+                         {"bearing_heat.rear": rear_heat})
     assert EstimatorConfig().analysis_iterations > 1
-    iterated, error = first_analysis()
-    plain, error_plain = first_analysis(analysis_iterations=1)
+    iterated, error = first_analysis(run, spindle_model)
+    plain, error_plain = first_analysis(run, spindle_model, analysis_iterations=1)
     miss = abs(np.log(iterated["H_rear"] / rear_heat))
     assert miss < 0.5 * abs(np.log(plain["H_rear"] / rear_heat)), (iterated, plain)
     others = ("H_front", "R_front", "R_rear", "sensor_lag")
