@@ -633,6 +633,29 @@ def test_a_cold_start_s_heat_follows_the_rings_or_its_first_window_is_rerun(tmp_
     assert error_held > 4 * max(errors)
 
 
+def test_a_gauss_newton_iterate_moves_the_start_within_bounds_and_holds_what_is_held():
+    """The start a re-forecast runs from: field and log-factors moved by X w, a held factor
+    not, a factor past its bound put on it, and the readings moved by their lag derivative
+    times the lag's (bounded) move, as a member's readings are."""
+    rng = np.random.default_rng(13)
+    n, N = 6, 8
+    ens = Ensemble(np.full(n, 30.0), standardized(rng.standard_normal((n, N))),
+                   np.zeros(3), 0.3 * standardized(rng.standard_normal((3, N))))
+    start = estimation_method.WindowStart(ens, None, np.full(5, 30.0),
+                                          np.linspace(-1.0, 1.0, 5))
+    bounds = np.log([[0.3, 3.0], [0.3, 3.0], [0.2, 4.0]])
+    w = 50.0 * ens.log_factor_anomalies[2] / np.sum(ens.log_factor_anomalies[2] ** 2)
+    moved = start.moved(w, held_rows=[1], lag=2, log_bounds=bounds)
+    np.testing.assert_allclose(moved.field_C, ens.field_mean + ens.field_anomalies @ w)
+    assert moved.ensemble.log_factor_mean[1] == 0.0  # held
+    assert moved.ensemble.log_factor_mean[2] == pytest.approx(np.log(4.0))  # on its bound
+    np.testing.assert_allclose(moved.ensemble.log_factor_mean[0],
+                               np.clip(ens.log_factor_anomalies[0] @ w, *bounds[0]))
+    np.testing.assert_allclose(moved.readings_C, 30.0 + np.linspace(-1, 1, 5) * np.log(4.0))
+    assert moved.ensemble.field_anomalies is ens.field_anomalies  # the members' spread stays
+    np.testing.assert_array_equal(start.ensemble.log_factor_mean, 0.0)  # the start is kept
+
+
 @pytest.mark.parametrize("rear_heat", [1.8, 0.55])
 def test_the_first_analysis_is_iterated_where_a_cold_start_is_far_from_the_prior(
         tmp_path, spindle_model, rear_heat):

@@ -354,12 +354,16 @@ class WindowStart:
     def field_C(self) -> np.ndarray:
         return self.ensemble.field_mean
 
-    def moved(self, weights: np.ndarray, held_rows: list[int], lag: int | None) -> WindowStart:
+    def moved(self, weights: np.ndarray, held_rows: list[int], lag: int | None,
+              log_bounds: np.ndarray) -> WindowStart:
         """The start with its mean moved by the ensemble weights (x̄ + X w; `held_rows` of
-        the log-factors stay), the readings with the moved lag (a member's rule)."""
+        the log-factors stay, the others within `log_bounds` (p, 2): a Gauss–Newton step
+        has no line search), the readings with the moved lag (a member's rule)."""
         ens = self.ensemble
         dphi = ens.log_factor_anomalies @ weights
         dphi[held_rows] = 0.0
+        phi = np.clip(ens.log_factor_mean + dphi, log_bounds[:, 0], log_bounds[:, 1])
+        dphi = phi - ens.log_factor_mean
         moved = Ensemble(ens.field_mean + ens.field_anomalies @ weights, ens.field_anomalies,
                          ens.log_factor_mean + dphi, ens.log_factor_anomalies)
         readings = self.readings_C
@@ -517,7 +521,7 @@ class EnsembleEstimator:
             for _ in range(cfg.analysis_iterations - 1):
                 # Gauss–Newton: forecast the window again from the start moved by w, and
                 # linearise there (module doc, "Iterated first analysis")
-                moved = start.moved(w, rows, self._lag)
+                moved = start.moved(w, rows, self._lag, self._bounds)
                 with threadpool_limits(1):
                     fc, _ = self._forecast_from(moved)
                 sim_C = np.asarray(f.simulated_C, float).copy()
