@@ -1,7 +1,7 @@
 """Benchmark of the reference spindle: model build and the 30 min open-loop run.
 
 `run()` returns timings in seconds; the open-loop run (9000 rpm, 25.3 °C,
-30 min, 4 s steps, loads re-evaluated every 60 s, no field output) has a target of ≤ 1 s.
+30 min, 4 s steps, loads re-evaluated every step, no field output) has a target of ≤ 1 s.
 """
 
 from __future__ import annotations

@@ -140,12 +140,14 @@ def test_spikes_at_coarse_sampling_are_still_spikes(tmp_path):
 
 
 def test_twin_simulate_output_reads_without_spikes(tmp_path, spindle_model):
-    # `twin simulate` writes 4 s steps whose loads change at each 60 s window: its own
-    # keypoints.csv is a clean run (disp_r_um is not a run column: ignored, and said so)
+    # `twin simulate`'s keypoints.csv is a clean run (disp_r_um is not a run column: ignored,
+    # and said so), even with its loads held over 60 s windows, which turns each ring sharply
+    # at 60 s: the samples of the warm-up before the turn are no spikes
     from twin.spindle import simulate
     from twin.spindle.output import keypoints_csv
 
-    run = read_run(write(tmp_path, keypoints_csv(simulate(spindle_model, 15000.0, 5.0, 22.0))))
+    result = simulate(spindle_model, 15000.0, 5.0, 22.0, update_every_s=60.0)
+    run = read_run(write(tmp_path, keypoints_csv(result)))
     assert {(f["column"], f["kind"]) for f in run.quality} == {("disp_r_um", "ignored_column")}
 
 

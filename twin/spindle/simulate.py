@@ -4,12 +4,16 @@
     result.keypoints()        # dict of arrays: time_s, T1_C..T5_C, disp_z_um, disp_r_um
 
 Backward Euler with Δt = 4 s from a uniform start at the ambient temperature.  The loads
-are the nominal ones (`nominal_conditions`), re-evaluated every `update_every_s` (60 s, the
-twin's window) from the simulated ring and sleeve temperatures T1..T4: the oil thins as
-the bearings warm (less heat) and the fit tightens or loosens (Eq. 5).  Pass
-`update_every_s=None` to hold the cold-start loads for the whole run.  Each window costs
-one factorization; each step one back-substitution and a few dot products (key points,
-nose drift through the adjoint probe vectors, energy balance).
+are the nominal ones (`nominal_conditions`), re-evaluated every `update_every_s` (default:
+every step) from the simulated ring and sleeve temperatures T1..T4 at its start: the oil
+thins as the bearings warm (less heat) and the fit tightens or loosens (Eq. 5), as on a
+real spindle, continuously.  Held longer, the loads jump: held over a 60 s window from the
+cold start (the oil at ambient, too much heat), they dropped T1 by 1.8 K in the 4 s after
+the first minute at 13 500 rpm.  Pass `update_every_s=None` to hold the cold-start loads
+for the whole run.  An update changes only the source vector and the contact terms (a
+low-rank update of the factorization of the speed's films); each step costs one
+back-substitution and a few dot products (key points, nose drift through the adjoint probe
+vectors, energy balance).
 
 Displacements are relative to the start of the run (the thermal drift).  Energy balance of
 every step: heat_in (sources) = heat_out (films) + stored, residual in W.
@@ -23,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
+from twin.contract import SENSOR_NAMES, STEP_S
 from twin.errors import InputError
 from twin.spindle.conditions import BoundaryConditions, check_operating_point, nominal_conditions
 from twin.spindle.model import SpindleModel
@@ -50,7 +54,7 @@ class SimulationResult:
     max_temperature_region: str
     region_mean_C: dict[str, float]
     region_max_C: dict[str, float]
-    conditions: list[BoundaryConditions]  # one per window
+    conditions: list[BoundaryConditions]  # one per load update (the first: cold start)
     final_T: np.ndarray
     fields: list[tuple[float, np.ndarray]] = field(default_factory=list)  # (t, T) snapshots
     wall_time_s: float = 0.0
@@ -71,7 +75,7 @@ class SimulationResult:
 
 def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: float,
              coolant_C: float | None = None, dt: float = STEP_S, *,
-             update_every_s: float | None = WINDOW_S,
+             update_every_s: float | None = STEP_S,
              field_every_s: float | None = None) -> SimulationResult:
     """Open-loop transient at a constant speed (see the module doc).
 
@@ -85,11 +89,11 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be positive, got {dt}")
     n_steps = max(1, int(math.ceil(minutes * 60.0 / dt - 1e-9)))
-    steps_per_window = n_steps
+    steps_per_update = n_steps
     if update_every_s is not None:
         if not update_every_s > 0:
             raise ValueError(f"update_every_s must be positive, got {update_every_s}")
-        steps_per_window = max(1, int(round(update_every_s / dt)))
+        steps_per_update = max(1, int(round(update_every_s / dt)))
     field_every = None if field_every_s is None else max(1, int(round(field_every_s / dt)))
 
     start = time.perf_counter()
@@ -114,7 +118,7 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     while k < n:
         if not conditions or update_every_s is not None:
             s = sensors[k]
-            hot = bool(conditions)  # the first window starts cold, at ambient
+            hot = bool(conditions)  # the first step starts cold, at ambient
             bc = nominal_conditions(
                 spec, speed_rpm, ambient_C, coolant,
                 T_bearings_C=(s[0], s[2]) if hot else None,
@@ -123,7 +127,7 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
             conditions.append(bc)
             loads = bc.to_thermal_loads()
             stepper = thermal.transient(loads, dt=dt, theta=1.0)
-        for T_new in stepper.march(T, min(steps_per_window, n - k)):
+        for T_new in stepper.march(T, min(steps_per_update, n - k)):
             eb = stepper.energy_balance(T, T_new)
             energy[:, k] = (eb["heat_in_W"], eb["heat_out_W"], eb["stored_W"], eb["residual_W"])
             T = T_new
