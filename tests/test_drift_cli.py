@@ -123,6 +123,24 @@ def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):
     assert result.exit_code == 2 and "--sensors" in result.output
 
 
+def test_more_sensors_than_the_data_hold_is_bad_input(machine, tmp_path):
+    # --sensors 5 on data with three temperature columns fitted on those three and said
+    # nothing: the user asked for five
+    _, data, _ = machine
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(out), "--sensors", "5",
+                 "--method", "mlr", "--quiet")
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output, result.output
+    assert "--sensors" in lines[0] and "5" in lines[0] and "at most 3" in lines[0], lines[0]
+    assert not out.exists()
+    # the count of the clusters' best sensors is still accepted
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(out), "--sensors", "3",
+                 "--method", "mlr", "--quiet")
+    assert result.exit_code == 0, result.output
+
+
 def test_drift_group_is_listed_with_its_commands():
     result = CliRunner().invoke(app, ["--help"])
     assert result.exit_code == 0 and "drift" in result.output

@@ -87,7 +87,8 @@ def fit(
         "stack. Default: the best of all by time-blocked validation."),
     sensors: str = typer.Option(
         "auto", "--sensors", help="auto (best of every correlation cluster), K (best K of "
-        "those), all, or a comma-separated list of temperature columns."),
+        "those; more than there are clusters is an error), all, or a comma-separated list "
+        "of temperature columns."),
     seed: int = typer.Option(0, "--seed", help="Seed of the network weights and k-means."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:

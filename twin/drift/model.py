@@ -67,7 +67,15 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
         k = int(text)
         if k < 1:
             raise InputError("the sensor count must be at least 1", column="--sensors")
-        return ranking.pick(k)
+        best = ranking.pick()
+        if k > len(best):
+            # K counts the clusters' best sensors; fitting on fewer than asked, silently,
+            # is not what the user asked for
+            raise InputError(
+                f"{k} sensors asked for, but the data's {len(available)} temperature columns "
+                f"form {len(best)} correlation clusters: give at most {len(best)}, or 'all' "
+                "for every column", column="--sensors")
+        return best[:k]
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in available]
     if unknown or not names:
