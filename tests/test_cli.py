@@ -400,3 +400,18 @@ def test_an_impossible_operating_point_names_the_option(command, options, option
     assert result.exit_code == 2, result.output
     assert result.output.startswith(f"error: column '{option}': ") and words in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_version_prints_the_installed_package_version():
+    from importlib.metadata import version
+
+    code = "import sys\nfrom twin.cli import main\nsys.argv = ['twin', '--version']\nmain()"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == f"twin {version('spindle-twin')}\n" and done.stderr == ""
+    # a command still runs, and its own options are not shadowed
+    result = CliRunner().invoke(app, ["--version", "simulate", "--help"])
+    assert result.exit_code == 0 and result.output.startswith("twin ")
+    result = CliRunner().invoke(app, ["simulate", "--help"])
+    assert result.exit_code == 0 and "Open-loop transient" in result.output

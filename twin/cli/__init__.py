@@ -39,6 +39,32 @@ COMMANDS = (
 """(name, function) of every `twin` command, in the order `twin --help` lists them."""
 
 
+PACKAGE = "spindle-twin"
+"""The distribution whose metadata `twin --version` reads (pyproject.toml's name)."""
+
+
+def _print_version(value: bool) -> None:
+    if not value:
+        return
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        typer.echo(f"twin {version(PACKAGE)}")
+    except PackageNotFoundError:  # run from a checkout that was never installed
+        typer.echo(f"twin: the {PACKAGE} package is not installed; no version to tell",
+                   err=True)
+        raise typer.Exit(1) from None
+    raise typer.Exit(0)
+
+
+def _options(
+    version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                 help="Print the installed version and exit."),
+) -> None:
+    # the app's own options (typer's callback); the help text is the app's
+    pass
+
+
 def build_app() -> typer.Typer:
     """The `twin` app with every command of `COMMANDS` under the shared error handling."""
     app = typer.Typer(
@@ -49,6 +75,7 @@ def build_app() -> typer.Typer:
         add_completion=False,
         pretty_exceptions_enable=False,
     )
+    app.callback()(_options)
     for name, function in COMMANDS:
         app.command(name)(report_errors(function))
     # a command group: its sub-commands carry report_errors themselves
