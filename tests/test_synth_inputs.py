@@ -75,7 +75,7 @@ def test_design_example_scenario_parses(tmp_path):
     ("[bearing_heat.front]\ntime_s = [0, 300]\nfactor = [1.0]\n", 1, "bearing_heat.front",
      "1 values for 2 times"),
     ("[sensors]\nlag_s = 8\nnoise_c = 1\n", 3, "sensors.noise_c", "unknown key"),
-    ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck", "unknown sensor"),
+    ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck.0", "unknown sensor"),
     ("\n[coolant]\ntime_s = [0]\ninlet_C = [300]\n", 4, "coolant.inlet_C.0", "less than"),
     ("[contact_resistance.front]\ntime_s = [0, 60]\nfactor = [1.0, 0.0]\n", 3,
      "contact_resistance.front.factor.1", "greater than 0"),
@@ -102,6 +102,29 @@ def test_bad_scenarios(text, row, column, words):
     assert words in info.value.reason
 
 
+@pytest.mark.parametrize("text, row, column", [
+    # a list's bad item is named on its own line, not on its key's (the first line of the
+    # list): in a list of ten dropouts the key's line said nothing of which one was wrong
+    ('[faults]\ndropouts = [{sensor = "T4", start_s = 600, end_s = 660},\n'
+     '            {sensor = "T9", start_s = 700, end_s = 760}]\n', 3, "faults.dropouts.1.sensor"),
+    ('[faults]\nspikes = [\n  # one per sensor\n  {sensor = "T1", time_s = 60},\n'
+     '  {sensor = "T2", time_s = 120, size = 500.0},\n]\n', 5, "faults.spikes.1.size"),
+    ('[faults]\nstuck = ["T1", "T2",\n         "T7"]\n', 3, "faults.stuck.2"),
+    ('[bearing_heat.front]\ntime_s = [0, 300, 600]\nfactor = [\n  1.0, # "x" [\n  1.1,\n'
+     '  -1.0,\n]\n', 6, "bearing_heat.front.factor.2"),
+    # arrays of tables: the item's own [[header]] or its key under it
+    ('[[faults.dropouts]]\nsensor = "T4"\nstart_s = 600\nend_s = 660\n'
+     '[[faults.dropouts]]\nsensor = "T3"\nstart_s = 700\nend_s = 650\n', 5,
+     "faults.dropouts.1"),
+    ('[[faults.spikes]]\nsensor = "T4"\ntime_s = 60\n[[faults.spikes]]\nsensor = "T5"\n'
+     'time_s = 60\nsize = 1e3\n', 7, "faults.spikes.1.size"),
+])
+def test_a_list_items_error_names_the_items_line(text, row, column):
+    with pytest.raises(InputError) as info:
+        parse_scenario(text, "bad.toml")
+    assert (info.value.row, info.value.column) == (row, column), str(info.value)
+
+
 def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     # a spike at 99999 s in a 5-min run landed on its last sample; a late dropout vanished
     from typer.testing import CliRunner
@@ -116,7 +139,7 @@ def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     with pytest.raises(InputError, match=r"spike at 99999 s is after the run's end \(300 s\)"
                        ) as info:
         load_scenario(path, duration_s=300.0)
-    assert (info.value.row, info.value.column) == (2, "faults.spikes.1.time_s")
+    assert (info.value.row, info.value.column) == (3, "faults.spikes.1.time_s")  # its line
     path.write_text('[faults]\ndropouts = [{sensor = "T3", start_s = 400, end_s = 460}]\n')
     with pytest.raises(InputError, match="dropout from 400 s is after the run's end"):
         load_scenario(path, duration_s=300.0)

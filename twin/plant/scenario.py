@@ -48,7 +48,15 @@ import os
 import re
 from typing import Annotated, ClassVar, Self
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from twin.contract import SENSOR_NAMES
 from twin.errors import InputError
@@ -192,15 +200,14 @@ MAX_SPIKE = 100.0
 """Largest spike (°C or µm): a glitch a logger writes, still a short number in the file."""
 
 
+SensorName = Annotated[str, AfterValidator(sensor_column)]
+"""A sensor as a scenario names it, read as its run column (`T2` → `T2_C`)."""
+
+
 class Faults(_Strict):
-    stuck: list[str] = []
+    stuck: list[SensorName] = []  # an item's error names its index, hence its line
     dropouts: list[Dropout] = []
     spikes: list[Spike] = []
-
-    @field_validator("stuck")
-    @classmethod
-    def _known(cls, names: list[str]) -> list[str]:
-        return [sensor_column(n) for n in names]
 
 
 class ModelOptions(_Strict):
@@ -224,26 +231,94 @@ class Scenario(_Strict):
 
 
 def _line_of(text: str, loc: tuple) -> int | None:
-    """Best-effort line of a dotted location (`bearing_heat.front.factor`) in TOML text."""
-    keys = [str(k) for k in loc if not isinstance(k, int)]
+    """Best-effort line of a location (`faults.dropouts.1.sensor`) in TOML text: the line of
+    a list's item itself (tomllib keeps no positions, so the text is searched), else of its
+    key, else of its table's header."""
     lines = text.split("\n")
-    start = 0
-    table_len = 0
-    for n in range(len(keys), 0, -1):  # the deepest [a.b] header that exists
-        header = re.compile(r"^\s*\[\s*" + r"\s*\.\s*".join(map(re.escape, keys[:n])) + r"\s*\]")
-        hit = next((i for i, ln in enumerate(lines) if header.match(ln)), None)
+    path = [str(k) for k in loc]
+    header_at, body_from, used = None, 0, 0
+    for n in range(len(path), 0, -1):  # the deepest [a.b] or k-th [[a.b]] header there is
+        dotted = r"\s*\.\s*".join(map(re.escape, path[:n]))
+        if n < len(path) and path[n].isdigit():  # an item of an array of tables
+            hits = [i for i, ln in enumerate(lines)
+                    if re.match(r"^\s*\[\[\s*" + dotted + r"\s*\]\]", ln)]
+            if len(hits) > int(path[n]):
+                header_at, used = hits[int(path[n])], n + 1
+                break
+        hit = next((i for i, ln in enumerate(lines)
+                    if re.match(r"^\s*\[\s*" + dotted + r"\s*\]", ln)), None)
         if hit is not None:
-            start, table_len = hit, n
+            header_at, used = hit, n
             break
-    rest = keys[table_len:]
-    if rest:
+    if header_at is not None:
+        body_from = header_at + 1
+    rest = path[used:]
+    if rest and not rest[0].isdigit():
         key = re.compile(r"^\s*" + re.escape(rest[0]) + r"\s*=")
-        for i in range(start + (1 if table_len else 0), len(lines)):
-            if table_len and i > start and lines[i].lstrip().startswith("["):
+        for i in range(body_from, len(lines)):
+            if header_at is not None and lines[i].lstrip().startswith("["):
                 break
             if key.match(lines[i]):
+                if len(rest) > 1 and rest[1].isdigit():
+                    offset = sum(len(ln) + 1 for ln in lines[:i]) + lines[i].index("=") + 1
+                    item = _array_item_offset(text, offset, int(rest[1]))
+                    if item is not None:
+                        return text.count("\n", 0, item) + 1
                 return i + 1
-    return start + 1 if table_len else None
+    return None if header_at is None else header_at + 1
+
+
+def _array_item_offset(text: str, offset: int, index: int) -> int | None:
+    """Offset in `text` of item `index` of the TOML array whose value starts after
+    `offset` (just past its key's `=`); None if no array, or fewer items, is there.
+    Strings and comments are skipped: a `,` or `[` inside them separates nothing."""
+    i = offset
+    while i < len(text) and text[i] in " \t":
+        i += 1
+    if i >= len(text) or text[i] != "[":
+        return None
+    depth, count, expecting = 0, -1, False
+    while i < len(text):
+        c = text[i]
+        if c == "#":
+            i = text.find("\n", i)
+            if i < 0:
+                return None
+            continue
+        if depth == 1 and expecting and c not in " \t\r\n,]":
+            count, expecting = count + 1, False
+            if count == index:
+                return i
+        if c in "\"'":
+            i = _string_end(text, i)
+            continue
+        if c in "[{":
+            depth += 1
+            expecting = expecting or depth == 1
+        elif c in "]}":
+            depth -= 1
+            if depth == 0:
+                return None
+        elif c == "," and depth == 1:
+            expecting = True
+        i += 1
+    return None
+
+
+def _string_end(text: str, i: int) -> int:
+    """Offset just past the TOML string starting at `i` (basic or literal, one-line or
+    triple-quoted); the text's end for an unterminated one."""
+    quote = text[i]
+    delimiter = quote * 3 if text.startswith(quote * 3, i) else quote
+    j = i + len(delimiter)
+    while j < len(text):
+        if quote == '"' and text[j] == "\\":
+            j += 2
+            continue
+        if text.startswith(delimiter, j):
+            return j + len(delimiter)
+        j += 1
+    return len(text)
 
 
 def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
