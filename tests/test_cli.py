@@ -329,6 +329,12 @@ def test_train_refuses_a_model_file_not_named_safetensors(tmp_path):
      "error: Invalid value for '--methods': unknown method 'magic'", "twin replay"),
     (["twin", "replay", "--out", "OUT", "--jobs", "0"], "error: Invalid value for '--jobs'",
      "twin replay"),
+    # a choice's message is the choices, without pydantic's "Value error, " before them
+    (["twin", "replay", "--out", "OUT", "--snapshots", "some"],
+     "error: Invalid value for '--snapshots': 'some' is not one of 'none', 'end', 'every'",
+     "twin replay"),
+    (["twin", "snapshot", "RUN.csv", "--time", "60", "--out", "S.png", "--field", "heat"],
+     "error: Invalid value for '--field': 'heat' is not one of", "twin snapshot"),
     (["twin", "drift", "fit", "DATA.csv", "--out", "M.safetensors"],
      "error: Missing option '--target'", "twin drift fit"),
     (["apdl-like", "run", "DECK.inp"], "error: Missing option '--out'", "apdl-like run"),

@@ -117,6 +117,9 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
         context = getattr(exc, "ctx", None)
         hint = f"; see '{context.command_path} --help'" if context is not None else ""
         message = " ".join(format_message().split()).rstrip(".")
+        # a choice typer checks through pydantic keeps pydantic's "Value error, " before
+        # the words that matter ("'some' is not one of 'none', 'end', 'every'")
+        message = message.replace(": Value error, ", ": ", 1)
         print(f"error: {message}{hint}", file=sys.stderr)
         sys.exit(getattr(exc, "exit_code", EXIT_INPUT_ERROR))
     sys.exit(code if isinstance(code, int) else 0)
