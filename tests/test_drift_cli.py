@@ -141,6 +141,19 @@ def test_more_sensors_than_the_data_hold_is_bad_input(machine, tmp_path):
     assert result.exit_code == 0, result.output
 
 
+def test_a_sensor_listed_twice_is_fitted_once(machine, tmp_path):
+    # --sensors A_C,A_C,B_C fitted on three columns, two of them the same sensor (and said
+    # "sensors: A_C, A_C, B_C"); --target and --methods already take each name once
+    from twin.drift.modelfile import load_drift_model
+
+    _, data, _ = machine
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(out), "--sensors",
+                 "A_C, A_C,B_C", "--method", "mlr", "--quiet")
+    assert result.exit_code == 0, result.output
+    assert load_drift_model(out).spec.sensors == ("A_C", "B_C")
+
+
 def test_drift_group_is_listed_with_its_commands():
     result = CliRunner().invoke(app, ["--help"])
     assert result.exit_code == 0 and "drift" in result.output

@@ -76,7 +76,7 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
                 f"form {len(best)} correlation clusters: give at most {len(best)}, or 'all' "
                 "for every column", column="--sensors")
         return best[:k]
-    names = [n.strip() for n in text.split(",") if n.strip()]
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))  # once each
     unknown = [n for n in names if n not in available]
     if unknown or not names:
         raise InputError(f"unknown temperature columns {unknown}; the data hold "
