@@ -421,3 +421,24 @@ def test_version_prints_the_installed_package_version():
     assert result.exit_code == 0 and result.output.startswith("twin ")
     result = CliRunner().invoke(app, ["simulate", "--help"])
     assert result.exit_code == 0 and "Open-loop transient" in result.output
+
+
+@pytest.mark.parametrize("argv", [
+    ["replay", "RUN", "--methods", "open_loop,estimator", "--snapshots", "none", "--out", "OUT"],
+    ["snapshot", "RUN", "--time", "60", "--method", "ratio", "--out", "S.png"],
+])
+def test_a_model_given_is_checked_whatever_the_methods(argv, tmp_path, monkeypatch):
+    # without bpnn a mistyped --model was silently ignored: the user believed it was used
+    from twin.cli.inputs import bundled_runs_dir
+
+    run = str(bundled_runs_dir().resolve() / "spindle_9000rpm_30min.csv")
+    argv = [run if a == "RUN" else a for a in argv]
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, [*argv, "--model", "modle.safetensors"])
+    assert result.exit_code == 2, result.output
+    assert "modle.safetensors, column '--model': model file not found" in result.output
+    (tmp_path / "notes.safetensors").write_text("not a model")
+    result = CliRunner().invoke(app, [*argv, "--model", "notes.safetensors"])
+    assert result.exit_code == 2, result.output
+    assert "notes.safetensors: not a readable safetensors model file" in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.safetensors"]

@@ -158,9 +158,11 @@ def between(low: float, high: float = math.inf) -> Callable[[float], float]:
 
 def checked_model(methods: list[str], model: Path | None) -> str | None:
     """The model file the methods need (the bundled one by default), loaded once to check
-    it: a bad model is bad input for every run, so it fails before any work starts."""
-    if "bpnn" not in methods:
-        return str(model) if model else None
+    it: a bad model is bad input for every run, so it fails before any work starts.  A
+    model given is checked whether or not a method uses it: a mistyped --model passed with
+    methods that need none was ignored without a word."""
+    if "bpnn" not in methods and model is None:
+        return None
     model = model or bundled_model()
     if model is None:
         raise InputError(
