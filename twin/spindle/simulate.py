@@ -29,7 +29,12 @@ import numpy as np
 
 from twin.contract import SENSOR_NAMES, STEP_S
 from twin.errors import InputError
-from twin.spindle.conditions import BoundaryConditions, check_operating_point, nominal_conditions
+from twin.spindle.conditions import (
+    BoundaryConditions,
+    bearing_values,
+    check_operating_point,
+    nominal_conditions,
+)
 from twin.spindle.model import SpindleModel
 
 
@@ -114,16 +119,15 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     conditions: list[BoundaryConditions] = []
     coolant = ambient_C if coolant_C is None else coolant_C
 
+    cold = nominal_conditions(spec, speed_rpm, ambient_C, coolant)  # the start, at ambient
     k = 0
     while k < n:
         if not conditions or update_every_s is not None:
             s = sensors[k]
-            hot = bool(conditions)  # the first step starts cold, at ambient
-            bc = nominal_conditions(
-                spec, speed_rpm, ambient_C, coolant,
-                T_bearings_C=(s[0], s[2]) if hot else None,
-                T_sleeves_C=(s[1], s[3]) if hot else None,
-            )
+            # only the bearing values follow the rings: films and motor loss depend on the
+            # speed and the ambient alone (and sharing them keeps a day's updates small)
+            bc = cold.with_values(**bearing_values(spec, speed_rpm, (s[0], s[2]),
+                                                   (s[1], s[3]))) if conditions else cold
             conditions.append(bc)
             loads = bc.to_thermal_loads()
             stepper = thermal.transient(loads, dt=dt, theta=1.0)
