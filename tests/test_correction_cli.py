@@ -185,3 +185,16 @@ def test_runs_too_short_or_stopped_to_train_on_exit_2_saying_so(tmp_path, monkey
         assert result.exit_code == 2, result.output
         assert "too few" in result.output and "longer runs" in result.output
         assert result.output.count("\n") == 1 and not out.exists()
+
+
+def test_a_gate_run_that_is_also_a_training_run_is_refused(runs, tmp_path, monkeypatch):
+    # the gate is to replay runs never trained on: the same file given as a training run
+    # (here through its folder) and as --gate-runs trained on it and gated on it, silently
+    monkeypatch.setattr(training, "training_simulator", lambda *a, **k: pytest.fail("ran"))
+    out = tmp_path / "m.safetensors"
+    result = _invoke(["train", str(runs[0].parent), "--out", str(out),
+                      "--gate-runs", str(runs[1]), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert str(runs[1]) in result.output and "--gate-runs" in result.output
+    assert "trained on" in result.output and len(result.output.strip().splitlines()) == 1
+    assert not out.exists()

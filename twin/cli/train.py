@@ -58,6 +58,12 @@ def train(
 
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
     check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
+    trained = {path.resolve() for path in runs}
+    for path in gate_runs:  # the gate measures the networks on runs they never saw
+        if path.resolve() in trained:
+            raise InputError("is also a training run; the gate replays runs never trained "
+                             "on: leave it out of the RUN list or of --gate-runs",
+                             file=str(path), column="--gate-runs")
     if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
         raise InputError("the model file must end in .safetensors", file=str(out),
                          column="--out")
