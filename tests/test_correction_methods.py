@@ -147,7 +147,7 @@ class _ConstantCorrection:
         return np.asarray(anchor) * 1.2
 
 
-def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_sleeve():
+def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_is_read_through_its_sleeve():
     from twin.correction.methods import ANCHOR_LAW, ratio_anchor
 
     t, T = _measured()
@@ -163,21 +163,50 @@ def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_falls_back_on_its_
     assert f.dead_rings() == ("rear",)
     anchor = ratio_anchor(f, np.full(4, 1.05))
     # the ratio law alone has no T3 and holds the rear heat factor; the anchor reads the
-    # sleeve instead, which the twin overshoots: the rear heat comes down
+    # ring as the twin's ring off by as much as its sleeve is (0.4 K hot): the heat comes
+    # down, and the resistance, which no drop tells, is held
     ratio = np.array(RatioCorrection().correct(f).values)
     assert ratio[1] / nominal[1] == pytest.approx(1.05, rel=1e-12)
     assert anchor[1] / nominal[1] < 1.0
-    on_sleeve = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto][:, [0, 1, 3, 3, 4]],
-                               t[upto], sim[upto][:, [0, 1, 3, 3, 4]], nominal, previous,
-                               previous_factors=(1.05, 1.05, 1.05, 1.05))
-    assert anchor == pytest.approx(np.array(ANCHOR_LAW.correct(on_sleeve).values), rel=1e-12)
+    assert anchor[3] / nominal[3] == pytest.approx(1.05, rel=1e-12)
+    stand_in = T[upto].copy()
+    stand_in[:, 2] = T[upto][:, 3] + 0.5  # the measured sleeve plus the twin's drop
+    read = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], stand_in, t[upto], sim[upto],
+                          nominal, previous, previous_factors=(1.05, 1.05, 1.05, 1.05))
+    assert anchor[:3] == pytest.approx(np.array(ANCHOR_LAW.correct(read).values)[:3],
+                                       rel=1e-12)
     # the networks correct the anchor (× 1.2 here) where their inputs exist; the rear
-    # bearing's networks never saw a sleeve for a ring, the anchor stands there
+    # bearing's networks never saw a stand-in for a ring, the anchor stands there
     method = make_corrector("bpnn", model=_ConstantCorrection())
     method.anchor_factors = np.full(4, 1.05)
     values = np.array(method.correct(f).values)
     assert values[[0, 2]] == pytest.approx(1.2 * anchor[[0, 2]], rel=1e-12)
     assert values[[1, 3]] == pytest.approx(anchor[[1, 3]], rel=1e-12)
+
+
+@pytest.mark.parametrize("twin_offset_C", [-0.3, 0.3])
+def test_a_dead_rings_sleeve_below_ambient_moves_the_heat_towards_the_measurement(
+        twin_offset_C):
+    """A front sleeve on a cooling jacket 1.5 K below ambient, T1 dead.  The twin's sleeve
+    colder than the measured one asks for more heat, warmer for less, whichever side of
+    ambient the sleeve is on.  Read as the ring over ambient, (−1.5)/(−1.8) = 0.83 cut the
+    heat of a twin already too cold (and that cooled it further, to the guard)."""
+    from twin.correction.methods import ratio_anchor
+
+    t = np.arange(0.0, 601.0, 2.0)
+    T = np.column_stack([np.full_like(t, np.nan), np.full_like(t, AMBIENT - 1.5),
+                         np.full_like(t, AMBIENT + 8.0), np.full_like(t, AMBIENT + 5.0),
+                         np.full_like(t, AMBIENT + 1.0)])
+    sim = T.copy()
+    sim[:, 0] = AMBIENT + 2.0  # the twin's front ring, 3.5 K over its sleeve
+    sim[:, 1] += twin_offset_C
+    nominal = _nominal()
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, t, sim, nominal, nominal)
+    assert f.dead_rings() == ("front",)
+    factors = ratio_anchor(f, np.ones(4)) / np.array(nominal)
+    # Eq. 2 on the stand-in: (2.0 − offset) / 2.0, the rest of the twin matches: neutral
+    assert factors[0] == pytest.approx(1.0 - twin_offset_C / 2.0, rel=1e-9)
+    assert factors[1:] == pytest.approx([1.0, 1.0, 1.0], rel=1e-9)
 
 
 def test_speed_change_carries_the_factor():

@@ -249,7 +249,8 @@ class WindowFeatures:
         and the twin's T4 needed 15 min to come back (suite 555 run 4).  The drop ratio
         (Eq. 6) compared the stale sleeve with the twin's moving one as well.  Without the
         column every factor it enters is neutral: the resistance is held until the sleeve
-        reads again (a dead ring is then read on its sleeve, `with_sleeve_for_dead_rings`).
+        reads again (a dead ring is then read through its sleeve,
+        `with_dead_rings_read_through_sleeves`).
         """
         seen = self.seen_in_last_window()
         if seen.all():
@@ -258,23 +259,44 @@ class WindowFeatures:
         measured[:, ~seen] = np.nan
         return dataclasses.replace(self, measured_C=measured)
 
-    def with_sleeve_for_dead_rings(self) -> WindowFeatures:
-        """These features with the ring column (measured and simulated) of each of
-        `dead_rings` replaced by its sleeve's.
+    def with_dead_rings_read_through_sleeves(self) -> WindowFeatures:
+        """These features with the measured ring column of each of `dead_rings` replaced
+        by a stand-in read through its sleeve: the measured sleeve plus the twin's own
+        ring-to-sleeve drop at the same times, i.e. the twin's ring off the measurement by
+        as much as the twin's sleeve is.  The simulated columns are left as they are.
 
-        The sleeve sits next to the ring and sees the same bearing heat a little damped, so
-        a heat correction keeps working on it; the ring-to-sleeve drop is then 0 in both,
-        which the ratio law's drop guard reads as "no information" (the resistance is held).
+        Eq. 2 then reads (t_f,ring + e_sleeve − t_amb)/(t_f,ring − t_amb), e_sleeve the
+        sleeve's measured-minus-simulated level: the sleeve's error over the twin's ring
+        rise.  For a heat error the ring's error is the sleeve's plus the drop's (which
+        moves with the heat too), so this step never overshoots, and its sign is the
+        sleeve error's on whichever side of ambient the sleeve sits.  The drop of the
+        stand-in is the twin's own and carries nothing about the contact: the anchor holds
+        a dead ring's resistance (`twin.correction.methods.ratio_anchor`).
+
+        Why not the sleeve itself in Eq. 2, (t_m,sleeve − t_amb)/(t_f,sleeve − t_amb), as
+        until 2026-11-27: a sleeve on the cooling jacket sits near the coolant, not far
+        above ambient, so its rise over ambient is not proportional to the bearing heat.
+        With the coolant below ambient both rises were negative and the ratio inverted: a
+        twin sleeve colder than the measured one cut the heat, which cooled it further,
+        down to the guard's 0.2× nominal (suite 550055 run 8, T1 stuck, coolant 1.8 K
+        below ambient: T2 1.68 K RMS off against 0.21 K for the ratio law, which holds
+        the heat).  Near ambient the rise was below the guard's floor and the heat stayed
+        where the first window's lagging sleeve had put it.  The rear sleeve, 5–10 K over
+        ambient, read well that way and reads a little slower now.
         """
         dead = self.dead_rings()
         if not dead:
             return self
-        measured, simulated = self.measured_C.copy(), self.simulated_C.copy()
+        measured = self.measured_C.copy()
         for bearing in dead:
             ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
-            measured[:, ring] = measured[:, sleeve]
-            simulated[:, ring] = simulated[:, sleeve]
-        return dataclasses.replace(self, measured_C=measured, simulated_C=simulated)
+            if len(self.simulated_time_s) == 0:
+                measured[:, ring] = np.nan  # no twin yet to read the sleeve against
+                continue
+            drop = np.interp(self.measured_time_s, self.simulated_time_s,
+                             self.simulated_C[:, ring] - self.simulated_C[:, sleeve])
+            measured[:, ring] = measured[:, sleeve] + drop
+        return dataclasses.replace(self, measured_C=measured)
 
     def anchored_inputs(self, anchor: ArrayLike) -> dict[str, np.ndarray]:
         """The (1, 6) input row of each anchored network (ANCHORED_INPUT_NAMES) for this

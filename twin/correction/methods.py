@@ -250,8 +250,9 @@ def ratio_anchor(features: WindowFeatures, anchor_factors: ArrayLike) -> np.ndar
     """The value the anchored networks correct, in BoundaryValues order: the ratio law
     (`ANCHOR_LAW`) applied to the previous *anchor* — `anchor_factors`, its factors
     on the previous nominal values (ones at window 0) — not to the corrected values, with a
-    dead ring sensor's place taken by its sleeve (`WindowFeatures.with_sleeve_for_dead_rings`)
-    and no sensor read on its last value from before it died
+    dead ring sensor read through its sleeve
+    (`WindowFeatures.with_dead_rings_read_through_sleeves`) and its resistance held, and no
+    sensor read on its last value from before it died
     (`WindowFeatures.without_dead_sensors`: a resistance is held while its sleeve is dead).
 
     Why its own chain: the ratio law is an integral action on the key-point error.  Chained
@@ -262,12 +263,20 @@ def ratio_anchor(features: WindowFeatures, anchor_factors: ArrayLike) -> np.ndar
     With a network output of 0 the two chains coincide: the ratio law exactly.
 
     Why the sleeve: with T3 stuck the ratio law has nothing to correct the rear heat by and
-    holds it; the twin's T4 then ran 1.8 K off on a suite run, on the sleeve 0.2 K.
+    holds it; the twin's T4 then ran 1.8 K off on a suite run, on the sleeve 0.2 K.  Why
+    the resistance is held: without the ring there is no ring-to-sleeve drop to read it
+    by (the stand-in's drop is the twin's own).
     """
-    f = features.without_dead_sensors().with_sleeve_for_dead_rings()
+    f = features.without_dead_sensors()
+    dead = f.dead_rings()
     factors = tuple(float(a) for a in np.asarray(anchor_factors, dtype=float))
-    f = dataclasses.replace(f, previous_factors=factors)
-    return np.asarray(ANCHOR_LAW.correct(f).values, dtype=float)
+    f = dataclasses.replace(f.with_dead_rings_read_through_sleeves(), previous_factors=factors)
+    values = np.asarray(ANCHOR_LAW.correct(f).values, dtype=float)
+    held = limit_to_nominal(f.carried_previous(), f.nominal, ANCHOR_LAW.guards)
+    for k, bearing in enumerate(BEARINGS):
+        if bearing in dead:
+            values[2 + k] = held[2 + k]
+    return values
 
 
 @dataclass
