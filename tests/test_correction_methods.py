@@ -169,12 +169,22 @@ def test_anchored_bpnn_corrects_the_ratio_law_and_a_dead_ring_is_read_through_it
     assert ratio[1] / nominal[1] == pytest.approx(1.05, rel=1e-12)
     assert anchor[1] / nominal[1] < 1.0
     assert anchor[3] / nominal[3] == pytest.approx(1.05, rel=1e-12)
+    # the stand-in: the twin's ring off by the sleeve's error (−0.4 K) over the sleeve's
+    # rise, which here is most of the ring's (the rear sleeve, well over ambient)
+    now = sim[upto][-1]
+    ring_rise, sleeve_rise = now[2] - AMBIENT, now[3] - AMBIENT
+    assert sleeve_rise > 0.5 * ring_rise
     stand_in = T[upto].copy()
-    stand_in[:, 2] = T[upto][:, 3] + 0.5  # the measured sleeve plus the twin's drop
+    stand_in[:, 2] = sim[upto][:, 2] + ring_rise / sleeve_rise * (T[upto][:, 3] - sim[upto][:, 3])
     read = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], stand_in, t[upto], sim[upto],
                           nominal, previous, previous_factors=(1.05, 1.05, 1.05, 1.05))
     assert anchor[:3] == pytest.approx(np.array(ANCHOR_LAW.correct(read).values)[:3],
                                        rel=1e-12)
+    # which is Eq. 2 on the sleeve itself, as the anchor read it before 2026-11-27
+    on_sleeve = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T[upto][:, [0, 1, 3, 3, 4]],
+                               t[upto], sim[upto][:, [0, 1, 3, 3, 4]], nominal, previous,
+                               previous_factors=(1.05, 1.05, 1.05, 1.05))
+    assert anchor[1] == pytest.approx(ANCHOR_LAW.correct(on_sleeve).values[1], rel=1e-3)
     # the networks correct the anchor (× 1.2 here) where their inputs exist; the rear
     # bearing's networks never saw a stand-in for a ring, the anchor stands there
     method = make_corrector("bpnn", model=_ConstantCorrection())
@@ -204,9 +214,19 @@ def test_a_dead_rings_sleeve_below_ambient_moves_the_heat_towards_the_measuremen
     f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, t, sim, nominal, nominal)
     assert f.dead_rings() == ("front",)
     factors = ratio_anchor(f, np.ones(4)) / np.array(nominal)
-    # Eq. 2 on the stand-in: (2.0 − offset) / 2.0, the rest of the twin matches: neutral
-    assert factors[0] == pytest.approx(1.0 - twin_offset_C / 2.0, rel=1e-9)
+    # Eq. 2 on the stand-in: 1 − offset / (half the ring's 2 K rise); the rest of the twin
+    # matches the measurement: neutral
+    assert factors[0] == pytest.approx(1.0 - twin_offset_C / 1.0, rel=1e-9)
     assert factors[1:] == pytest.approx([1.0, 1.0, 1.0], rel=1e-9)
+    # a twin ring at ambient has no rise to scale the error by: the heat is held
+    sim[:, 0] = AMBIENT
+    held = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, t, sim, nominal, nominal)
+    assert ratio_anchor(held, np.ones(4)) / np.array(nominal) == pytest.approx(np.ones(4))
+    # window 0 before the twin has a sample: nothing to read, the nominal values
+    first = WindowFeatures(0, 0.0, SPEED, AMBIENT, t[:1], T[:1], np.zeros(0), np.zeros((0, 5)),
+                           nominal, nominal)
+    assert first.dead_rings() == ("front",)
+    assert ratio_anchor(first, np.ones(4)) == pytest.approx(np.array(nominal))
 
 
 def test_speed_change_carries_the_factor():
