@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "2dbb8d32b0eb5a034ed2b2940b30591d7ad13c9ad8d4331bf4e10398673959cb"
+BUNDLED_MODEL_SHA256 = "8f31842f1bf31b2a23970c50962d5ccfdc3666a3726bbf1bdbc4942b262e217b"
 
 
 def _make_model():
