@@ -246,8 +246,8 @@ def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     # R² printed to 16 digits, and nothing said that the gate had zeroed every network
     result = CliRunner().invoke(app, ["model-info", str(_bundled_model())])
     assert result.exit_code == 0, result.output
-    assert "heat_front" in result.output and "R² 0.15" in result.output
-    assert "R² 0.149" not in result.output
+    assert "resistance_front" in result.output and "R² 0.18" in result.output
+    assert "R² 0.178" not in result.output
     assert "networks kept by the closed-loop gate: none (bpnn gives the anchor)" in result.output
     assert "anchor 99.37 %" in result.output
 
