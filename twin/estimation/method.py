@@ -245,7 +245,7 @@ from twin.estimation.parameters import (
     parameters,
 )
 from twin.lag import first_order_lag
-from twin.spindle.conditions import BoundaryConditions, bearing_values
+from twin.spindle.conditions import BoundaryConditions, bearing_values_at
 
 HEAT_FACTORS = frozenset({"H_front", "H_rear", "motor"})
 """The factors on heat that a stopped spindle does not generate."""
@@ -670,9 +670,8 @@ class EnsembleEstimator:
         at the temperatures of `field_C` (the analysed field the window starts from, not the
         loop's last forecast: after a missed speed change they differ by kelvins, and the
         Palmgren heat with them)."""
-        T = self._sensors @ field_C
-        return bc.with_values(**bearing_values(self.model, bc.speed_rpm, (T[0], T[2]),
-                                               (T[1], T[3])))
+        return bc.with_values(**bearing_values_at(self.model, bc.speed_rpm,
+                                                  self._sensors @ field_C))
 
     def _rerun(self, f: WindowFeatures, fc: WindowForecast, start: WindowStart
                ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:

@@ -21,7 +21,7 @@ temperature (a chiller tracking the room).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from twin.errors import InputError
@@ -250,6 +250,16 @@ def bearing_values(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or Sp
     out = {f"H_{s}": bearing_heat_density(spec, s, speed_rpm, T_b[s]) for s in SIDES}
     out.update({f"R_{s}": contact_resistance(spec, s, T_b[s], T_s[s]) for s in SIDES})
     return out
+
+
+def bearing_values_at(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or SpindleSpec
+                      sensors_C: Sequence[float]) -> dict[str, float]:
+    """`bearing_values` at a spindle's own readings T1..T4 (SENSOR_NAMES order: T1 front
+    outer ring, T2 its sleeve, T3 rear outer ring, T4 its sleeve): the nominal bearing heat
+    and contact resistance as they follow the rings, re-evaluated every solver step by the
+    open-loop run (`twin.spindle.simulate`) and the emulated spindle (`twin.plant`)."""
+    return bearing_values(model, speed_rpm, (float(sensors_C[0]), float(sensors_C[2])),
+                          (float(sensors_C[1]), float(sensors_C[3])))
 
 
 def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN001

@@ -31,7 +31,7 @@ from twin.contract import SENSOR_NAMES, STEP_S
 from twin.errors import InputError
 from twin.spindle.conditions import (
     BoundaryConditions,
-    bearing_values,
+    bearing_values_at,
     check_operating_point,
     nominal_conditions,
 )
@@ -123,11 +123,10 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     k = 0
     while k < n:
         if not conditions or update_every_s is not None:
-            s = sensors[k]
             # only the bearing values follow the rings: films and motor loss depend on the
             # speed and the ambient alone (and sharing them keeps a day's updates small)
-            bc = cold.with_values(**bearing_values(spec, speed_rpm, (s[0], s[2]),
-                                                   (s[1], s[3]))) if conditions else cold
+            bc = cold.with_values(**bearing_values_at(spec, speed_rpm, sensors[k])
+                                  ) if conditions else cold
             conditions.append(bc)
             loads = bc.to_thermal_loads()
             stepper = thermal.transient(loads, dt=dt, theta=1.0)
