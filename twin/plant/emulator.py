@@ -12,9 +12,12 @@ film-group factors, scaled material conductivity and expansion, thermocouples a 
 off their nominal points.  A stop (speed 0) has no bearing or motor heat and the
 standstill film coefficients; the truth simply cools down.
 
-The nominal loads themselves follow the truth's own state as in the twin
-(`nominal_conditions` with the ring and sleeve temperatures: oil viscosity, Eq. 5 fit),
-re-evaluated every `UPDATE_S`.  The sensors then add thermocouple lag, noise and faults.
+The nominal bearing heat and contact resistance follow the truth's own ring and sleeve
+temperatures (oil viscosity, Eq. 5 fit) every 2 s step, as a real spindle's do
+continuously: held over 20 s from the cold start (oil at ambient, too much heat), they
+dropped T1 by up to 0.23 K per second after 20 s at 15 000 rpm.  The drifting ambient and
+coolant and the motor and film factors are held over `UPDATE_S`.  The sensors then add
+thermocouple lag, noise and faults.
 
 Displacement probes are zeroed at the start of the run (as on a test stand), so
 `disp_z_um` is the thermal drift of the nose from the cold start.
@@ -50,7 +53,8 @@ from twin.plant.truth import (
 DT_S = 2.0
 """Truth time step, s (the twin uses 4 s)."""
 UPDATE_S = 20.0
-"""The truth's loads are re-evaluated this often, s (the twin corrects every 60 s)."""
+"""The truth's ambient, coolant, motor and film factors are held this long, s; its bearing
+heat and contact resistance follow its rings every step (`run_truth`)."""
 
 
 
@@ -113,14 +117,20 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
               dt: float = DT_S, update_s: float = UPDATE_S) -> TruthRun:
     """Backward-Euler transient of the truth from a uniform start at the ambient.
 
-    Loads are held over update intervals that also break at every speed change.
+    Every step takes the bearing heat and contact resistance at the truth's own ring and
+    sleeve temperatures at its start (`bearing_values_at`: Palmgren with the oil at the
+    ring, Eq. 4/5 with the fit) times the truth factors at its start, as a real spindle's
+    follow its rings, continuously.  The rest (ambient and coolant inlet at the interval's
+    mean, motor and film-group factors) is held over intervals of `update_s` that also
+    break at every speed change: a new set of film coefficients costs a factorization.
     """
     from twin.spindle import nominal_conditions
+    from twin.spindle.conditions import bearing_values_at
 
     n = int(math.ceil(duration_s / dt - 1e-9))
     t = np.arange(n + 1) * dt
     steps_per_update = max(1, int(round(update_s / dt)))
-    # a load update at every regular interval and at the first step after a speed change
+    # an interval at every regular update and at the first step after a speed change
     starts = set(range(0, n, steps_per_update))
     starts.update(int(math.ceil(c / dt - 1e-9)) for c in speed.changes_in(0.0, duration_s))
     starts = sorted(s for s in starts if s < n)
@@ -140,41 +150,40 @@ def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  
     loads_log = {k: np.empty(n + 1) for k in names}
     heat_in, residual = np.empty(n), np.empty(n)
     films_at_speed: dict[float, dict[str, float]] = {}
+    bearing_tables = {"H_front": tables.H_front, "H_rear": tables.H_rear,
+                      "R_front": tables.R_front, "R_rear": tables.R_rear}
     for a, b in zip(starts, [*starts[1:], n], strict=True):
         mid = 0.5 * (t[a] + t[b])  # drifting temperatures: the interval's mean value
-        s = sensors[a]
-        bc = nominal_conditions(model, float(speed(t[a])), float(tables.ambient_C(mid)),
-                                float(tables.coolant_C(mid)),
-                                T_bearings_C=(s[0], s[2]) if a else None,
-                                T_sleeves_C=(s[1], s[3]) if a else None)
+        base = nominal_conditions(model, float(speed(t[a])), float(tables.ambient_C(mid)),
+                                  float(tables.coolant_C(mid)))
         # Film coefficients depend on speed, and on the ambient only through air properties
         # (≪ 1 % per K): hold them per speed so that the drift of the ambient and coolant
         # moves only the bulk temperatures, and the step matrix factorization is reused.
-        h = films_at_speed.setdefault(bc.speed_rpm, {k: v[0] for k, v in bc.convection.items()})
+        h = films_at_speed.setdefault(base.speed_rpm,
+                                      {k: v[0] for k, v in base.convection.items()})
         # model-form error: film groups and motor loss off their correlations/catalogue
-        bc = replace(bc, convection={k: (h[k] * form.film_factor(k, t[a]), v[1])
-                                     for k, v in bc.convection.items()},
-                     motor_heat={r: q * float(form.motor_heat(t[a]))
-                                 for r, q in bc.motor_heat.items()})
-        factors = {"factor_H_front": float(tables.H_front(t[a])),
-                   "factor_H_rear": float(tables.H_rear(t[a])),
-                   "factor_R_front": float(tables.R_front(t[a])),
-                   "factor_R_rear": float(tables.R_rear(t[a])),
-                   "factor_motor": float(form.motor_heat(t[a])),
-                   **{f"factor_film_{g}": float(form.film[g](t[a])) for g in FILM_GROUPS}}
-        true = {"H_front": bc.H_front * factors["factor_H_front"],
-                "H_rear": bc.H_rear * factors["factor_H_rear"],
-                "R_front": bc.R_front * factors["factor_R_front"],
-                "R_rear": bc.R_rear * factors["factor_R_rear"]}
-        loads = bc.to_thermal_loads(**true)
-        row = {"speed_rpm": bc.speed_rpm, "H_front_nominal": bc.H_front,
-               "H_rear_nominal": bc.H_rear, "R_front_nominal": bc.R_front,
-               "R_rear_nominal": bc.R_rear, **true, "coolant_C": bc.coolant_C,
-               "ambient_C": bc.ambient_C, **factors}
-        for k, v in row.items():
-            loads_log[k][a:b] = v
-        stepper = thermal.transient(loads, dt=dt, theta=1.0)
-        for k, T_new in enumerate(stepper.march(T, b - a), start=a):
+        base = replace(base, convection={k: (h[k] * form.film_factor(k, t[a]), v[1])
+                                         for k, v in base.convection.items()},
+                       motor_heat={r: q * float(form.motor_heat(t[a]))
+                                   for r, q in base.motor_heat.items()})
+        held = {"speed_rpm": base.speed_rpm, "coolant_C": base.coolant_C,
+                "ambient_C": base.ambient_C, "factor_motor": float(form.motor_heat(t[a])),
+                **{f"factor_film_{g}": float(form.film[g](t[a])) for g in FILM_GROUPS}}
+        for key, v in held.items():
+            loads_log[key][a:b] = v
+        for k in range(a, b):
+            # the bearing values follow the rings every step (Palmgren's oil viscosity,
+            # the fit of Eq. 5), each times its truth factor at the step's start
+            nominal = bearing_values_at(model, base.speed_rpm, sensors[k])
+            for key, v in nominal.items():
+                factor = float(bearing_tables[key](t[k]))
+                loads_log[f"{key}_nominal"][k] = v
+                loads_log[f"factor_{key}"][k] = factor
+                loads_log[key][k] = v * factor
+            stepper = thermal.transient(
+                base.to_thermal_loads(**{key: loads_log[key][k] for key in nominal}),
+                dt=dt, theta=1.0)
+            T_new = stepper.step(T)
             eb = stepper.energy_balance(T, T_new)
             heat_in[k], residual[k] = eb["heat_in_W"], eb["residual_W"]
             T = T_new
@@ -266,7 +275,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
                          truth.time_s.size - 1)
     truth_cols = {"time_s": t_out}
     for k, v in truth.loads.items():
-        truth_cols[k] = v[step_index]  # held over each update interval
+        truth_cols[k] = v[step_index]  # the values of the truth step the sample falls in
     for j, s in enumerate(SENSOR_NAMES):
         truth_cols[f"{s}_true_C"] = np.interp(t_out, truth.time_s, truth.sensors_C[:, j])
     truth_cols.update(disp_z_true_um=disp_z, disp_x_true_um=x_true, disp_y_true_um=y_true)
