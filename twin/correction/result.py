@@ -49,7 +49,7 @@ class Correction:
     """The thermocouples' time constant, s (a method that estimates it; 0: not estimated)."""
     loads_follow_rings: bool = False
     """The window's bearing heat and contact resistance follow the twin's own ring and
-    sleeve temperatures every 20 s (`twin.correction.rerun.LOAD_UPDATE_STEPS`), as the
+    sleeve temperatures every solver step (`twin.correction.rerun.LOAD_UPDATE_STEPS`), as the
     spindle's do: the values above are then factors on the nominal values at the window's
     start field, re-applied to the nominal values at each piece's start.  False: held for
     the whole window (the paper's methods: every 60 s the boundary conditions are set)."""

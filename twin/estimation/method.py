@@ -74,9 +74,10 @@ The filter (Evensen 2009; REFERENCE.md §7)
     Palmgren heat falls by a fifth with the oil's viscosity, which the forecast held at
     its cold value for 60 s; the first analysis read that as bearing heat 15–25 % low and
     the second window started 1–2 K cold (suite 112233 run 8).  A re-run re-evaluates the
-    nominal bearing heat and contact resistance every 20 s at its own temperatures, as the
-    spindle's follow its rings.  Measured on suites 8888, 7777, 909, 112233 (used to
-    design it) and 2024, 60606, 31415, 271828, 5150, 60221 (not): mean temperature
+    nominal bearing heat and contact resistance every solver step at its own temperatures,
+    as the spindle's follow its rings (every 20 s in the measurements that follow).
+    Measured on suites 8888, 7777, 909, 112233 (used to design it) and 2024, 60606,
+    31415, 271828, 5150, 60221 (not): mean temperature
     accuracy +0.004 to +0.022 points on every suite, mean deformation +0.004 to +0.08;
     re-running every window this way measured the same at three factorizations per
     window.  After the analysis the loop's nominal bearing heat and contact resistance
@@ -86,13 +87,14 @@ The filter (Evensen 2009; REFERENCE.md §7)
     capped at the prior, mean clipped to the bounds; (3) forecast of the next window
     (`forecast`): the mean by the FEM with the mean factors, members tangent-linear on one
     factorization, stepping 20 s.  The mean's nominal bearing heat and contact resistance
-    follow its own ring and sleeve temperatures every 20 s (`loads_follow_rings`, three
-    pieces per window, as a re-run takes them), the factors held: the factors are the
-    correction, the nominal values' dependence on temperature is physics the spindle obeys
-    within the minute too.  Held for 60 s instead, the first window at a new speed ran up
-    to 3.8 K warm at the front ring after a step from 3100 to 13 400 rpm on a window
-    boundary, as the cold rings' Palmgren heat was kept while they warmed, and the next
-    analysis read that as too much bearing heat (the window after ran 1.1 K cold).
+    follow its own ring and sleeve temperatures every 4 s solver step (`loads_follow_rings`,
+    `twin.correction.rerun.LOAD_UPDATE_STEPS`, as a re-run takes them), the factors held:
+    the factors are the correction, the nominal values' dependence on temperature is
+    physics the spindle obeys within the minute too.  Held for 60 s instead, the first
+    window at a new speed ran up to 3.8 K warm at the front ring after a step from 3100
+    to 13 400 rpm on a window boundary, as the cold rings' Palmgren heat was kept while
+    they warmed, and the next analysis read that as too much bearing heat (the window
+    after ran 1.1 K cold).
     Multiplicative inflation (default 1.2) guards against
     collapse; the bounded log-space priors against drift.  1.2 rather than 1.05 because the
     model-form error keeps the members too sure of the drift after starts, steps and stops
@@ -131,7 +133,7 @@ Causality
 Deck, analysed state and members
     The window deck `decks/window_kkk.inp` carries the mean's loads (bearing heat and contact
     resistance in their usual commands, motor and film factors already applied to the
-    rotor/stator heat and the film coefficients), as three 20 s load steps whose bearing
+    rotor/stator heat and the film coefficients), as 15 load steps of 4 s whose bearing
     heat and contact resistance the loop took at the twin's temperatures at each one's
     start (`twin.loop.replay`, `Correction.loads_follow_rings`).  It runs from the
     analysed mean field at
@@ -324,7 +326,7 @@ class EstimatorConfig:
     the rings the forecast already is that re-run."""
     loads_follow_rings: bool = True
     """The window's nominal bearing heat and contact resistance follow the twin's ring and
-    sleeve temperatures every 20 s (module doc); False: held at the window start."""
+    sleeve temperatures every solver step (module doc); False: held at the window start."""
     analysis_iterations: int = 3
     """Gauss–Newton iterations of the analysis of a run's first `iterated_windows` windows
     (1: the plain ETKF everywhere; module doc, "Iterated first analysis")."""
@@ -677,7 +679,7 @@ class EnsembleEstimator:
                ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
         """The window just ended re-run from its start field, each solver step at the speed
         recorded at its midpoint, with the nominal bearing heat and contact resistance
-        re-evaluated every 20 s at the re-run's own ring and sleeve temperatures, as the
+        re-evaluated every solver step at the re-run's own ring and sleeve temperatures, as the
         spindle's follow them (`twin.correction.rerun`): this window's nominal conditions
         at the current speed, nominal conditions for any other speed (a step up and a stop
         inside one window), all with the same factors (`start`'s).  Returns T1..T5 history

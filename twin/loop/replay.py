@@ -11,7 +11,7 @@ window starts:
       → T1..T5 and the nose drift per step (probes), fields at the window end
 
 A correction with `loads_follow_rings` (the estimator's) gives its values as factors on
-the nominal values at the window's start field: the deck is then three load steps of 20 s,
+the nominal values at the window's start field: the deck is then 15 load steps of 4 s,
 each with the nominal bearing heat and contact resistance at the twin's own ring and sleeve
 temperatures at its start times those factors (`_follow_rings`, the same pieces as a
 re-run below).  The others' values hold for the whole window, as the paper sets them.
@@ -24,7 +24,7 @@ Re-run of a missed speed change (methods with `rerun_missed_speed`: `bpnn`; the 
 `ratio` and `open_loop` keep the forecast, the `estimator` re-runs inside its own
 analysis).  When the recorded speed changed inside window k−1, after its loads were
 fixed, that window is re-run from its start field with the recorded speed
-(`twin.correction.rerun`: per speed, in pieces of 20 s, each with the nominal loads at
+(`twin.correction.rerun`: per speed, step by step, each with the nominal loads at
 its own temperatures times the window's correction factors, as the spindle's loads follow
 its rings) before window k's correction; all of it was measured before 60k s.  So is
 window 0 of a run, whose loads were held at the cold start's temperatures for 60 s while
