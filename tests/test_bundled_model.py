@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "8f31842f1bf31b2a23970c50962d5ccfdc3666a3726bbf1bdbc4942b262e217b"
+BUNDLED_MODEL_SHA256 = "abd192f69926bd567a2f32f86b519a5ce11b9073a4524a44d2d58e3fb23906fe"
 
 
 def _make_model():

@@ -244,12 +244,17 @@ def test_an_unreachable_dask_scheduler_is_bad_input_naming_the_option(monkeypatc
 
 def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     # R² printed to 16 digits, and nothing said that the gate had zeroed every network
+    from twin.correction.modelfile import load_model
+
+    meta = load_model(_bundled_model(), option=None).metadata
+    r2 = meta["r2"]["resistance_front"]["value"]
+    anchor = meta["held_out_temperature_accuracy_pct"]["anchor"]
     result = CliRunner().invoke(app, ["model-info", str(_bundled_model())])
     assert result.exit_code == 0, result.output
-    assert "resistance_front" in result.output and "R² 0.18" in result.output
-    assert "R² 0.178" not in result.output
+    line = next(ln for ln in result.output.splitlines() if "resistance_front" in ln)
+    assert f"R² {r2:.2f} " in line and f"R² {r2:.3f}" not in line, line
     assert "networks kept by the closed-loop gate: none (bpnn gives the anchor)" in result.output
-    assert "anchor 99.37 %" in result.output
+    assert f"anchor {anchor:.2f} %" in result.output and f"{anchor:.3f}" not in result.output
 
 
 def test_model_info_names_no_option_it_does_not_have(tmp_path, monkeypatch):
