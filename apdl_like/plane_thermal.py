@@ -31,6 +31,7 @@ step is bisected only when its Picard iteration does not converge.
 from __future__ import annotations
 
 import functools
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -552,8 +553,12 @@ def solve_constrained(A: sp.csr_matrix, rhs: np.ndarray, fixed: tuple[np.ndarray
     if free.any():
         rhs_free = br[free] - Ar[free][:, ~free] @ x[~free]
         try:
-            x[free] = spla.spsolve(Ar[free][:, free].tocsc(), rhs_free)
-        except RuntimeError:
+            # SuperLU reports an exactly singular matrix either way: raise or warn and
+            # return NaN; the warning would reach the user's console before the error
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", spla.MatrixRankWarning)
+                x[free] = spla.spsolve(Ar[free][:, free].tocsc(), rhs_free)
+        except (RuntimeError, spla.MatrixRankWarning):
             x[free] = np.nan  # singular: the caller names what is missing
     return P @ x
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -373,3 +374,17 @@ V(2) = 2.5
 *CFCLOS
 """)
     assert s.state.listing.files["cmds.inp"] == ["D,7,TEMP,5", "NSEL,ALL"]
+
+
+def test_a_singular_thermal_system_is_one_located_error_without_scipy_s_warning():
+    """Found by the mutation fuzz: with nothing holding the temperature (no D,,TEMP and
+    no convection) SuperLU may not raise but warn `MatrixRankWarning` and return NaN; the
+    ApdlError came, but the warning went to the user's console before it."""
+    from scipy.sparse.linalg import MatrixRankWarning
+
+    deck = VALID_DECK.replace("D,ALL,TEMP,20\n", "", 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MatrixRankWarning)
+        with pytest.raises(ApdlError, match=r"fuzz.inp:\d+: SOLVE: the thermal system is "
+                                            r"singular: fix a temperature"):
+            Session().run_text(deck, "fuzz.inp")
