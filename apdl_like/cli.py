@@ -2,6 +2,8 @@
 
     apdl-like run DECK --out DIR       params.json, result_NNN.vtu, log.txt
                   [--spindle]        on the reference spindle (a replay's window decks)
+                  [--start FILE.vtu] from that temperature state (window_kkk_start.vtu,
+                                     result_NNN.vtu): what ANTYPE,,REST continues
     apdl-like export-cdb --out FILE    the default spindle mesh as an ANSYS archive
 
 Bad input (an `ApdlError`, or any `twin.errors.InputError`) prints one line and exits 2;
@@ -45,6 +47,10 @@ def run(
                                  "loaded as the twin loads it (nodes, elements, materials, "
                                  "components, contact real sets 101..): the database a "
                                  "replay's decks/window_kkk.inp run on."),
+    start: Path = typer.Option(None, "--start", help="With --spindle: the temperature state "
+                               "(a replay's decks/window_kkk_start.vtu, or a result_NNN.vtu "
+                               "of an earlier run) at its TIME, which a deck's "
+                               "ANTYPE,TRANS,REST continues from."),
 ) -> None:
     """Run a deck statement by statement, as MAPDL does.
 
@@ -54,9 +60,19 @@ def run(
     from apdl_like.session import Session
 
     regular_file_info(deck, use="read deck")  # a folder, a fifo, nothing there: say which
-    check_out_dir(out, inputs=[deck], owned=["params.json", "log.txt"])
+    if start is not None:
+        if not spindle:
+            raise InputError("--start needs --spindle (a state of the reference spindle's "
+                             "nodes)")
+        regular_file_info(start, use="read start state")
+    check_out_dir(out, inputs=[deck, *([start] if start is not None else [])],
+                  owned=["params.json", "log.txt"])
     session = _spindle_session(deck.parent, strict) if spindle else Session(
         base_dir=deck.parent, strict=strict)
+    if start is not None:
+        from apdl_like.outputs import read_state_vtu
+
+        session.start_from_nodes(*read_state_vtu(start), source=str(start))
     stopped: InputError | None = None
     try:
         session.run_file(deck)

@@ -2,7 +2,13 @@
 
 VTU points are every APDL node at (X, Y, 0) = (r, z, 0) in metres; nodal arrays TEMP (°C),
 U (m, 3 components, U_z = 0) and S (Pa, 6 components XX YY ZZ XY YZ XZ with ZZ the hoop
-stress) plus SEQV; NaN marks nodes outside the elements.  Every file is written atomically.
+stress) plus SEQV; NaN marks nodes outside the elements; the field data TIME holds the load
+step's end time (s).  Every file is written atomically.
+
+A *state file* is the same format with TEMP and TIME only (`write_state_vtu`; a replay's
+`decks/window_kkk_start.vtu`, with the estimator's READINGS_START_C and SENSOR_LAG_S as
+further field data): `read_state_vtu` reads it, or any result_NNN.vtu, as the temperature
+state a restart (ANTYPE,,REST) continues from (`apdl-like run --start`).
 """
 
 from __future__ import annotations
@@ -61,8 +67,51 @@ def write_result_vtu(session: SessionState, result_index: int, path: Path) -> No
         for j, item in enumerate(("SX", "SY", "SZ", "SXY")):
             s[:, j] = nodal[item]
         data.update(U=u, S=s, SEQV=nodal["SEQV"])
-    mesh = meshio.Mesh(points, _cells(session), point_data=data)
+    mesh = meshio.Mesh(points, _cells(session), point_data=data,
+                       field_data={"TIME": np.array([res.time])})
     write_vtu(path, mesh)
+
+
+def write_state_vtu(path: str | Path, points_rz: np.ndarray, triangles: np.ndarray,
+                    temperature_C: np.ndarray, time_s: float,
+                    extra: dict[str, np.ndarray] | None = None) -> Path:
+    """A state file (module doc): points_rz (n, 2) m, triangles (m, 3) 0-based node ids,
+    temperature_C (n,) per node, time_s; `extra` further field data (1-D arrays)."""
+    import meshio
+
+    points = np.column_stack([points_rz, np.zeros(len(points_rz))])
+    field_data = {"TIME": np.array([float(time_s)])}
+    field_data.update({k: np.atleast_1d(np.asarray(v, float)) for k, v in (extra or {}).items()})
+    mesh = meshio.Mesh(points, [("triangle", np.asarray(triangles, dtype=np.int64))],
+                       point_data={"TEMP": np.asarray(temperature_C, float)},
+                       field_data=field_data)
+    return write_vtu(path, mesh, compress=True)
+
+
+def read_state_vtu(path: str | Path) -> tuple[np.ndarray, np.ndarray, float]:
+    """(points (n, 2) m, TEMP (n,) °C, TIME s) of a state or result file; InputError naming
+    the file if it is not one."""
+    import contextlib
+    import io
+
+    from meshio import vtu
+
+    from twin.errors import InputError
+
+    try:  # the format's reader itself: meshio.read prints and exits on a bad file
+        with contextlib.redirect_stdout(io.StringIO()):
+            mesh = vtu.read(str(path))
+    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds on a bad file
+        why = f" ({exc})" if str(exc).strip() else ""
+        raise InputError(f"not a readable .vtu file{why}", file=str(path)) from None
+    temp = mesh.point_data.get("TEMP")
+    if temp is None or np.ndim(temp) != 1:
+        raise InputError("no nodal TEMP array (a state file or an apdl-like result_NNN.vtu "
+                         "is needed)", file=str(path))
+    time = np.ravel(mesh.field_data.get("TIME", []))
+    if time.size != 1 or not np.isfinite(time[0]):
+        raise InputError("no TIME field data (the time of the state, s)", file=str(path))
+    return np.asarray(mesh.points[:, :2], float), np.asarray(temp, float), float(time[0])
 
 
 def result_name(step: int) -> str:

@@ -138,6 +138,29 @@ class Session:
         sol.time = float(time_s)
         sol.fresh_start = False
 
+    def start_from_nodes(self, points_rz: np.ndarray, nodal_C: np.ndarray, time_s: float,
+                         source: str = "<state>") -> None:
+        """Carry a nodal temperature state (one value per APDL node, at the nodes' own
+        (r, z) `points_rz`) in at `time_s`: what ANTYPE,,REST continues from.  ApdlError
+        naming `source` unless it holds a finite value for every node of this model."""
+        from apdl_like.solve import fem_model
+
+        nodes = self.state.db.nodes
+        nodal_C = np.asarray(nodal_C, float)
+        if nodal_C.shape != (len(nodes.ids),) or np.shape(points_rz) != (len(nodes.ids), 2):
+            raise ApdlError(f"the state holds {nodal_C.size} nodes, the model "
+                            f"{len(nodes.ids)}: not a state of this model", file=source)
+        if not np.allclose(points_rz, nodes.xy, rtol=0.0, atol=1e-9):
+            raise ApdlError("the state's nodes are not this model's nodes (coordinates "
+                            "differ)", file=source)
+        fem = fem_model(self.state)
+        thermal = fem.mesh.thermal
+        n_dofs = thermal.p.shape[1] + (thermal.facets.shape[1] if fem.order == 2 else 0)
+        T = fem.nodal_to_thermal(nodal_C, np.full(n_dofs, np.nan))
+        if not np.all(np.isfinite(T)):
+            raise ApdlError("the state leaves nodes without a finite TEMP", file=source)
+        self.set_state(T, time_s)
+
     def advance(self, T: np.ndarray, start_s: float, deck: str,
                 file: str = "<window deck>") -> np.ndarray:
         """Run one window deck from temperature `T` (thermal dofs, °C) at `start_s`.

@@ -77,14 +77,25 @@ def _num(x: float) -> str:
     return repr(float(x))
 
 
+HOW_TO_RUN = (
+    "! loads only: runs on the spindle model (apdl-like run DECK --spindle --out DIR); a",
+    "! later window restarts from the field the run carried in: --start with the previous",
+    "! deck's last result_NNN.vtu, or window_kkk_start.vtu where written (README, Usage)",
+)
+
+
 def window_deck(loads: LoadSet, layout: DeckLayout,
-                start_temperature_C: float | None = None) -> str:
-    """The APDL text of one window.
+                start_temperature_C: float | None = None,
+                load_step: tuple[int, int] | None = None, notes: tuple[str, ...] = ()) -> str:
+    """The APDL text of one window, or of one load step of a window written as several.
 
     start_temperature_C  the uniform field a run's first window (start 0 s) starts from,
                          written as TUNIF so that the deck runs alone (`apdl-like run
                          --spindle`); None: the session's (a later window restarts from the
                          field its session carries)
+    load_step            (i, n): this text is load step i of the window's n (1-based): the
+                         title says so, and only the first says how the deck runs
+    notes                comment lines (without "! ") saying where the step's loads come from
     """
     for name in loads.heat_generation:
         if name not in layout.regions:
@@ -96,13 +107,18 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
         if name not in layout.interfaces:
             raise ValueError(f"contact resistance on unknown interface {name!r}")
     end = loads.start_s + loads.n_steps * loads.dt_s
-    out = [
-        f"! spindle twin, window {loads.window}: t = {loads.start_s:g} .. {end:g} s, "
-        f"{loads.n_steps} steps of {loads.dt_s:g} s",
-        "! loads only: runs in a session that holds the spindle model (apdl_like.Session;",
-        "! alone: apdl-like run DECK --spindle, window 0 or a deck that /INPUTs the windows",
-        "! in order, as a later window restarts from the field its session carries)",
-    ]
+    steps = f"{loads.n_steps} step{'s' if loads.n_steps != 1 else ''} of {loads.dt_s:g} s"
+    if load_step is None:
+        out = [f"! spindle twin, window {loads.window}: t = {loads.start_s:g} .. {end:g} s, "
+               f"{steps}, loads held over the window", *HOW_TO_RUN]
+    else:
+        i, n = load_step
+        first = [f"! spindle twin, window {loads.window}: {n} load steps, each with its own "
+                 "loads", *HOW_TO_RUN]
+        out = [*(first if i == 1 else []),
+               f"! ---- window {loads.window}, load step {i} of {n}: "
+               f"t = {loads.start_s:g} .. {end:g} s, {steps}"]
+    out += [f"! {line}" for line in notes]
     if loads.contact_resistance:
         out.append("/PREP7")
         for name, r in sorted(loads.contact_resistance.items()):
@@ -117,7 +133,7 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
         *([f"TUNIF,{_num(start_temperature_C)}   ! C, the uniform start field"]
           if start_temperature_C is not None and loads.start_s == 0.0 else []),
         "TIMINT,ON",
-        "KBC,1                 ! loads held over the window (stepped)",
+        "KBC,1                 ! loads held over the load step (stepped)",
         f"DELTIM,{_num(loads.dt_s)}",
         f"TIME,{_num(end)}",
         "OUTRES,ALL,ALL",

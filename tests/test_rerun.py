@@ -101,6 +101,17 @@ def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
     # one load step per 4 s solver step (the loads follow the rings), 15 per window
     assert w[0].rerun_deck.count("SOLVE") == 15
     assert w[1].rerun_deck.count("SOLVE") == 15
+    # 15 load steps stay readable: how the deck runs is said once, then each step says
+    # which it is, its speed and where its loads come from (the 4-line header and
+    # "15 steps ... held over the window" were repeated on every 4 s step)
+    lines = w[1].rerun_deck.splitlines()
+    assert sum("loads only" in x for x in lines) == 1
+    assert sum("load step" in x and " of 15: " in x for x in lines) == 15
+    assert "! ---- window 1, load step 5 of 15: t = 76 .. 80 s, 1 step of 4 s" in lines
+    assert "! re-run at the recorded speed 12000 rpm; bearing heat and contact resistance " \
+           "follow the rings:" in lines
+    assert not any("held over the window" in x or "1 steps" in x for x in lines)
+    assert "held over the window" in w[2].deck and w[2].deck.count("loads only") == 1
     # a replay done in another process brings its re-run decks back
     assert method_replay_from_json(method_replay_to_json(replay)).windows[1].rerun_deck == \
         w[1].rerun_deck
@@ -131,3 +142,80 @@ def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
     # ... and window 2 starts from it
     window2 = session.advance(rerun_end, 120.0, w[2].deck)
     np.testing.assert_allclose(sensors(window2), reported(2), atol=1e-9)
+
+
+def test_every_window_runs_with_apdl_like_from_the_replays_outputs(tmp_path, spindle_model):
+    """A user's audit of `twin replay`'s decks with `apdl-like run`, from the folder alone.
+    The estimator starts each window from its analysed field and bpnn the window after a
+    re-run from the re-run's end, neither the end of the deck before: no command could run
+    those windows (`--start` did not exist, no start field was written), and chaining the
+    decks missed the analysis or the re-run by kelvins.  Each such window's start field is
+    `decks/.../window_kkk_start.vtu` (with the estimator's readings and lag), and a result
+    file of `apdl-like run` starts the next deck too."""
+    import csv
+
+    import meshio
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app as apdl_app
+    from twin.cli import app
+    from twin.lag import first_order_lag
+
+    model = spindle_model
+    run = write_speed_step_run(tmp_path / "step.csv", model)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", str(run), "--out", str(out), "--methods",
+                                      "bpnn,estimator", "--snapshots", "none", "--quiet"])
+    assert result.exit_code == 0, result.output
+    run_dir = out / "step"
+    with open(run_dir / "keypoints.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+
+    def reported(method, k):  # T1..T5 of window k as keypoints.csv has them (6 digits)
+        return np.array([[float(r[f"T{i}_twin_C"]) for i in range(1, 6)] for r in rows
+                         if r["method"] == method
+                         and 60.0 * k < float(r["time_s"]) <= 60.0 * (k + 1)])
+
+    def apdl(deck, start, name):
+        args = ["run", str(deck), "--spindle", "--quiet", "--out", str(tmp_path / name)]
+        result = CliRunner().invoke(apdl_app, args + (["--start", str(start)] if start else []))
+        assert result.exit_code == 0, result.output
+        return [meshio.read(f) for f in sorted((tmp_path / name).glob("result_*.vtu"))]
+
+    def sensors(vtu):
+        return model.sensor_matrix @ vtu.point_data["TEMP"]
+
+    # the estimator's window 2: its deck from its analysed field, 15 load steps of 4 s; the
+    # metal at T1..T5 through the stated lag from the stated readings is what it reported
+    decks = run_dir / "decks" / "estimator"
+    start = meshio.read(decks / "window_002_start.vtu")
+    assert start.field_data["TIME"][0] == 120.0
+    steps = apdl(decks / "window_002.inp", decks / "window_002_start.vtu", "est2")
+    assert [s.field_data["TIME"][0] for s in steps] == [120.0 + 4.0 * i for i in range(1, 16)]
+    metal = np.vstack([sensors(start), [sensors(s) for s in steps]])
+    readings = first_order_lag(metal, 4.0 * np.arange(16), start.field_data["SENSOR_LAG_S"][0],
+                               start.field_data["READINGS_START_C"])[1:]
+    np.testing.assert_allclose(readings, reported("estimator", 2), atol=1e-4)
+    # the analysed field is not the forecast's end: chaining the decks would miss it
+    window1 = apdl(decks / "window_001.inp", decks / "window_001_start.vtu", "est1")
+    assert np.abs(sensors(window1[-1]) - sensors(start)).max() > 0.05
+
+    # bpnn: window 1's re-run from window 1's start ends on window 2's start field, from
+    # which window 2's deck gives the reported window 2
+    decks = run_dir / "decks"
+    rerun = apdl(decks / "window_001_rerun.inp", decks / "window_001_start.vtu", "rerun1")
+    window2_start = meshio.read(decks / "window_002_start.vtu").point_data["TEMP"]
+    np.testing.assert_allclose(rerun[-1].point_data["TEMP"], window2_start, atol=1e-9)
+    window2 = apdl(decks / "window_002.inp", tmp_path / "rerun1" / "result_015.vtu", "bpnn2")
+    np.testing.assert_allclose(sensors(window2[-1]), reported("bpnn", 2)[-1], atol=1e-4)
+    window1 = apdl(decks / "window_001.inp", decks / "window_001_start.vtu", "bpnn1")
+    assert np.abs(sensors(window1[-1]) - sensors(rerun[-1])).max() > 0.3
+
+    # a start state needs the spindle's nodes; a file that is not one is named
+    result = CliRunner().invoke(apdl_app, ["run", str(decks / "window_002.inp"), "--out",
+                                           str(tmp_path / "x"), "--start", str(run)])
+    assert result.exit_code == 2 and "--start needs --spindle" in result.output
+    result = CliRunner().invoke(apdl_app, ["run", str(decks / "window_002.inp"), "--spindle",
+                                           "--out", str(tmp_path / "x"), "--start", str(run)])
+    assert result.exit_code == 2 and f"{run}" in result.output and "vtu" in result.output
+    assert len(result.output.strip().splitlines()) == 1

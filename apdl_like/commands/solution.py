@@ -45,7 +45,8 @@ def antype(s: SessionState, c: Call) -> None:
         raise ApdlError(f"{status} (restart): no previous solution in this run to "
                         "continue from; restarting from another run's files (.rdb, .Rnnn) "
                         "is not supported: /INPUT the deck that solves it first, in the "
-                        "same run")
+                        "same run, or give the state with apdl-like run --spindle --start "
+                        "FILE.vtu")
     else:
         s.solution.fresh_start = False
         s.solution.new_analysis = False

@@ -62,10 +62,12 @@ from twin.correction.features import (
     correction_factors,
 )
 from twin.correction.rerun import (
+    LOAD_UPDATE_STEPS,
     first_window_at_speed,
     recorded_step_speeds,
     rerun_window,
     speed_change_s,
+    speed_stretches,
 )
 from twin.correction.result import Correction, Corrector
 from twin.lag import first_order_lag
@@ -97,6 +99,13 @@ class WindowRecord:
     """The window re-run with its recorded speed (module doc), if the speed changed inside
     it and the method re-runs: run from the window's start field, it ends on the field the
     next window starts from."""
+    start_C: np.ndarray | None = None
+    """The field (thermal dofs, °C) the window starts from where its deck alone does not
+    say it: the estimator's analysed field, the end of a re-run, or the start of a window
+    with a re-run deck (which runs from it too); None where the window starts from the
+    uniform TUNIF of its deck or from the end of window k−1's deck, and the method states
+    no readings (`Correction.readings_start_C`, written beside it).  Written as
+    `decks/window_kkk_start.vtu` (`apdl-like run --start`)."""
 
 
 @dataclass
@@ -118,8 +127,9 @@ class MethodReplay:
 
 
 WindowSolver = Callable[..., tuple]
-"""(conditions, correction, T_start, start_s, window, n_steps=15) → (T per step (n_steps,
-n), deck text or None)."""
+"""(conditions, correction, T_start, start_s, window, n_steps=15, load_step=None, notes=())
+→ (T per step (n_steps, n), deck text or None); load_step (i, n) and notes only label the
+deck (`apdl_like.writer.window_deck`)."""
 
 
 def direct_window_solver(model: SpindleModel) -> WindowSolver:
@@ -127,7 +137,8 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
 
     def solve(
         bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int,
-        n_steps: int = STEPS_PER_WINDOW,
+        n_steps: int = STEPS_PER_WINDOW, load_step: tuple[int, int] | None = None,
+        notes: tuple[str, ...] = (),
     ) -> tuple[np.ndarray, str | None]:
         loads = bc.to_thermal_loads(
             H_front=corr.H_front_W_m3,
@@ -172,7 +183,8 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
 
     def solve(
         bc: BoundaryConditions, corr: Correction, T: np.ndarray, start_s: float, window: int,
-        n_steps: int = STEPS_PER_WINDOW,
+        n_steps: int = STEPS_PER_WINDOW, load_step: tuple[int, int] | None = None,
+        notes: tuple[str, ...] = (),
     ) -> tuple[np.ndarray, str]:
         loads = bc.to_thermal_loads(
             H_front=corr.H_front_W_m3,
@@ -192,7 +204,8 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
         # a run's first window starts from a uniform field: the deck says which, so that
         # it runs alone too
         deck = window_deck(load_set, session.layout,
-                           start_temperature_C=float(T[0]) if start_s == 0.0 else None)
+                           start_temperature_C=float(T[0]) if start_s == 0.0 else None,
+                           load_step=load_step, notes=notes)
         return session.advance(T, start_s, deck, file=f"window_{window:03d}.inp"), deck
 
     return solve
@@ -307,11 +320,14 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
         )
+        previous_end = T
         if reruns and last is not None and (
                 first_window_at_speed(features, last.bc.speed_rpm)
                 or speed_change_s(features, last.bc.speed_rpm) is not None):
             rerun, records[-1].rerun_deck = _rerun(model, solver, last, features, factors,
                                                    conditions)
+            if records[-1].start_C is None and last.start_s > 0.0:  # the re-run starts there
+                records[-1].start_C = last.T_start.copy()
             # the twin's state is the re-run's: it starts the window, its key points over
             # the window just ended are what the method compares with the measurement
             T = rerun[-1]
@@ -352,7 +368,11 @@ def replay_method(
         sim_T[sl.start + 1 : sl.stop + 1] = (model.sensor_matrix @ steps.T).T
         reported_T[sl] = _reported(np.vstack([start_T, sim_T[sl.start + 1 : sl.stop + 1]]), corr)
         drift[sl] = 1e6 * expansion * ((steps - T0) @ model.probe_vectors.T)
-        records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck))
+        # the start field where the decks do not give it (or the readings need stating)
+        start_field = (None if last.T_start is previous_end and corr.readings_start_C is None
+                       else last.T_start.copy())
+        records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck,
+                                    start_C=start_field))
         if field_step is not None and sl.start < field_step <= sl.stop:
             fields[STEP_S * field_step] = steps[field_step - sl.start - 1].copy()
         elif keep_fields and field_step is None:
@@ -408,20 +428,23 @@ def _rerun(model: SpindleModel, solver: WindowSolver, last: _WindowRun,
     correction factor of window k−1 (held through a stop)."""
     return _follow_rings(model, solver, last,
                          recorded_step_speeds(features, STEPS_PER_WINDOW, STEP_S), factors,
-                         conditions)
+                         conditions, rerun=True)
 
 
 def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
                   speeds: np.ndarray, factors: np.ndarray,
-                  conditions: Callable[..., BoundaryConditions]
+                  conditions: Callable[..., BoundaryConditions], rerun: bool = False
                   ) -> tuple[np.ndarray, str | None]:
     """`window` solved from its start field with the speed of each solver step `speeds`,
     in pieces of constant speed and at most LOAD_UPDATE_STEPS (`twin.correction.rerun`):
     each piece gets the nominal conditions at its speed and its own starting temperatures,
     times `factors` (the four values') and the window's model-form factors.  Returns the
-    fields after each step (steps, n) and the pieces' decks as one text (None without)."""
+    fields after each step (steps, n) and the pieces' decks as one text (None without),
+    each piece's comments saying where its loads come from (`rerun`: a re-run's)."""
     ambient, coolant = window.bc.ambient_C, window.bc.coolant_C
     decks: list[str] = []
+    n_pieces = len(speed_stretches(speeds, max_steps=LOAD_UPDATE_STEPS))
+    model_form = ", ".join(f"{k} {v:.4g}" for k, v in sorted(window.thermal_factors.items()))
 
     def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
         # the nominal loads at this piece's own temperatures (they follow the rings every
@@ -430,7 +453,18 @@ def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
         if window.thermal_factors:
             bc = bc.scaled(window.thermal_factors)
         corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front, bc.R_rear])))
-        steps, deck = solver(bc, corr, T, start_s, window.window, n_steps=n)
+        rings = model.sensor_matrix[:4] @ T
+        notes = (
+            f"{'re-run at the recorded speed' if rerun else 'speed'} {speed:g} rpm; bearing "
+            "heat and contact resistance follow the rings:",
+            f"  nominal at T1..T4 = {' '.join(f'{x:.3f}' for x in rings)} C (the field at "
+            f"{start_s:g} s) x the window's factors",
+            f"  H front/rear {factors[0]:.4g} {factors[1]:.4g}, R front/rear "
+            f"{factors[2]:.4g} {factors[3]:.4g}" + (f"; model-form: {model_form}"
+                                                    if model_form else ""),
+        )
+        steps, deck = solver(bc, corr, T, start_s, window.window, n_steps=n,
+                             load_step=(len(decks) + 1, n_pieces), notes=notes)
         if deck is not None:
             decks.append(deck)
         return steps
@@ -459,11 +493,12 @@ def method_replay_to_json(r: MethodReplay) -> str:
         return {
             "window": w.window, "start_s": w.start_s, "speed_rpm": w.speed_rpm,
             "ambient_C": w.ambient_C, "nominal": list(w.nominal), "deck": w.deck,
-            "rerun_deck": w.rerun_deck,
+            "rerun_deck": w.rerun_deck, "start_C": _array(w.start_C),
             "correction": {
                 "values": list(c.values), "C_H": list(c.C_H), "C_C": list(c.C_C),
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
                 "band_sd": _array(c.band_sd), "sensor_lag_s": c.sensor_lag_s,
+                "readings_start_C": _array(c.readings_start_C),
                 "loads_follow_rings": c.loads_follow_rings,
             },
         }
@@ -486,10 +521,11 @@ def method_replay_from_json(text: str) -> MethodReplay:
         correction = Correction(
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
             state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]),
+            readings_start_C=_from_array(c["readings_start_C"]),
             sensor_lag_s=c["sensor_lag_s"], loads_follow_rings=c["loads_follow_rings"])
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
                             correction, BoundaryValues(*w["nominal"]), w["deck"],
-                            w["rerun_deck"])
+                            w["rerun_deck"], _from_array(w["start_C"]))
 
     return MethodReplay(
         method=d["method"], time_s=_from_array(d["time_s"]), T_twin_C=_from_array(d["T_twin_C"]),

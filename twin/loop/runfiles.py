@@ -7,7 +7,9 @@ Layout under DIR/<run-name>/ (shared DESIGN.md):
                        <name>_factor for further estimated values (motor, film groups)
     accuracy.json      per-method metrics (twin.loop.metrics)
     quality.json       data-quality findings of the recorded run
-    decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/)
+    decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/),
+                                window_kkk_rerun.inp (a re-run) and window_kkk_start.vtu
+                                (the start field where the decks do not give it)
     fields/*.vtu + fields.pvd   the primary method's field at every window end
     snapshots/*.png             field pictures (--snapshots end|every)
     plots/*.png                 the report's figures of this run
@@ -199,7 +201,23 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
                 write_text(deck_dir / f"window_{w.window:03d}.inp", w.deck)
             if w.rerun_deck is not None:
                 write_text(deck_dir / f"window_{w.window:03d}_rerun.inp", w.rerun_deck)
+            if w.start_C is not None and w.deck is not None:
+                _write_start_state(deck_dir / f"window_{w.window:03d}_start.vtu", model, w)
     return accuracy, token
+
+
+def _write_start_state(path: Path, model, w) -> None:  # noqa: ANN001
+    """The field window `w` starts from, on the deck session's nodes (node i+1 = vertex i,
+    `apdl_like.session`), with the estimator's stated readings and lag: what `apdl-like run
+    --spindle --start` runs its deck (or its re-run deck) from."""
+    from apdl_like.outputs import write_state_vtu
+
+    thermal = model.mesh.thermal
+    c = w.correction
+    extra = {} if c.readings_start_C is None else {
+        "READINGS_START_C": c.readings_start_C, "SENSOR_LAG_S": c.sensor_lag_s}
+    write_state_vtu(path, thermal.p.T, thermal.t.T, w.start_C[:thermal.p.shape[1]],
+                    w.start_s, extra)
 
 
 def _snapshot_times(fields: dict[float, np.ndarray], snapshots: str) -> list[float]:
