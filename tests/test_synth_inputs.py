@@ -170,6 +170,10 @@ def test_speed_profile(tmp_path):
     ("time_s,speed_rpm,ambient_C\n0,9000,298\n", 2, "ambient_C"),
     ("time_s,speed_rpm\n", 1, None),
     ("# from the logger\ntime_s;speed_rpm\n0;9000\n", 2, None),  # not comma-separated
+    # a column named twice (or without a name) was read from its first place without a
+    # word: which speed the emulated spindle ran was the reader's choice, not the file's
+    ("time_s,speed_rpm,speed_rpm\n0,6000,5000\n", 1, "speed_rpm"),
+    ("time_s,speed_rpm,,ambient_C\n0,6000,1,24\n", 1, None),
 ])
 def test_bad_speed_profiles(tmp_path, text, row, column):
     path = tmp_path / "p.csv"

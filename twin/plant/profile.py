@@ -15,7 +15,7 @@ import numpy as np
 from twin.errors import InputError
 from twin.paths import read_input_text
 from twin.plant.timetable import StepTable
-from twin.runs.csv_format import check_comma_separated, csv_records
+from twin.runs.csv_format import check_header, csv_records
 from twin.runs.table import parse_cell
 
 
@@ -44,7 +44,7 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
             continue
         fields = [f.strip() for f in next(csv_records([line], file, [number]))]
         if header is None:
-            check_comma_separated(fields, file, number)
+            check_header(fields, file, number)
             header, header_line = fields, number
         else:
             rows.append((number, fields))

@@ -58,13 +58,7 @@ def read_csv_table(path: str | os.PathLike[str],
 
     if header is None:
         raise InputError("empty file: no header row and no data", file=file)
-    check_comma_separated(header, file, header_line)
-    for position, name in enumerate(header, start=1):
-        if not name:
-            raise InputError(f"header field {position} is empty", file=file, row=header_line)
-        if header.count(name) > 1:
-            raise InputError("column appears twice in the header", file=file, row=header_line,
-                             column=name)
+    check_header(header, file, header_line)
     if not data_lines:
         raise InputError("no data rows after the header", file=file, row=header_line)
     if len(data_lines) > MAX_SAMPLES:
@@ -86,6 +80,18 @@ def read_csv_table(path: str | os.PathLike[str],
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored)
+
+
+def check_header(header: list[str], file: str, line: int) -> None:
+    """InputError unless `header` (row `line`) is comma-separated and names each column once,
+    none empty: a name given twice would leave which column is read to the reader."""
+    check_comma_separated(header, file, line)
+    for position, name in enumerate(header, start=1):
+        if not name:
+            raise InputError(f"header field {position} is empty", file=file, row=line)
+        if header.count(name) > 1:
+            raise InputError("column appears twice in the header", file=file, row=line,
+                             column=name)
 
 
 def check_comma_separated(header: list[str], file: str, line: int) -> None:
