@@ -527,10 +527,11 @@ class EnsembleEstimator:
                 moved = start.moved(w, rows, self._lag, self._bounds)
                 with threadpool_limits(1):
                     fc, _ = self._forecast_from(moved)
-                sim_C = np.asarray(f.simulated_C, float).copy()
-                sim_C[-cfg.steps_per_window:] = fc.sensors_mean_C
-                if rerun:
+                if rerun:  # the mean again at the recorded speed, as the first pass
                     sim_C, fc.end.field_mean, fc = self._rerun(f, fc, moved)
+                else:
+                    sim_C = np.asarray(f.simulated_C, float).copy()
+                    sim_C[-cfg.steps_per_window:] = fc.sensors_mean_C
                 obs = self._observations(f, fc, sim_C, moved)
                 w_forecast = w
                 w, W = etkf_weights(obs.mean, obs.anomalies, obs.observed, obs.sd,
