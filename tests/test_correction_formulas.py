@@ -68,8 +68,29 @@ def test_guards_neutral_for_tiny_negative_or_missing_denominators():
     # missing sensor
     assert contact_drop_ratio(np.nan, 0.5, g) == 1.0
     assert total_rise_ratio(30.0, np.inf, 25.0, g) == 1.0
-    # both cooling: a proper ratio
-    assert window_rise_ratio(-0.22, -0.2, g) == pytest.approx(1.1)
+    # two falls over a window: cooling faster than the twin means less heat, not 1.1×
+    assert window_rise_ratio(-0.22, -0.2, g) == 1.0
+
+
+def test_eq2_holds_below_ambient_where_the_ratio_runs_backwards():
+    # a cold jacket holds the ring below ambient: measured −1.0 K, twin −0.6 K (the ring is
+    # colder than the twin) gave 1.67, raising the heat; a twin rise below the floor or
+    # negative carries no heat ratio
+    g = RatioGuards()
+    assert total_rise_ratio(24.0, 24.4, 25.0, g) == 1.0
+    assert total_rise_ratio(22.6, 20.8, 25.0, g) == 1.0  # warmer than the twin: not 0.57
+    assert heat_first_correction(1e6, 24.0, 24.4, 25.0, g) == 1e6
+    # above ambient Eq. 2 is unchanged, also with the measured ring still below it
+    assert total_rise_ratio(26.0, 27.0, 25.0, g) == pytest.approx(0.5)
+    assert total_rise_ratio(24.9, 26.0, 25.0, g) == 1.0
+
+
+def test_eq6_reads_two_negative_drops_as_a_resistance_ratio():
+    # the drop is heat flux × resistance in either direction of the flux (a sleeve warmer
+    # than its ring while the spindle cools): −0.55 against −0.50 K is still R 1.1× the twin's
+    g = RatioGuards()
+    assert contact_drop_ratio(-0.55, -0.50, g) == pytest.approx(1.1)
+    assert contact_drop_ratio(0.55, -0.50, g) == 1.0
 
 
 def test_guards_clip_to_limits():

@@ -284,6 +284,25 @@ def test_paper_literal_law_is_worse_in_closed_loop():
     assert np.std(values_paper[-10:, 0]) > 3 * np.std(values_default[-10:, 0])
 
 
+def test_ratio_law_does_not_cut_the_heat_of_a_ring_below_ambient():
+    # a slow bearing on a coolant jacket colder than the air: its ring is measured 2.4 K
+    # below ambient, the twin's 4.2 K below (the twin too cold: too little heat).  Eq. 2 on
+    # the two negative rises gave 0.57 and cut the heat, cooling the twin further; the
+    # ratio law and bpnn's anchor now hold the heat there
+    from twin.correction.methods import ratio_anchor
+
+    t = np.arange(0.0, 601.0, 2.0)
+    measured = np.tile([AMBIENT - 2.4, AMBIENT - 3.0, AMBIENT + 3.0, AMBIENT + 2.0, AMBIENT],
+                       (t.size, 1))
+    simulated = measured + np.array([-1.8, -1.8, 0.0, 0.0, 0.0])
+    nominal = _nominal()
+    f = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, measured, t, simulated, nominal, nominal)
+    for values in (RatioCorrection().correct(f).values, ratio_anchor(f, np.ones(4))):
+        factors = np.array(values) / np.array(nominal)
+        assert factors[0] == pytest.approx(1.0)  # the front heat is held, not 0.57
+        assert factors[1] == pytest.approx(1.0)  # the rear ring matches: unchanged
+
+
 def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
     from twin.correction.methods import ANCHOR_LAW, ratio_anchor
 
