@@ -161,8 +161,6 @@ def test_cli_choices_match_the_modules_that_act_on_them():
           "--out", "OUT.csv"], "--minutes"),
         (["synth", "--speed", "9000", "--minutes", "nan", "--ambient", "25", "--seed", "1",
           "--out", "OUT.csv"], "--minutes"),
-        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "-40", "--seed", "1",
-          "--out", "OUT.csv"], "--ambient"),
         (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "-2",
           "--out", "OUT.csv"], "--seed"),
         (["synth", "--speed", "-5", "--minutes", "3", "--ambient", "25", "--seed", "1",
@@ -401,6 +399,11 @@ def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monk
 @pytest.mark.parametrize("options, option, words", [
     (["--speed", "20000", "--ambient", "25"], "--speed", "exceeds the spindle's limit"),
     (["--speed", "9000", "--ambient", "25", "--coolant", "90"], "--coolant", "got 90"),
+    # one range for both (twin.contract.OPERATING_TEMPERATURE_C): simulate took an ambient
+    # up to 80 °C and synth down to -30 only
+    (["--speed", "9000", "--ambient", "60"], "--ambient", "between -40 and 45 °C, got 60"),
+    (["--speed", "9000", "--ambient", "-41"], "--ambient", "between -40 and 45 °C, got -41"),
+    (["--speed", "9000", "--ambient", "25", "--coolant", "46"], "--coolant", "got 46"),
 ])
 def test_an_impossible_operating_point_names_the_option(command, options, option, words,
                                                          tmp_path, monkeypatch):

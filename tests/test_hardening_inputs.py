@@ -135,8 +135,11 @@ def test_synth_profile_with_an_ambient_column(tmp_path):
     result = cli("synth", "--profile", profile, "--minutes", 2, "--ambient", 25, "--seed", 1,
                  "--out", tmp_path / "r.csv", "--quiet")
     assert result.exit_code == 0, result.output
-    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,50\n")
+    # 50 °C is above the plausible range: refused where it is written (row and column),
+    # not after the run was emulated as a run replay would read as Fahrenheit
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,25\n60,6000,50\n")
     result = cli("synth", "--profile", profile, "--minutes", 2, "--ambient", 25, "--seed", 1,
                  "--out", tmp_path / "r2.csv", "--quiet")
-    assert result.exit_code == 2 and "p.csv" in result.output and "Fahrenheit" in result.output
+    assert result.exit_code == 2 and "p.csv" in result.output, result.output
+    assert "3" in result.output and "ambient_C" in result.output and "-40..45" in result.output
     assert not (tmp_path / "r2.csv").exists()

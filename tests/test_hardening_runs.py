@@ -109,8 +109,10 @@ def test_defect6_parquet_huge_uint64(tmp_path):
 
 @pytest.mark.parametrize(("column", "value", "text"), [
     ("speed_rpm", 20000.0, "exceeds the spindle's limit 15000"),
-    ("ambient_C", -50.0, "outside the -40..80"),
-    ("coolant_C", 150.0, "outside the -40..80"),
+    ("ambient_C", -50.0, "outside the -40..45"),
+    ("coolant_C", 150.0, "outside the -40..45"),
+    # above the plausible range but not the median (not read as Fahrenheit): was accepted
+    ("coolant_C", 50.0, "outside the -40..45"),
 ])
 def test_defect7_out_of_range_refused_at_read_time_naming_row(tmp_path, column, value, text):
     cols = warmup()

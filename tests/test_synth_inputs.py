@@ -77,6 +77,12 @@ def test_design_example_scenario_parses(tmp_path):
     ("[sensors]\nlag_s = 8\nnoise_c = 1\n", 3, "sensors.noise_c", "unknown key"),
     ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck.0", "unknown sensor"),
     ("\n[coolant]\ntime_s = [0]\ninlet_C = [300]\n", 4, "coolant.inlet_C.0", "less than"),
+    # the one plausible range (twin.contract.OPERATING_TEMPERATURE_C): a coolant at 50 °C
+    # was emulated in full and then refused as a run replay would read as Fahrenheit
+    ("[coolant]\ntime_s = [0, 60]\ninlet_C = [20, 50]\n", 3, "coolant.inlet_C.1",
+     "less than or equal to 45"),
+    ("[ambient]\ntime_s = [0]\nambient_C = [-41]\n", 3, "ambient.ambient_C.0",
+     "greater than or equal to -40"),
     ("[contact_resistance.front]\ntime_s = [0, 60]\nfactor = [1.0, 0.0]\n", 3,
      "contact_resistance.front.factor.1", "greater than 0"),
     ("[ambient]\ntime_s = [0, 0]\nambient_C = [20, 21]\n", 1, "ambient", "increasing"),
@@ -168,6 +174,7 @@ def test_speed_profile(tmp_path):
     ("time_s,speed_rpm\n0,9000\n0,8000\n", 3, "time_s"),
     ("time_s,speed_rpm\n0,-1\n", 2, "speed_rpm"),
     ("time_s,speed_rpm,ambient_C\n0,9000,298\n", 2, "ambient_C"),
+    ("time_s,speed_rpm,ambient_C\n0,9000,25\n60,9000,50\n", 3, "ambient_C"),  # > 45 °C
     ("time_s,speed_rpm\n", 1, None),
     ("# from the logger\ntime_s;speed_rpm\n0;9000\n", 2, None),  # not comma-separated
     # a column named twice (or without a name) was read from its first place without a
@@ -181,6 +188,17 @@ def test_bad_speed_profiles(tmp_path, text, row, column):
     with pytest.raises(InputError) as info:
         read_speed_profile(path)
     assert (info.value.row, info.value.column) == (row, column)
+
+
+def test_scenario_and_profile_take_the_range_replay_takes(tmp_path):
+    from twin.contract import OPERATING_TEMPERATURE_C
+
+    low, high = OPERATING_TEMPERATURE_C
+    scenario = parse_scenario(f"[ambient]\ntime_s = [0, 60]\nambient_C = [{low}, {high}]\n")
+    assert scenario.ambient.ambient_C == [low, high]
+    path = tmp_path / "p.csv"
+    path.write_text(f"time_s,speed_rpm,ambient_C\n0,6000,{low}\n60,6000,{high}\n")
+    assert read_speed_profile(path).ambient_C(60.0) == high
 
 
 def test_tables():
@@ -246,6 +264,21 @@ def test_default_truth_is_seeded_and_overridable():
     merged = truth_tables(parse_scenario(SCENARIO), a)
     assert merged.H_front(300.0) == pytest.approx(1.12)
     assert merged.H_rear is a.H_rear and merged.R_rear(1800.0) == pytest.approx(0.8)
+
+
+def test_default_drift_stays_in_the_plausible_range():
+    # a run started at the range's edge: the coolant's default rise (0.3–1.2 K) took it
+    # past 45 °C and the truth's own nominal model refused it, naming no option
+    from twin.contract import OPERATING_TEMPERATURE_C
+
+    low, high = OPERATING_TEMPERATURE_C
+    for edge in (low, high):
+        for seed in range(4):
+            tables = default_tables(np.random.default_rng(seed), 1800.0,
+                                    lambda t: np.full(np.shape(t), 9000.0),
+                                    lambda t, e=edge: np.full(np.shape(t), e), edge)
+            for table in (tables.ambient_C, tables.coolant_C):
+                assert low <= table.values.min() and table.values.max() <= high
 
 
 def test_xy_drift_is_the_lagged_linear_response_to_the_temperature_rises():

@@ -22,3 +22,18 @@ STEPS_PER_WINDOW = 15
 
 STEP_S = WINDOW_S / STEPS_PER_WINDOW
 """Solver time step (s): 4 s."""
+
+OPERATING_TEMPERATURE_C = (-40.0, 45.0)
+"""The plausible ambient air and coolant inlet temperatures (°C, closed range): the one
+range every command and reader accepts — a recorded run's `ambient_C` and `coolant_C` rows
+(`twin replay`, `twin train`), `--ambient` and `--coolant` of `twin simulate` and `twin
+synth`, a speed profile's `ambient_C` and a scenario's `[ambient]` and `[coolant]`.  The
+lower end is the film, viscosity and fit models' envelope; the upper one is above any
+machine-shop air or spindle coolant, and where a logged air or coolant temperature reads as
+Fahrenheit (45 °F is 7 °C: a room or coolant logged in °F reads above it;
+`twin.runs.validate`).
+
+Why one range: until 2026-11-27 replay and simulate took −40..80 °C (replay refusing a
+median of 45 °C or more as Fahrenheit), synth −30..45 and profiles and scenarios −30..60,
+so a profile's 50 °C was emulated in full and only then refused, without its row, as a
+run replay would read as Fahrenheit."""

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from twin.contract import OPERATING_TEMPERATURE_C
 from twin.data import bundled_path
 from twin.errors import InputError
 
@@ -68,6 +69,10 @@ def runs_in(folder: Path) -> list[Path]:
     runs = sorted(p for p in folder.iterdir()
                   if p.suffix in (".csv", ".parquet") and p.is_file())
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
+
+
+RANGE_C = "{:g}..{:g}".format(*OPERATING_TEMPERATURE_C)
+"""The plausible ambient and coolant range as the options' help gives it (°C)."""
 
 
 def check_operating_options(spec: SpindleSpec, speed: float, ambient: float,

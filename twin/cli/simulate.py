@@ -6,7 +6,13 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between, check_operating_options
+from twin.cli.inputs import (
+    MAX_SIZE_FACTOR,
+    MIN_SIZE_FACTOR,
+    RANGE_C,
+    between,
+    check_operating_options,
+)
 
 
 def simulate_command(
@@ -14,10 +20,12 @@ def simulate_command(
     minutes: float = typer.Option(..., "--minutes", callback=between(0.0),
                                   help="Duration, minutes (rounded up to whole 4 s "
                                   "steps)."),
-    ambient: float = typer.Option(..., "--ambient", help="Ambient temperature, °C."),
+    ambient: float = typer.Option(..., "--ambient", help="Ambient temperature, °C "
+                                  f"({RANGE_C})."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
     coolant: float | None = typer.Option(
-        None, "--coolant", help="Coolant inlet temperature, °C (default: the ambient)."
+        None, "--coolant", help=f"Coolant inlet temperature, °C ({RANGE_C}; default: the "
+        "ambient)."
     ),
     spec: Path | None = typer.Option(None, "--spec", help="Spindle spec TOML."),
     size_factor: float = typer.Option(1.0, "--size-factor",

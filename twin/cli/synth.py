@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from twin.cli.inputs import RANGE_C
 from twin.errors import InputError
 
 SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
@@ -43,9 +44,8 @@ def synth(
     minutes: float | None = typer.Option(None, "--minutes", min=2.0, max=24 * 60.0,
                                          help="Run length, minutes (two 60 s windows at "
                                          "least; --suite: default 40)."),
-    ambient: float | None = typer.Option(None, "--ambient", min=-30.0,
-                                         help="Ambient temperature at the start, °C (not "
-                                         "with --suite)."),
+    ambient: float | None = typer.Option(None, "--ambient", help="Ambient temperature at the "
+                                         f"start, °C ({RANGE_C}; not with --suite)."),
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C]); 0 rpm is a stop."),
@@ -57,8 +57,8 @@ def synth(
                                      "distribution (twin.plant.suite) into the --out folder."),
     rate: float = typer.Option(1.0, "--rate", min=0.1, max=10.0, help="Sample rate, Hz."),
     coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
-                                         "at the start, °C (default: the ambient, as the "
-                                         "nominal model assumes)."),
+                                         f"at the start, °C ({RANGE_C}; default: the "
+                                         "ambient, as the nominal model assumes)."),
     overwrite: bool = typer.Option(False, "--overwrite", help="With --suite: remove the "
                                    "runs already in the --out folder that this suite does "
                                    "not write (without it they are an error)."),
@@ -70,7 +70,6 @@ def synth(
     from twin.plant.profile import read_speed_profile
     from twin.plant.scenario import load_scenario
     from twin.runs import check_replayable
-    from twin.runs.validate import FAHRENHEIT_AIR_RANGE_C
     from twin.spindle.spec import load_spec
 
     if suite is not None:
@@ -85,15 +84,8 @@ def synth(
     for name, value in (("--minutes", minutes), ("--ambient", ambient)):
         if value is None:
             raise InputError("missing: a single run needs it", column=name)
-    # replay reads an air or coolant temperature from 45 °C up as Fahrenheit: synth must not
-    # write what replay refuses
-    fahrenheit = FAHRENHEIT_AIR_RANGE_C[0]
-    if not -30.0 <= ambient < fahrenheit:
-        raise InputError(f"ambient must lie in -30..{fahrenheit:g} °C (replay reads warmer air "
-                         f"as Fahrenheit), got {ambient:g}", column="--ambient")
-    if coolant is not None and not coolant < fahrenheit:
-        raise InputError(f"coolant must be below {fahrenheit:g} °C (replay reads warmer "
-                         f"coolant as Fahrenheit), got {coolant:g}", column="--coolant")
+    # the range replay reads (twin.contract.OPERATING_TEMPERATURE_C; NaN too): synth must
+    # not write what replay refuses
     check_operating_options(load_spec(None), speed or 0.0, ambient, coolant)
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError("the run must be written as .csv or .parquet", file=str(out),

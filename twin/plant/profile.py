@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
 from twin.paths import read_input_text
 from twin.plant.timetable import StepTable
@@ -77,9 +78,10 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
         if speed < 0:
             raise InputError(f"negative speed {speed:g} rpm", file=file, row=number,
                              column="speed_rpm")
-        if len(wanted) == 3 and not -30.0 <= values[k, 2] <= 60.0:
-            raise InputError(f"ambient {values[k, 2]:g} °C is outside -30..60 °C", file=file,
-                             row=number, column="ambient_C")
+        low, high = OPERATING_TEMPERATURE_C
+        if len(wanted) == 3 and not low <= values[k, 2] <= high:
+            raise InputError(f"ambient {values[k, 2]:g} °C is outside the {low:g}..{high:g} °C "
+                             "the twin models", file=file, row=number, column="ambient_C")
     ambient = StepTable(values[:, 0], values[:, 2]) if len(wanted) == 3 else None
     return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient,
                         tuple(number for number, _ in rows))

@@ -58,7 +58,7 @@ from pydantic import (
     model_validator,
 )
 
-from twin.contract import SENSOR_NAMES
+from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
 from twin.errors import InputError
 from twin.paths import parse_toml, read_input_text
 from twin.plant.timetable import TimeTable
@@ -118,7 +118,7 @@ class FactorTable(_Series):
     columns: ClassVar[tuple[str, ...]] = ("factor",)
 
 
-Celsius = Annotated[float, Field(ge=-30.0, le=60.0)]
+Celsius = Annotated[float, Field(ge=OPERATING_TEMPERATURE_C[0], le=OPERATING_TEMPERATURE_C[1])]
 
 
 class CoolantTable(_Series):

@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.contract import OPERATING_TEMPERATURE_C
 from twin.lag import first_order_lag
 from twin.plant.scenario import Scenario
 from twin.plant.timetable import TimeTable
@@ -157,6 +158,9 @@ def default_tables(rng: np.random.Generator, duration_s: float,
         + 0.15 * (np.sin(2 * np.pi * t / period + phase) - np.sin(phase))
     ambient_trend = u(-0.3, 0.8) / max(duration_s, 1.0)
     ambient = ambient_of(t) + ambient_trend * t
+    # the drift stays in the range the twin models: a run started at its edge (--ambient
+    # -40) drifted out and the truth's own nominal model refused it, naming no option
+    coolant, ambient = (np.clip(x, *OPERATING_TEMPERATURE_C) for x in (coolant, ambient))
     # Per-run X/Y gain scales.  The three draws per axis replay those of the earlier
     # random X/Y tables (sign, amplitude, time constant), so every seeded run keeps its
     # bearing and contact tables, which are drawn after these: the amplitude's uniform

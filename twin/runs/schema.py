@@ -32,6 +32,3 @@ writes.  Checked on the time column before anything is allocated per step or win
 
 MAX_SAMPLES = 1_000_000
 """Most samples a run may hold (a day at about 11 Hz); a faster log must be resampled."""
-
-OPERATING_TEMPERATURE_C = (-40.0, 80.0)
-"""Ambient and coolant temperatures the twin's film, viscosity and fit models cover (°C)."""

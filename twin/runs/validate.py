@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin.contract import WINDOW_S
+from twin.contract import OPERATING_TEMPERATURE_C, WINDOW_S
 from twin.errors import InputError
 from twin.runs.schema import (
     AMBIENT,
@@ -17,7 +17,6 @@ from twin.runs.schema import (
     COOLANT,
     MAX_DURATION_S,
     MAX_SAMPLE_INTERVAL_S,
-    OPERATING_TEMPERATURE_C,
     REQUIRED,
     SPEED,
     TEMPERATURES,
@@ -27,8 +26,9 @@ from twin.runs.table import RawTable
 
 KELVIN_MEDIAN_C = 200.0
 """A °C column whose median exceeds this is Kelvin: no spindle part runs at 200 °C."""
-FAHRENHEIT_AIR_RANGE_C = (45.0, 130.0)
-"""Ambient air or coolant with a median in this range is Fahrenheit (59–95 °F rooms)."""
+FAHRENHEIT_AIR_RANGE_C = (OPERATING_TEMPERATURE_C[1], 130.0)
+"""Ambient air or coolant with a median above the first (the plausible range's top) and up
+to the second is Fahrenheit: 45–130 °F is 7–54 °C, any room or coolant logged in °F."""
 
 
 def check_structure(table: RawTable) -> None:
@@ -108,7 +108,7 @@ def _check_celsius(table: RawTable, name: str) -> None:
             f"values look like Kelvin (median {median:.2f}); the column must be in °C "
             f"(subtract 273.15)", file=table.file, row=row, column=name)
     lo, hi = FAHRENHEIT_AIR_RANGE_C
-    if name in (AMBIENT, COOLANT) and lo <= median <= hi:
+    if name in (AMBIENT, COOLANT) and lo < median <= hi:
         raise InputError(
             f"values look like Fahrenheit (median {median:.1f}, an implausible air/coolant "
             "temperature in °C); the column must be in °C", file=table.file, row=row,

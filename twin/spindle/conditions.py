@@ -24,6 +24,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
+from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
 from twin.fem import ThermalLoads
 from twin.physics import (
@@ -41,7 +42,6 @@ from twin.physics import (
     rotating_disk_h,
 )
 from twin.physics.contact import harmonic_mean, thermal_interference_um
-from twin.runs.schema import OPERATING_TEMPERATURE_C
 from twin.spindle.spec import ConvectionSpec, SpindleSpec
 
 SIDES = ("front", "rear")
