@@ -175,6 +175,10 @@ def test_speed_profile(tmp_path):
     ("time_s,speed_rpm\n0,-1\n", 2, "speed_rpm"),
     ("time_s,speed_rpm,ambient_C\n0,9000,298\n", 2, "ambient_C"),
     ("time_s,speed_rpm,ambient_C\n0,9000,25\n60,9000,50\n", 3, "ambient_C"),  # > 45 °C
+    # a first row after 0 s held its speed back to 0 s without a word (a spindle standing
+    # until then was as likely meant): the row is named
+    ("# warm start\ntime_s,speed_rpm\n60,9000\n600,12000\n", 3, "time_s"),
+    ("time_s,speed_rpm\n0.5,9000\n", 2, "time_s"),
     ("time_s,speed_rpm\n", 1, None),
     ("# from the logger\ntime_s;speed_rpm\n0;9000\n", 2, None),  # not comma-separated
     # a column named twice (or without a name) was read from its first place without a

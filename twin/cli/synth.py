@@ -48,7 +48,8 @@ def synth(
                                          f"start, °C ({RANGE_C}; not with --suite)."),
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
-                                        "(time_s, speed_rpm[, ambient_C]); 0 rpm is a stop."),
+                                        "(time_s, speed_rpm[, ambient_C]) from 0 s, each "
+                                        "row held until the next; 0 rpm is a stop."),
     scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
                                          "factors, model-form error, sensors, faults; "
                                          "see above)."),

@@ -1,7 +1,12 @@
 """Speed profile CSV of the emulator: `time_s, speed_rpm[, ambient_C]`.
 
-A speed (and ambient, if given) holds until the next row; before the first row the first
-row's values hold.  `#` lines are comments.  Rows are numbered as lines in an editor.
+A speed (and ambient, if given) holds until the next row; the first row is at 0 s (the
+run's start).  `#` lines are comments.  Rows are numbered as lines in an editor.
+
+Why the first row must be at 0 s: a profile starting later (`60,9000`) was read as 9000 rpm
+from the start, the first row's value held back to 0 s without a word, where its writer may
+as well have meant a spindle standing until then.  Asked to say which, the error names the
+row.
 """
 
 from __future__ import annotations
@@ -70,6 +75,10 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
                                  column=name)
             values[k, j] = value
         time, speed = values[k, 0], values[k, 1]
+        if k == 0 and time != 0:
+            raise InputError(f"the first row must be at 0 s, the run's start (got {time:g} s): "
+                             "add a row at 0 s with the speed until then (0 rpm: standing)",
+                             file=file, row=number, column="time_s")
         if time < 0:
             raise InputError("time must be ≥ 0", file=file, row=number, column="time_s")
         if k and time <= values[k - 1, 0]:
