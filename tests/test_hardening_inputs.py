@@ -129,6 +129,23 @@ def test_defect5_unbounded_work_from_arguments_refused(tmp_path, args):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_synth_refuses_an_ambient_from_both_profile_and_scenario(tmp_path):
+    # the scenario's [ambient] won and the profile's ambient_C column was read for nothing
+    profile, scenario = tmp_path / "p.csv", tmp_path / "s.toml"
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,24\n60,9000,26\n")
+    scenario.write_text("[ambient]\ntime_s = [0]\nambient_C = [20.0]\n")
+    args = ["synth", "--profile", profile, "--minutes", 2, "--ambient", 25, "--seed", 1,
+            "--quiet"]
+    result = cli(*args, "--scenario", scenario, "--out", tmp_path / "r.csv")
+    assert result.exit_code == 2, result.output
+    assert "s.toml" in result.output and "'ambient'" in result.output
+    assert "p.csv" in result.output and not (tmp_path / "r.csv").exists()
+    # either one alone is fine
+    scenario.write_text("[coolant]\ntime_s = [0]\ninlet_C = [20.0]\n")
+    result = cli(*args, "--scenario", scenario, "--out", tmp_path / "r2.csv")
+    assert result.exit_code == 0, result.output
+
+
 def test_synth_profile_with_an_ambient_column(tmp_path):
     profile = tmp_path / "p.csv"
     profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,24\n60,9000,25\n")

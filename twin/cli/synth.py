@@ -92,11 +92,16 @@ def synth(
         raise InputError("the run must be written as .csv or .parquet", file=str(out),
                          column="--out")
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
+    speed_profile = None if profile is None else read_speed_profile(profile)
+    truth = load_scenario(scenario, duration_s=60.0 * minutes)
+    profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
+    if profile_ambient and truth.ambient is not None:
+        # the scenario's table won and the profile's column was read for nothing
+        raise InputError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
+                         "the ambient: keep one of them", file=str(scenario), column="ambient")
     run = synthesize(
-        speed_rpm=speed,
-        profile=None if profile is None else read_speed_profile(profile),
-        minutes=minutes, ambient_C=ambient, seed=seed,
-        scenario=load_scenario(scenario, duration_s=60.0 * minutes), rate_hz=rate,
+        speed_rpm=speed, profile=speed_profile,
+        minutes=minutes, ambient_C=ambient, seed=seed, scenario=truth, rate_hz=rate,
         coolant_C=coolant,
         scenario_name=None if scenario is None else str(scenario),
         profile_name=None if profile is None else str(profile),
