@@ -71,9 +71,13 @@ class OpenLoop:
     """No correction: the nominal values (Eq. 1 heat, Eq. 4 resistance) at the current speed."""
 
     name: str = "open_loop"
+    loads_follow_rings: bool = True
+    """The nominal values follow the twin's rings every solver step
+    (`Correction.loads_follow_rings`); False: held at the window start's for the window."""
 
     def correct(self, features: WindowFeatures) -> Correction:
-        return Correction.relative_to(features.nominal, features.previous)
+        return Correction.relative_to(features.nominal, features.previous,
+                                      loads_follow_rings=self.loads_follow_rings)
 
 
 @dataclass(frozen=True)
@@ -113,13 +117,19 @@ class RatioCorrection:
     None: Eq. 6 as the paper's (the drop proportional to R; the `ratio` method).  See
     `SPINDLE_CONTACT_METAL`."""
     name: str = "ratio"
+    loads_follow_rings: bool = True
+    """The corrected values are factors on nominal values that follow the twin's rings
+    every solver step (`Correction.loads_follow_rings`): the law is set every window as the
+    paper's, the Palmgren heat and Eq. 4/5 resistance it multiplies follow the rings.
+    False: the values held for the window, the paper's literal boundary conditions."""
 
     def correct(self, features: WindowFeatures) -> Correction:
         f = features
         g = self.guards
         if f.window == 0:
             # nothing measured yet that the twin could be compared with
-            return Correction.relative_to(f.nominal, f.previous)
+            return Correction.relative_to(f.nominal, f.previous,
+                                          loads_follow_rings=self.loads_follow_rings)
         # levels and rises from a line through the last window: the measured samples are
         # noisy, and ratios of noisy differences would swing the correction window to window
         meas_now, meas_rise = window_line_fit(
@@ -177,7 +187,8 @@ class RatioCorrection:
                     R1, C_C, self.metal_factors[k] * nominal[2 + k], noise_step,
                     g.contact.limits)
         values = limit_to_nominal(values, nominal, g)
-        return Correction.relative_to(values, f.previous)
+        return Correction.relative_to(values, f.previous,
+                                      loads_follow_rings=self.loads_follow_rings)
 
 
 SPINDLE_CONTACT_METAL = (1.27, 1.0)
@@ -287,8 +298,7 @@ class BpnnCorrection:
     anchored model (the default) corrects the ratio-law value, `ratio_anchor`, by the
     factor exp(output); where its inputs are not finite (window 0, a dead sensor) the
     value is the anchor.  The twin's state and simulated key points it reads come from
-    the re-run of a window with a missed speed change and of a run's first window
-    (`rerun_missed_speed`).  A
+    the re-run of a window with a missed speed change (`rerun_missed_speed`).  A
     paper-configuration model predicts the value itself; non-finite
     inputs fall back to the previous window's correction factor on the current nominal
     value.  The output is kept within the guards' band around the nominal value.  A
@@ -304,9 +314,12 @@ class BpnnCorrection:
     """The last anchor as factors on its nominal values (held through a stop)."""
     rerun_missed_speed: bool = True
     """Ask the loop to re-run a window whose recorded speed changed after its loads were
-    fixed, and a run's window 0 (its loads held at the cold start's temperatures), and to
-    start the next window (and read its inputs) from that re-run (`twin.loop.replay`,
-    `twin.correction.rerun`)."""
+    fixed (and, with `loads_follow_rings` off, a run's window 0, its loads held at the cold
+    start's temperatures), and to start the next window (and read its inputs) from that
+    re-run (`twin.loop.replay`, `twin.correction.rerun`)."""
+    loads_follow_rings: bool = True
+    """The values are factors on nominal values that follow the twin's rings every solver
+    step (`Correction.loads_follow_rings`); False: held for the window."""
 
     def correct(self, features: WindowFeatures) -> Correction:
         nominal = np.asarray(features.nominal, dtype=float)
@@ -335,7 +348,8 @@ class BpnnCorrection:
                 anchor = fallback[i:i + 1] if self.model.anchored else None
                 values[i] = float(self.model.predict(output, x, anchor)[0])
         values = limit_to_nominal(values, nominal, self.guards)
-        return Correction.relative_to(values, features.previous)
+        return Correction.relative_to(values, features.previous,
+                                      loads_follow_rings=self.loads_follow_rings)
 
 
 def make_corrector(

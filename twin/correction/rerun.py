@@ -7,9 +7,10 @@ whole window k−1 is known, so a method may re-run that window from its start f
 the recorded speed, step by step, and start window k from the re-run's end field and
 read its errors off the re-run instead of the forecast that missed the input.
 
-A run's window 0 is re-run the same way (`first_window_at_speed`): its loads were held
-at the cold start's temperatures while the rings warmed, and the re-run's loads follow its
-own temperatures every `LOAD_UPDATE_STEPS` (every solver step).
+A run's window 0 whose loads were held (a correction without `loads_follow_rings`) is
+re-run the same way (`first_window_at_speed`): they were held at the cold start's
+temperatures while the rings warmed, and the re-run's loads follow its own temperatures
+every `LOAD_UPDATE_STEPS` (every solver step), as every window's do by default.
 
 One implementation serves every method that does it: the `estimator`
 (`twin.estimation.method`, with its analysed factors) and the loop's state correction for

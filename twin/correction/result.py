@@ -51,8 +51,9 @@ class Correction:
     """The window's bearing heat and contact resistance follow the twin's own ring and
     sleeve temperatures every solver step (`twin.correction.rerun.LOAD_UPDATE_STEPS`), as the
     spindle's do: the values above are then factors on the nominal values at the window's
-    start field, re-applied to the nominal values at each piece's start.  False: held for
-    the whole window (the paper's methods: every 60 s the boundary conditions are set)."""
+    start field, re-applied to the nominal values at each piece's start (every method's
+    default, `twin.loop.replay`).  False: the values held for the whole window, the paper's
+    literal per-window boundary conditions (one load step per deck)."""
 
     @property
     def values(self) -> BoundaryValues:

@@ -40,7 +40,9 @@ def simulate_for_training(run, model) -> list[SimulatedRun]:  # noqa: ANN001
     out = []
     for seed, (drive, spread) in enumerate(TRAINING_PASSES):
         fit = WindowFit(run, model, drive_spread=spread, seed=seed, drive=drive)
-        result = replay_method(run, model, fit, keep_fields=False)
+        # straight on twin.fem: training needs no decks
+        result = replay_method(run, model, fit, solver=direct_window_solver(model),
+                               keep_fields=False)
         out.append(_simulated(run, result, np.array(fit.fitted), np.array(fit.anchors),
                               np.array(fit.anchored_inputs)))
     return out

@@ -46,7 +46,7 @@ from twin.contract import STEP_S, STEPS_PER_WINDOW
 from twin.correction.features import OUTPUTS, WindowFeatures, correction_factors
 from twin.correction.methods import ratio_anchor
 from twin.correction.result import Correction
-from twin.loop.replay import direct_window_solver
+from twin.loop.replay import direct_window_solver, solve_following_rings
 from twin.runs import RecordedRun
 from twin.spindle.model import SpindleModel
 
@@ -124,7 +124,9 @@ class WindowFit:
         if self.drive_spread > 0:
             scatter = self._rng.normal(0.0, self.drive_spread, 4) * DRIVE_SPREAD_WEIGHTS
             driven = driven * np.exp(scatter)
-        return Correction.relative_to(driven, f.previous)
+        # the twin advances as every method's twin does: the values are factors on the
+        # nominal values, which follow its rings every solver step
+        return Correction.relative_to(driven, f.previous, loads_follow_rings=True)
 
     def _fit(self, f: WindowFeatures, nominal: np.ndarray) -> np.ndarray:
         times = f.start_s + STEP_S * np.arange(1, STEPS_PER_WINDOW + 1)
@@ -136,13 +138,17 @@ class WindowFit:
             return theta
         weight = (self.noise_C / self.prior_spread) ** 2
         for _ in range(self.iterations):
-            base = self._window(f, nominal * np.exp(theta))
-            residual = (base - target)[seen]
+            # the residual from the window as the loop runs it (loads following the rings),
+            # the sensitivities from windows with the loads held: a fifth of the cost, and
+            # Gauss-Newton needs only their direction (the heat's feedback through the ring
+            # changes them by a few per cent)
+            residual = (self._window(f, nominal, theta, follow=True) - target)[seen]
+            base = self._window(f, nominal, theta)
             jacobian = np.empty((residual.size, 4))
             for j in range(4):
                 probe = theta.copy()
                 probe[j] += self.step
-                jacobian[:, j] = (self._window(f, nominal * np.exp(probe)) - base)[seen] / self.step
+                jacobian[:, j] = (self._window(f, nominal, probe) - base)[seen] / self.step
             normal = jacobian.T @ jacobian + weight * np.eye(4)
             step = np.linalg.solve(normal, -jacobian.T @ residual - weight * theta)
             # a window of few valid samples (dropouts, spikes) can throw Gauss-Newton far off:
@@ -150,9 +156,16 @@ class WindowFit:
             theta = np.clip(theta + step, -LOG_FACTOR_LIMIT, LOG_FACTOR_LIMIT)
         return theta
 
-    def _window(self, f: WindowFeatures, values: np.ndarray) -> np.ndarray:
-        """T1..T4 of the twin over the window (15, 4) with these four values."""
+    def _window(self, f: WindowFeatures, nominal: np.ndarray, theta: np.ndarray,
+                follow: bool = False) -> np.ndarray:
+        """T1..T4 of the twin over the window (15, 4) with the log factors `theta` on the
+        nominal values: following the rings every step (`follow`) or held at `nominal`."""
         T, bc = f.twin_state
-        steps, _ = direct_window_solver(self.model)(bc, Correction(*values), T, f.start_s,
-                                                    f.window)
+        solver = direct_window_solver(self.model)
+        if follow:
+            steps = solve_following_rings(self.model, solver, T, f.start_s, f.window, bc,
+                                          np.exp(theta))
+        else:
+            steps, _ = solver(bc, Correction(*(nominal * np.exp(theta))), T, f.start_s,
+                              f.window)
         return (self.model.sensor_matrix[list(FIT_SENSORS)] @ steps.T).T
