@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "abd192f69926bd567a2f32f86b519a5ce11b9073a4524a44d2d58e3fb23906fe"
+BUNDLED_MODEL_SHA256 = "16b5bc6f97c4b6aeb1b5359280bc56bd279947570dcba33e39e4951c8af46d58"
 
 
 def _make_model():

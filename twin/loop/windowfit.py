@@ -14,10 +14,13 @@ runs it drove the contact resistance to 0.6× its true value, and networks train
 those targets lost deformation accuracy against the open loop.  The fit reads the heat
 error off the window itself.
 
-The fit: parameters θ are log factors on the nominal values, p = p_nominal · e^θ.  The
-window response is linear in the heat and mildly non-linear in the resistance, so two
-Gauss–Newton steps with forward-difference sensitivities (5 window solves each, 2.3 ms a
-window on the default mesh) converge.  A Gaussian prior θ ~ N(0, prior_spread²) against a
+The fit: parameters θ are log factors on the nominal values, p = p_nominal · e^θ, which
+follow the twin's rings every solver step as in the loop (`Correction.loads_follow_rings`).
+The window response is linear in the heat and mildly non-linear in the resistance, so two
+Gauss–Newton steps converge, each with the residual of one window run as the loop runs it
+and forward-difference sensitivities from five windows with the nominal values held at the
+window start (one factorization each instead of fifteen; the ring's feedback on the heat
+changes a sensitivity by a few per cent, which moves the steps, not where they end).  A Gaussian prior θ ~ N(0, prior_spread²) against a
 residual noise of `noise_C` keeps an unidentifiable value (a rear drop of a few tenths
 of a kelvin) near its nominal:
 
