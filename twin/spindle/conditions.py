@@ -42,7 +42,7 @@ from twin.physics import (
     rotating_disk_h,
 )
 from twin.physics.contact import harmonic_mean, thermal_interference_um
-from twin.spindle.spec import ConvectionSpec, SpindleSpec
+from twin.spindle.spec import BearingSpec, ConvectionSpec, SpindleSpec
 
 SIDES = ("front", "rear")
 
@@ -204,51 +204,124 @@ def film_coefficient(conv: ConvectionSpec, spec: SpindleSpec, speed_rpm: float,
     return max(h, conv.min_h_W_per_m2K)
 
 
+@dataclass(frozen=True)
+class BearingConstants:
+    """What Eq. 1 and Eq. 4/5 take from a bearing's spec apart from the operating point:
+    its volume and pitch diameter, and the fit of its outer ring in the sleeve at assembly
+    (pressure P0, resistance R0, Lamé stiffness per µm of interference)."""
+
+    spec: BearingSpec
+    volume_m3: float
+    pitch_diameter_mm: float
+    interface_radius_mm: float  # outer ring's outer radius
+    ring_expansion_per_K: float
+    sleeve_expansion_per_K: float
+    assembly_C: float
+    p0_MPa: float
+    r0_m2K_per_W: float
+    stiffness_MPa_per_um: float
+
+    @classmethod
+    def of(cls, spec: SpindleSpec, side: str) -> BearingConstants:
+        b = spec.bearings[side]
+        ring, sleeve = spec.material_of(b.outer_ring), spec.material_of(b.sleeve)
+        ring_box, sleeve_box = spec.region_box(b.outer_ring), spec.region_box(b.sleeve)
+        modulus = harmonic_mean(ring.youngs_modulus_GPa, sleeve.youngs_modulus_GPa)
+        conductivity = harmonic_mean(ring.conductivity_W_per_mK, sleeve.conductivity_W_per_mK)
+        radii = (ring_box.r_inner_mm, ring_box.r_outer_mm, sleeve_box.r_outer_mm)
+        p0 = fit_pressure_MPa(b.fit_interference_um, *radii, modulus)
+        return cls(
+            spec=b, volume_m3=spec.bearing_volume_m3(side),
+            pitch_diameter_mm=spec.pitch_diameter_mm(side),
+            interface_radius_mm=ring_box.r_outer_mm,
+            ring_expansion_per_K=ring.expansion_per_K,
+            sleeve_expansion_per_K=sleeve.expansion_per_K,
+            assembly_C=spec.spindle.assembly_temperature_C, p0_MPa=p0,
+            r0_m2K_per_W=contact_resistance_initial(b.roughness_um, conductivity, p0, modulus),
+            stiffness_MPa_per_um=fit_pressure_MPa(1.0, *radii, modulus),
+        )
+
+    def contact_resistance(self, ring_C: float, sleeve_C: float) -> float:
+        """R [m²K/W] of the outer ring / sleeve fit: Eq. 4 at the assembly pressure,
+        corrected by Eq. 5 for the thermal expansion of ring and sleeve."""
+        delta_um = thermal_interference_um(self.interface_radius_mm, ring_C - self.assembly_C,
+                                           sleeve_C - self.assembly_C,
+                                           self.ring_expansion_per_K,
+                                           self.sleeve_expansion_per_K)
+        return contact_resistance_thermal(
+            self.r0_m2K_per_W, self.p0_MPa, self.stiffness_MPa_per_um * delta_um,
+            min_pressure_fraction=self.spec.min_pressure_fraction)
+
+    def heat_density(self, speed_rpm: float, temperature_C: float) -> float:
+        """H [W/m³]: Palmgren power over the bearing volume (Eq. 1)."""
+        b = self.spec
+        power = bearing_heat_W(
+            speed_rpm, temperature_C, pitch_diameter_mm=self.pitch_diameter_mm, f0=b.f0,
+            nu40_mm2_s=b.lubricant_nu40_mm2_s, nu100_mm2_s=b.lubricant_nu100_mm2_s,
+            preload_N=b.preload_N, radial_load_N=b.radial_load_N,
+            contact_angle_deg=b.contact_angle_deg, static_load_rating_N=b.static_load_rating_N,
+            static_axial_factor_Y0=b.static_axial_factor_Y0,
+        )
+        return power / self.volume_m3
+
+
+@dataclass(frozen=True)
+class SpecConstants:
+    """The parts of the nominal conditions that follow from the spec alone (bearing and
+    motor volumes, pitch diameters, the fits at assembly): computed once per spec
+    (`SpindleModel.constants`) instead of on every solver step that re-evaluates the
+    bearing values."""
+
+    bearings: dict[str, BearingConstants]
+    motor_volume_m3: dict[str, float]
+
+    @classmethod
+    def of(cls, spec: SpindleSpec) -> SpecConstants:
+        m = spec.motor
+        return cls(bearings={s: BearingConstants.of(spec, s) for s in SIDES},
+                   motor_volume_m3={m.rotor: spec.region_volume_m3(m.rotor),
+                                    m.stator: spec.region_volume_m3(m.stator)})
+
+
+def _spec_and_constants(model) -> tuple[SpindleSpec, SpecConstants]:  # noqa: ANN001
+    """A SpindleModel's spec and its constants (computed once, with the model); a bare
+    SpindleSpec's, computed now."""
+    if isinstance(model, SpindleSpec):
+        return model, SpecConstants.of(model)
+    return model.spec, model.constants
+
+
 def contact_resistance(spec: SpindleSpec, side: str, ring_C: float, sleeve_C: float) -> float:
     """R [m²K/W] of a bearing's outer ring / sleeve fit: Eq. 4 at the assembly pressure,
     corrected by Eq. 5 for the thermal expansion of ring and sleeve (twin.physics.contact)."""
-    b = spec.bearings[side]
-    ring, sleeve = spec.material_of(b.outer_ring), spec.material_of(b.sleeve)
-    ring_box, sleeve_box = spec.region_box(b.outer_ring), spec.region_box(b.sleeve)
-    modulus = harmonic_mean(ring.youngs_modulus_GPa, sleeve.youngs_modulus_GPa)
-    conductivity = harmonic_mean(ring.conductivity_W_per_mK, sleeve.conductivity_W_per_mK)
-    radii = (ring_box.r_inner_mm, ring_box.r_outer_mm, sleeve_box.r_outer_mm)
-    p0 = fit_pressure_MPa(b.fit_interference_um, *radii, modulus)
-    r0 = contact_resistance_initial(b.roughness_um, conductivity, p0, modulus)
-    assembly = spec.spindle.assembly_temperature_C
-    delta_um = thermal_interference_um(ring_box.r_outer_mm, ring_C - assembly,
-                                       sleeve_C - assembly, ring.expansion_per_K,
-                                       sleeve.expansion_per_K)
-    stiffness = fit_pressure_MPa(1.0, *radii, modulus)  # MPa per µm of radial interference
-    return contact_resistance_thermal(r0, p0, stiffness * delta_um,
-                                      min_pressure_fraction=b.min_pressure_fraction)
+    return BearingConstants.of(spec, side).contact_resistance(ring_C, sleeve_C)
 
 
 def bearing_heat_density(spec: SpindleSpec, side: str, speed_rpm: float,
                          temperature_C: float) -> float:
     """H [W/m³] of a bearing: Palmgren power over the bearing volume (Eq. 1)."""
-    b = spec.bearings[side]
-    power = bearing_heat_W(
-        speed_rpm, temperature_C, pitch_diameter_mm=spec.pitch_diameter_mm(side), f0=b.f0,
-        nu40_mm2_s=b.lubricant_nu40_mm2_s, nu100_mm2_s=b.lubricant_nu100_mm2_s,
-        preload_N=b.preload_N, radial_load_N=b.radial_load_N,
-        contact_angle_deg=b.contact_angle_deg, static_load_rating_N=b.static_load_rating_N,
-        static_axial_factor_Y0=b.static_axial_factor_Y0,
-    )
-    return power / spec.bearing_volume_m3(side)
+    return BearingConstants.of(spec, side).heat_density(speed_rpm, temperature_C)
 
 
 def bearing_values(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or SpindleSpec
                    T_bearings_C: float | tuple[float, float],
                    T_sleeves_C: float | tuple[float, float] | None = None) -> dict[str, float]:
     """Nominal H_front, H_rear (Eq. 1, W/m³) and R_front, R_rear (Eq. 4/5, m²K/W) at the
-    given outer-ring (and sleeve; default: the ring's) temperatures, °C."""
-    spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
+    given outer-ring (and sleeve; default: the ring's) temperatures, °C.  Pass the
+    SpindleModel where it is called per step: its constants are computed once."""
+    return _bearing_values(_spec_and_constants(model)[1], speed_rpm, T_bearings_C,
+                           T_sleeves_C)
+
+
+def _bearing_values(constants: SpecConstants, speed_rpm: float,
+                    T_bearings_C: float | tuple[float, float],
+                    T_sleeves_C: float | tuple[float, float] | None) -> dict[str, float]:
     T_b = _pair(T_bearings_C, math.nan)
     T_s = _pair(T_sleeves_C, math.nan)
     T_s = {k: (T_b[k] if math.isnan(v) else v) for k, v in T_s.items()}
-    out = {f"H_{s}": bearing_heat_density(spec, s, speed_rpm, T_b[s]) for s in SIDES}
-    out.update({f"R_{s}": contact_resistance(spec, s, T_b[s], T_s[s]) for s in SIDES})
+    bearings = constants.bearings
+    out = {f"H_{s}": bearings[s].heat_density(speed_rpm, T_b[s]) for s in SIDES}
+    out.update({f"R_{s}": bearings[s].contact_resistance(T_b[s], T_s[s]) for s in SIDES})
     return out
 
 
@@ -270,23 +343,24 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
                        ) -> BoundaryConditions:
     """Nominal boundary conditions at an operating point.
 
-    `model`: a SpindleModel or a SpindleSpec (only the spec is used; volumes come from
-    the spec's rectangles, which the linear mesh reproduces exactly).
+    `model`: a SpindleModel or a SpindleSpec (only the spec is used, and the constants a
+    SpindleModel holds of it; volumes come from the spec's rectangles, which the linear
+    mesh reproduces exactly).
     `film_ambient_C`: the ambient at which the natural-convection and radiation film
     coefficients are evaluated (default: `ambient_C`, which is always the sink temperature).
     """
-    spec: SpindleSpec = model if isinstance(model, SpindleSpec) else model.spec
+    spec, constants = _spec_and_constants(model)
     check_operating_point(spec, speed_rpm, ambient_C, coolant_C)
     coolant = ambient_C if coolant_C is None else float(coolant_C)
-    values = bearing_values(spec, speed_rpm,
-                            ambient_C if T_bearings_C is None else T_bearings_C, T_sleeves_C)
+    values = _bearing_values(constants, speed_rpm,
+                             ambient_C if T_bearings_C is None else T_bearings_C, T_sleeves_C)
 
     m = spec.motor
     loss = motor_loss_W(speed_rpm, rated_power_W=m.rated_power_W,
                         base_speed_rpm=m.base_speed_rpm, load_fraction=m.load_fraction,
                         efficiency=m.efficiency, heat_share=m.heat_share)
     split = motor_heat_split_W(loss)
-    volumes = {m.rotor: spec.region_volume_m3(m.rotor), m.stator: spec.region_volume_m3(m.stator)}
+    volumes = dict(constants.motor_volume_m3)
     motor_heat = {m.rotor: split["rotor"] / volumes[m.rotor],
                   m.stator: split["stator"] / volumes[m.stator]}
 
@@ -301,6 +375,6 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
         motor_heat=motor_heat, convection=convection,
         bearing_regions={s: spec.bearing_regions(s) for s in SIDES},
         interfaces={s: spec.bearings[s].interface for s in SIDES},
-        bearing_volume_m3={s: spec.bearing_volume_m3(s) for s in SIDES},
+        bearing_volume_m3={s: constants.bearings[s].volume_m3 for s in SIDES},
         motor_volume_m3=volumes,
     )

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from twin.contract import SENSOR_NAMES
 from twin.fem import AxiMesh, ElasticProblem, Material, ThermalProblem
+from twin.spindle.conditions import SpecConstants
 from twin.spindle.spec import DEFAULT_SPEC_PATH, PROBE_NAMES, SpindleSpec, load_spec
 
 DEFAULT_MESH_PATH = DEFAULT_SPEC_PATH.with_suffix(".msh")
@@ -84,6 +85,9 @@ class SpindleModel:
     sensor_matrix  (5 × n_thermal_dofs) sparse: T1..T5 = sensor_matrix @ T
     probe_vectors  (2 × n_thermal_dofs): nose (axial z, radial r) displacement in m is
                    probe_vectors @ (T − T_ref)
+    constants      twin.spindle.conditions.SpecConstants of `spec` (bearing and motor
+                   volumes, fit constants), computed with the model: the per-step bearing
+                   values (`bearing_values_at`) take them from here
     """
 
     spec: SpindleSpec
@@ -96,9 +100,13 @@ class SpindleModel:
     sensor_matrix: sp.csr_matrix
     probe_vectors: np.ndarray
     order: int = 1
+    constants: SpecConstants = field(init=False, repr=False, compare=False)
 
     sensor_names = SENSOR_NAMES
     probe_names = PROBE_NAMES
+
+    def __post_init__(self) -> None:
+        self.constants = SpecConstants.of(self.spec)
 
     @classmethod
     def load(cls, spec_path: str | Path | None = None, size_factor: float = 1.0,

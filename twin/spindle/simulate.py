@@ -119,13 +119,13 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
     conditions: list[BoundaryConditions] = []
     coolant = ambient_C if coolant_C is None else coolant_C
 
-    cold = nominal_conditions(spec, speed_rpm, ambient_C, coolant)  # the start, at ambient
+    cold = nominal_conditions(model, speed_rpm, ambient_C, coolant)  # the start, at ambient
     k = 0
     while k < n:
         if not conditions or update_every_s is not None:
             # only the bearing values follow the rings: films and motor loss depend on the
             # speed and the ambient alone (and sharing them keeps a day's updates small)
-            bc = cold.with_values(**bearing_values_at(spec, speed_rpm, sensors[k])
+            bc = cold.with_values(**bearing_values_at(model, speed_rpm, sensors[k])
                                   ) if conditions else cold
             conditions.append(bc)
             loads = bc.to_thermal_loads()
