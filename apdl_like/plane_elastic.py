@@ -43,8 +43,8 @@ def elasticity_matrix(E: np.ndarray, nu: np.ndarray, mode: str) -> np.ndarray:
 
 def _strain(phi, component: int, mode: str, x: np.ndarray) -> list:  # noqa: ANN001
     """(ε1, ε2, ε3, γ12) of the test/trial function phi in displacement `component`."""
-    zero = 0.0 * phi.value
-    hoop = phi.value / x if mode == "axisymmetric" else zero
+    zero = 0.0 * np.asarray(phi)
+    hoop = np.asarray(phi) / x if mode == "axisymmetric" else zero
     if component == 0:
         return [phi.grad[0], zero, hoop, phi.grad[1]]
     return [zero, phi.grad[1], zero, phi.grad[0]]
@@ -146,7 +146,7 @@ def solve_elastic(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
                 Kab = stiffness_form(mode, ia, ib).assemble(b, E=E_q, nu=nu_q)
                 blocks[ib][ia] = S @ Kab @ S.T
             f[ia * n:(ia + 1) * n] += S @ thermal_load_form(mode, ia).assemble(
-                b, E=E_q, nu=nu_q, alpha=a_q, dT=b.interpolate(dT_local).value)
+                b, E=E_q, nu=nu_q, alpha=a_q, dT=np.asarray(b.interpolate(dT_local)))
         A = A + sp.bmat(blocks).tocsr()
     P = coupling_map(2 * n, couplings)
     u = solve_constrained(A.tocsr(), f, fixed, P)
@@ -177,12 +177,12 @@ def nodal_stress(mesh: PlaneMesh, mode: str, E: np.ndarray, nu: np.ndarray,
         b = Basis(part.basis.mesh, part.basis.elem, quadrature=(ref, np.ones(corners)))
         loc = part.local_dofs
         ur, uz = b.interpolate(disp[0][loc]), b.interpolate(disp[1][loc])
-        T = b.interpolate(dT[loc]).value
-        x = b.global_coordinates().value[0]
+        T = np.asarray(b.interpolate(dT[loc]))
+        x = np.asarray(b.global_coordinates())[0]
         eps = [ur.grad[0], uz.grad[1], np.zeros_like(x), ur.grad[1] + uz.grad[0]]
         if mode == "axisymmetric":
             on_axis = np.abs(x) < 1e-12 * max(1.0, float(np.abs(x).max()))
-            eps[2] = np.where(on_axis, ur.grad[0], ur.value / np.where(on_axis, 1.0, x))
+            eps[2] = np.where(on_axis, ur.grad[0], np.asarray(ur) / np.where(on_axis, 1.0, x))
         el = part.elements
         D = elasticity_matrix(E[el][:, None], nu[el][:, None], mode)
         th = alpha[el][:, None] * T

@@ -291,7 +291,7 @@ class PlaneThermal:
     # ---------------------------------------------------------------- pieces
     def _cell_field(self, k: int, props: list[Property], T_local: np.ndarray) -> np.ndarray:
         """A per-cell property at the quadrature points of part k, at temperature T."""
-        Tq = self.mesh.parts[k].basis.interpolate(T_local).value
+        Tq = np.asarray(self.mesh.parts[k].basis.interpolate(T_local))
         out = np.empty_like(Tq)
         for m, cells in self.groups[k].items():
             out[cells] = props[m](Tq[cells])
@@ -307,8 +307,8 @@ class PlaneThermal:
         ax = self.mesh.axisymmetric
         for k, part in enumerate(self.mesh.parts):
             b = part.basis
-            T0q = b.interpolate(T0[part.local_dofs]).value
-            T1q = b.interpolate(T1[part.local_dofs]).value
+            T0q = np.asarray(b.interpolate(T0[part.local_dofs]))
+            T1q = np.asarray(b.interpolate(T1[part.local_dofs]))
             c = np.empty_like(T1q)
             for m, cells in self.groups[k].items():
                 a, z = T0q[cells], T1q[cells]
@@ -460,7 +460,7 @@ class PlaneThermal:
         b = Basis(part.basis.mesh, part.basis.elem, elements=cells)
         T_local = T[part.local_dofs]
         mats = {m: np.nonzero(np.isin(cells, c))[0] for m, c in self.groups[k].items()}
-        Tq = b.interpolate(T_local).value
+        Tq = np.asarray(b.interpolate(T_local))
 
         def field(props: list[Property]) -> np.ndarray:
             out = np.empty_like(Tq)
@@ -505,7 +505,7 @@ class PlaneThermal:
             g = u.grad[:, :, 0].T  # (cells, 2)
             grad[part.elements] = g
             for m, cells in self.groups[k].items():
-                Tc = u.value[cells]  # (cells, 1): the properties take quadrature-point arrays
+                Tc = np.asarray(u)[cells]  # (cells, 1): the properties take quadrature-point arrays
                 kx = np.broadcast_to(inputs.kxx[m](Tc), Tc.shape)[:, 0]
                 ky = np.broadcast_to(inputs.kyy[m](Tc), Tc.shape)[:, 0]
                 flux[part.elements[cells]] = -np.column_stack([kx * g[cells, 0],

@@ -143,9 +143,9 @@ class ElasticProblem:
             u = flat
         uh = self.basis.interpolate(u)
         du = uh.grad
-        r = self.basis.global_coordinates().value[0]
-        eth = self._alpha * (self.temperature_basis.interpolate(T).value - self.T_ref)
-        e_rr, e_zz, e_tt = du[0, 0] - eth, du[1, 1] - eth, uh.value[0] / r - eth
+        r = np.asarray(self.basis.global_coordinates())[0]
+        eth = self._alpha * (np.asarray(self.temperature_basis.interpolate(T)) - self.T_ref)
+        e_rr, e_zz, e_tt = du[0, 0] - eth, du[1, 1] - eth, np.asarray(uh)[0] / r - eth
         g_rz = du[0, 1] + du[1, 0]
         tr = e_rr + e_zz + e_tt
         qp = {

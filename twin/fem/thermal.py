@@ -194,7 +194,7 @@ class ThermalProblem:
         """∫ value·v 2πr over a (facet) basis; `unit` is the cached load of value = 1."""
         if not callable(value):
             return float(value) * unit
-        x = basis.global_coordinates().value
+        x = np.asarray(basis.global_coordinates())
         return asm(unit_load_weighted, basis, s=field_values(value, x, what))
 
     def load_parts(self, loads: ThermalLoads) -> tuple[dict[str, float], dict[str, np.ndarray]]:
