@@ -18,7 +18,6 @@ from collections.abc import Mapping
 from functools import partial
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from skfem import Basis, FacetBasis, asm
@@ -93,6 +92,14 @@ class ThermalProblem:
             if mesh.interfaces
             else None
         )
+        # each interface's block on the diagonal of the update's W (its columns in U)
+        ends = np.cumsum([self._interface_mass[n].shape[0] for n in mesh.interfaces])
+        self._interface_blocks = {n: slice(int(e) - self._interface_mass[n].shape[0], int(e))
+                                  for n, e in zip(mesh.interfaces, ends, strict=True)}
+        # Σ h M_film·1 of the heat balance per set of film coefficients (they change with
+        # the speed only, the balance is asked for every step): the newest few, as the
+        # factorizations in `contact_update`
+        self._film_rows: dict[tuple[tuple[str, float], ...], np.ndarray] = {}
 
     # ------------------------------------------------------------ operators
     def _check_materials(self) -> None:
@@ -250,12 +257,16 @@ class ThermalProblem:
             raise ValueError(f"theta must lie in [0.5, 1], got {theta!r}")
         dt, theta = float(dt), float(theta)
         coeff, parts = self.load_parts(loads)
-        k_data = self.conduction_data + self.ops.data(coeff)
         c_data = self.capacity_data / dt
         dofs, values = self.fixed(loads)
+        # K on the pattern only where it is used: backward Euler's explicit side is C/Δt
+        # (C/Δt − 0·K is C/Δt to the bit), and a solver by low-rank update builds its own
+        k_data = None
+        if theta != 1.0 or dofs.size or self.contact_update is None:
+            k_data = self.conduction_data + self.ops.data(coeff)
         return ThermalStepper(
             self._step_solver(coeff, c_data, k_data, (dofs, values), dt, theta),
-            self.ops.csr(c_data - (1.0 - theta) * k_data),
+            self.ops.csr(c_data if k_data is None else c_data - (1.0 - theta) * k_data),
             sum(parts.values()),
             dt,
             theta,
@@ -266,12 +277,13 @@ class ThermalProblem:
         self,
         coeff: dict[str, float],
         c_data: np.ndarray,
-        k_data: np.ndarray,
+        k_data: np.ndarray | None,
         fixed: tuple[np.ndarray, np.ndarray],
         dt: float,
         theta: float,
     ) -> DirichletSolver | WoodburySolver:
-        """C/Δt + θK factorized (c_data = C/Δt, k_data = K on the shared pattern).
+        """C/Δt + θK factorized (c_data = C/Δt, k_data = K on the shared pattern, needed
+        with fixed temperatures or without contact interfaces only).
 
         Without fixed temperatures, C/Δt + θK less its contact terms is factorized once per
         distinct set of film coefficients (they change with speed only), and the contact
@@ -282,6 +294,7 @@ class ThermalProblem:
         """
         dofs, values = fixed
         if dofs.size or self.contact_update is None:
+            assert k_data is not None
             return DirichletSolver(self.ops.csr(c_data + theta * k_data), dofs, values)
         films = {k: v for k, v in coeff.items() if k.startswith("film:")}
 
@@ -289,12 +302,10 @@ class ThermalProblem:
             k_base = self.conduction_data + self.ops.data(films)
             return DirichletSolver(self.ops.csr(c_data + theta * k_base), dofs, values)
 
-        W = sla.block_diag(
-            *[
-                theta * coeff[f"interface:{n}"] * self._interface_mass[n]
-                for n in self.mesh.interfaces
-            ]
-        )
+        size = self.contact_update.U.shape[1]
+        W = np.zeros((size, size))  # block diagonal, as scipy's block_diag but no checks
+        for n, block in self._interface_blocks.items():
+            W[block, block] = theta * coeff[f"interface:{n}"] * self._interface_mass[n]
         key = (dt, theta, tuple(sorted(films.items())))
         return self.contact_update.solver(key, base, W)
 
@@ -327,10 +338,22 @@ class ThermalProblem:
             capacity=self.capacity_vector,
             sources_W=float(parts["sources"].sum()),
             flux_W=float(parts["flux"].sum()),
-            film=self.ops.matrix(films) @ np.ones(self.n_dofs),
+            film=self._film_row_sums(films),
             film_load_W=float(parts["convection"].sum()),
             **fixed,
         )
+
+    def _film_row_sums(self, films: dict[str, float]) -> np.ndarray:
+        """Σ h M_film·1 (W/K per dof) of film coefficients `films`; read-only.  Keyed in
+        the films' order, the order of the sum: a hit is the vector made anew, to the bit."""
+        key = tuple(films.items())
+        rows = self._film_rows.get(key)
+        if rows is None:
+            if len(self._film_rows) >= 8:  # bound memory: drop the oldest
+                self._film_rows.pop(next(iter(self._film_rows)))
+            rows = self._film_rows[key] = self.ops.matrix(films) @ np.ones(self.n_dofs)
+            rows.flags.writeable = False
+        return rows
 
     def energy_balance(
         self,
