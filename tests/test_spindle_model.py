@@ -73,3 +73,33 @@ def test_impossible_operating_points(spindle_model, speed, field):
 def test_bad_ambient(spindle_model):
     with pytest.raises(InputError, match="ambient_C"):
         nominal_conditions(spindle_model, 1000.0, 500.0)
+
+
+def test_loads_kept_between_steps_give_the_bits_a_fresh_model_gives(spindle_model):
+    """The thermal problem keeps a few film-load vectors and heat-balance film sums between
+    load sets (twin.fem.thermal) and the model its spec's bearing constants
+    (SpindleModel.constants): after other load sets, a step and its heat balance under a
+    load set are what a model that never saw another gives, to the bit; a load set that
+    differs from a kept one only in a bulk temperature or a film is not served from it."""
+    from dataclasses import replace
+
+    from twin.spindle import SpindleModel
+    from twin.spindle.conditions import bearing_values_at
+
+    def step(model, bc):  # noqa: ANN001, ANN202
+        stepper = model.thermal.transient(bc.to_thermal_loads(), dt=2.0, theta=1.0)
+        T0 = np.full(model.n_dofs, 31.0)
+        T1 = stepper.step(T0)
+        return T1, stepper.energy_balance(T0, T1)
+
+    a = nominal_conditions(spindle_model, 9000.0, 25.0)
+    a = a.with_values(**bearing_values_at(spindle_model, 9000.0, [33.0, 31.0, 30.0, 29.0]))
+    warmer = replace(a, convection={k: (h, t + 2.0) for k, (h, t) in a.convection.items()})
+    filmier = a.scaled({"film_coolant": 1.2})
+    cases = (a, warmer, filmier, a)
+    seen = [step(spindle_model, bc) for bc in cases]
+    for i in (0, 1, 2):  # each against a model that solves that load set first
+        fresh = step(SpindleModel.load(), cases[i])
+        for got in (seen[i], seen[3]) if i == 0 else (seen[i],):
+            np.testing.assert_array_equal(got[0], fresh[0])
+            assert got[1] == fresh[1]

@@ -100,6 +100,7 @@ class ThermalProblem:
         # the speed only, the balance is asked for every step): the newest few, as the
         # factorizations in `contact_update`
         self._film_rows: dict[tuple[tuple[str, float], ...], np.ndarray] = {}
+        self._convection_loads: dict[tuple[tuple[str, float, float], ...], np.ndarray] = {}
 
     # ------------------------------------------------------------ operators
     def _check_materials(self) -> None:
@@ -210,7 +211,7 @@ class ThermalProblem:
         Returns (coefficients of the unit operators, {"sources", "flux", "convection"}).
         """
         coeff: dict[str, float] = {}
-        parts = {k: np.zeros(self.n_dofs) for k in ("sources", "flux", "convection")}
+        parts = {k: np.zeros(self.n_dofs) for k in ("sources", "flux")}
         for region, q in loads.sources.items():
             unit = self.source_vector(region)
             basis = self._region_bases[region] if callable(q) else None
@@ -220,20 +221,41 @@ class ThermalProblem:
             parts["flux"] += self._weighted_load(
                 q, self.facet_basis(boundary), unit, f"boundary {boundary!r}"
             )
-        for boundary, (h, t_inf) in loads.convection.items():
+        for boundary, (h, _) in loads.convection.items():
             coeff[self._boundary_terms(boundary)] = float(h)
-            parts["convection"] += float(h) * self._weighted_load(
-                t_inf,
-                self.facet_basis(boundary),
-                self._facet_loads[boundary],
-                f"boundary {boundary!r}",
-            )
+        parts["convection"] = self._convection_load(loads.convection)
         for name in loads.contact_resistance:
             self.mesh.interface(name)
         for name in self.mesh.interfaces:
             r = loads.contact_resistance.get(name, self.PERFECT_CONTACT_R)
             coeff[f"interface:{name}"] = 1.0 / float(r)
         return coeff, parts
+
+    def _convection_load(self, convection: dict[str, tuple[float, float]]) -> np.ndarray:
+        """Σ h ∫ T∞ v 2πr ds over the convective boundaries (W; read-only).  With constant
+        bulk temperatures it is kept per set of (h, T∞) in the boundaries' order, the order
+        of the sum (a loop re-evaluating the bearing loads every step keeps its films):
+        a hit is the vector made anew, to the bit."""
+        key = None
+        if not any(callable(t_inf) for _, t_inf in convection.values()):
+            key = tuple((b, float(h), float(t)) for b, (h, t) in convection.items())
+        load = None if key is None else self._convection_loads.get(key)
+        if load is None:
+            load = np.zeros(self.n_dofs)
+            for boundary, (h, t_inf) in convection.items():
+                self._boundary_terms(boundary)
+                load += float(h) * self._weighted_load(
+                    t_inf,
+                    self.facet_basis(boundary),
+                    self._facet_loads[boundary],
+                    f"boundary {boundary!r}",
+                )
+            load.flags.writeable = False
+            if key is not None:
+                if len(self._convection_loads) >= 8:  # bound memory: drop the oldest
+                    self._convection_loads.pop(next(iter(self._convection_loads)))
+                self._convection_loads[key] = load
+        return load
 
     def system(self, loads: ThermalLoads) -> tuple[np.ndarray, np.ndarray]:
         """Conductance data K (on the shared pattern, W/K) and load vector f (W)."""
