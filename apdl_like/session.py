@@ -167,9 +167,14 @@ class Session:
 
         Returns the temperature after every substep of the deck's load step, shape
         (n_substeps, n_dofs).  At `start_s` = 0 the deck is a new analysis (ANTYPE,TRANS),
-        which starts from TUNIF: `T` must then be uniform and becomes TUNIF.
+        which starts from TUNIF: `T` must then be uniform and becomes TUNIF.  The session's
+        results are this deck's only (`results`).
         """
         T = np.asarray(T, float)
+        # the deck needs no earlier deck's result (its start state is handed in): kept, a
+        # replay's session held one result per solver step (about 35 kB each) and every
+        # SOLVE counted its load step through all of them
+        self.state.solution.results = []
         if start_s == 0.0:
             if T.size and np.any(T != T[0]):
                 raise ValueError("a window at t = 0 starts from a uniform temperature (TUNIF)")

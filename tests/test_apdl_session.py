@@ -87,6 +87,10 @@ def test_window_decks_reuse_operators_and_match_the_fem_api(mesh):
     assert set(problem.ops._terms) == terms and set(problem._source_vectors) == sources
     assert s.state.solution.time == 120.0 and steps.shape == (15, problem.n_dofs)
     np.testing.assert_array_equal(steps[-1], s.state.solution.temperature)
+    # a window holds its own result only (the loop advances every 4 s step: kept, the
+    # results of a whole run piled up in the session)
+    assert [(r.load_step, r.time) for r in s.results] == [(1, 120.0)]
+    np.testing.assert_array_equal(s.results[0].temperature, steps[-1])
 
     # the same two windows through twin.fem directly, loads written by hand
     ref = ThermalProblem(mesh, mats)
