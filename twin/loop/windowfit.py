@@ -20,9 +20,9 @@ The window response is linear in the heat and mildly non-linear in the resistanc
 Gauss–Newton steps converge, each with the residual of one window run as the loop runs it
 and forward-difference sensitivities from five windows with the nominal values held at the
 window start (one factorization each instead of fifteen; the ring's feedback on the heat
-changes a sensitivity by a few per cent, which moves the steps, not where they end).  A Gaussian prior θ ~ N(0, prior_spread²) against a
-residual noise of `noise_C` keeps an unidentifiable value (a rear drop of a few tenths
-of a kelvin) near its nominal:
+changes a sensitivity by a few per cent, which moves the steps, not where they end).  A
+Gaussian prior θ ~ N(0, prior_spread²) against a residual noise of `noise_C` keeps an
+unidentifiable value (a rear drop of a few tenths of a kelvin) near its nominal:
 
     minimise  Σ (T_twin(θ) − T_meas)² / noise_C²  +  Σ θ² / prior_spread²
 
