@@ -185,3 +185,19 @@ def test_sensor_temperatures_are_continuous_after_a_cold_start(spindle_model, sp
         assert jumps.size == 0, (name, r.time_s[jumps + 1], change[jumps], change[jumps - 1])
     # from a uniform start at ambient, at constant speed, the rings only warm up
     assert np.all(np.diff(r.sensors_C[:, [0, 2]], axis=0) > 0)
+
+
+@pytest.mark.parametrize("every", ["inf", "1e300"])
+def test_simulate_field_interval_past_the_end_keeps_start_and_end(tmp_path, every):
+    # --field-every inf passed typer's x >= 0 bound and ended in an internal error
+    # (OverflowError converting the step count); any interval past the end keeps the
+    # start and end fields, as --field-every 0 does
+    from twin.cli import app
+
+    out = tmp_path / "run"
+    result = CliRunner().invoke(app, ["simulate", "--speed", "6000", "--minutes", "0.2",
+                                      "--ambient", "24", "--field-every", every,
+                                      "--out", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in (out / "fields").iterdir()) == ["step_00000.vtu",
+                                                                   "step_00003.vtu"]

@@ -99,7 +99,10 @@ def simulate(model: SpindleModel, speed_rpm: float, minutes: float, ambient_C: f
         if not update_every_s > 0:
             raise ValueError(f"update_every_s must be positive, got {update_every_s}")
         steps_per_update = max(1, int(round(update_every_s / dt)))
-    field_every = None if field_every_s is None else max(1, int(round(field_every_s / dt)))
+    field_every = None
+    if field_every_s is not None:
+        # an interval past the run's end (inf too) keeps the start and the end only
+        field_every = max(1, int(round(min(field_every_s, n_steps * dt) / dt)))
 
     start = time.perf_counter()
     thermal = model.thermal
