@@ -12,6 +12,7 @@ from pathlib import Path
 
 import typer
 
+from twin.cli.inputs import MAX_SEED
 from twin.errors import InputError, report_errors
 
 drift_app = typer.Typer(
@@ -89,7 +90,8 @@ def fit(
         "auto", "--sensors", help="auto (best of every correlation cluster), K (best K of "
         "those; more than there are clusters is an error), all, or a comma-separated list "
         "of temperature columns."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the network weights and k-means."),
+    seed: int = typer.Option(0, "--seed", min=0, max=MAX_SEED,
+                             help="Seed of the network weights and k-means."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Fit a drift model; validation leaves one time block out at a time (never shuffled)."""

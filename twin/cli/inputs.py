@@ -52,6 +52,11 @@ finer, the work grows without a useful bound."""
 MAX_SIZE_FACTOR = 100.0
 """Mesh element size multiplier: above this the spindle is no longer resolved at all."""
 
+MAX_SEED = 2**32 - 1
+"""Largest --seed of the commands that seed torch or scikit-learn (k-means takes seeds
+below 2**32, torch below 2**64): beyond it a run ended in an internal error after its
+work, where typer can refuse the option before any."""
+
 
 def bundled_runs_dir() -> Path:
     """Where the example recorded runs shipped with the twin are (package data)."""

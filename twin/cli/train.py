@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from twin.cli.inputs import MAX_SEED
 from twin.loop.target_rules import TargetRule
 
 
@@ -15,7 +16,8 @@ def train(
                                       "a folder stands for the runs in it, as in replay."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
     epochs: int = typer.Option(5000, "--epochs", min=1, help="Maximum Rprop epochs."),
-    seed: int = typer.Option(0, "--seed", min=0, help="Seed of the 80/20 split and the weights."),
+    seed: int = typer.Option(0, "--seed", min=0, max=MAX_SEED,
+                             help="Seed of the 80/20 split and the weights."),
     paper_config: bool = typer.Option(
         False, "--paper-config",
         help="Save the paper's configuration (the paper's six inputs, linear hidden, "
