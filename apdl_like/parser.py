@@ -297,7 +297,7 @@ def read_deck(path: Path, shown: str | None = None) -> Program:
     except OSError as exc:
         raise ApdlError(f"cannot read deck: {exc.strerror}", file=name) from None
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")  # a Windows editor's byte-order mark is no command
     except UnicodeDecodeError:
         text = data.decode("latin-1")  # decks from old tools; every byte decodes
     return parse_deck(text, name)

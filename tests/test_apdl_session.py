@@ -333,3 +333,14 @@ def test_spindle_session_refuses_what_twin_fem_cannot_solve(mesh):
         with pytest.raises(ApdlError, match="material 1"):
             s.run_text(f"/PREP7\n{change}\nFINISH\n" + window_deck(loadset(0), s.layout),
                        "w.inp")
+
+
+def test_a_deck_saved_with_a_utf8_bom_runs(tmp_path):
+    # Notepad and other Windows editors start a UTF-8 file with a byte-order mark: the
+    # deck stopped at line 1 ("not a command or assignment: '\ufeff/PREP7'"), while the
+    # run CSVs beside it were read with their BOM; a deck it /INPUTs may carry one too
+    (tmp_path / "sub.inp").write_bytes(b"\xef\xbb\xbfB = A + 1\r\n")
+    (tmp_path / "deck.inp").write_bytes(b"\xef\xbb\xbf/PREP7\r\nA = 2\r\n/INPUT,sub,inp\r\n")
+    s = Session(base_dir=tmp_path)
+    s.run_file(tmp_path / "deck.inp")
+    assert s.params["A"] == 2.0 and s.params["B"] == 3.0
