@@ -422,3 +422,17 @@ def test_open_loop_replay_of_the_twins_own_simulation_reproduces_it(tmp_path, sp
                                                                   loads_follow_rings=False),
                          keep_fields=False)
     assert np.abs(held.T_twin_C - measured).max() > 1.0
+
+
+def test_snapshot_png_with_an_upper_case_suffix(spindle_model, tmp_path):
+    # twin snapshot takes --out S.PNG (its check is case-blind) but pyvista picks the
+    # format from the suffix as written: 'internal error: Unsupported extension .PNG'
+    from PIL import Image
+
+    from twin.loop.snapshot import render_snapshot
+
+    out = tmp_path / "S.PNG"
+    T = np.linspace(25.0, 40.0, spindle_model.n_dofs)
+    render_snapshot(spindle_model, T, out, section=True, window_size=(300, 200))
+    assert Image.open(out).format == "PNG"
+    assert [p.name for p in tmp_path.iterdir()] == ["S.PNG"]  # no temporary file left

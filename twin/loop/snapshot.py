@@ -113,7 +113,14 @@ def render_snapshot(
         ]
     try:
         with atomic_target(out_png) as tmp:
-            plotter.screenshot(str(tmp))
+            # pyvista picks the format from the suffix as written: S.PNG is no format to it
+            png = tmp.with_suffix(".png")
+            try:
+                plotter.screenshot(str(png))
+                png.replace(tmp)
+            finally:
+                if png != tmp:
+                    png.unlink(missing_ok=True)
     finally:
         plotter.close()
     return Path(out_png)
