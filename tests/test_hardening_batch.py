@@ -116,6 +116,27 @@ def test_report_lists_a_corrupt_accuracy_as_failed_instead_of_aborting(replayed,
     assert summary["failed"][0]["run"] == "b" and "unreadable" in summary["failed"][0]["error"]
 
 
+@pytest.mark.parametrize("metric, value", [
+    ("temperature_accuracy_pct", "99.1"),  # a hand-edited figure kept its quotes
+    ("deformation_accuracy_pct", True),
+    ("rmse_C", {"T1": "0.1"}),
+    ("rmse_C", [0.1]),
+])
+def test_report_lists_an_accuracy_of_the_wrong_type_as_failed(replayed, tmp_path, metric,
+                                                              value):
+    # the shape was checked to the method level only: a metric that is no number ended
+    # the report in 'internal error: ValueError: Unknown format code 'f' for ... str'
+    out = copy_of(replayed, tmp_path)
+    path = out / "b" / "accuracy.json"
+    acc = json.loads(path.read_text())
+    next(iter(acc["methods"].values()))[metric] = value
+    path.write_text(json.dumps(acc))
+    build_report(out)
+    summary = summary_of(out)
+    assert [r["run"] for r in summary["runs"]] == ["a"]
+    assert summary["failed"][0]["run"] == "b" and "unreadable" in summary["failed"][0]["error"]
+
+
 def test_defect10_unreadable_file_does_not_stop_the_batch(runs, tmp_path):
     missing, folder = tmp_path / "missing.csv", tmp_path / "folder.csv"
     folder.mkdir()

@@ -25,15 +25,26 @@ def read_accuracy(path: Path) -> dict | None:
         return None
     if not isinstance(acc, dict) or not isinstance(acc.get("methods"), dict):
         return None
-    for key in ("speed_rpm", "ambient_C", "duration_s"):
-        value = acc.get(key)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(
-                value):
-            return None
-    if not all(isinstance(m, dict) for m in acc["methods"].values()):
+    if not all(_is_number(acc.get(key)) for key in ("speed_rpm", "ambient_C", "duration_s")):
         return None
+    for metrics in acc["methods"].values():
+        if not isinstance(metrics, dict) or not all(
+                _is_metric(v) or isinstance(v, dict) and all(map(_is_metric, v.values()))
+                for v in metrics.values()):
+            return None
     acc["run"] = path.parent.name
     return acc
+
+
+def _is_number(value: object) -> bool:
+    return (isinstance(value, int | float) and not isinstance(value, bool)
+            and math.isfinite(value))
+
+
+def _is_metric(value: object) -> bool:
+    """A metric as accuracy.json holds it: a number, or null where it does not apply (a
+    run without drift, a method without a band)."""
+    return value is None or _is_number(value)
 
 
 def run_folder(out_root: Path, name: object) -> Path | None:
