@@ -53,6 +53,42 @@ def test_every_command_has_help(path):
     assert "Usage: twin " + " ".join(path) in " ".join(result.output.split())
 
 
+def _leaf_commands():  # noqa: ANN202 - (usage prefix, click command) pairs
+    from apdl_like.cli import app as apdl_app
+
+    for prog, typer_app in (("twin", app), ("apdl-like", apdl_app)):
+        group = typer.main.get_command(typer_app)
+        for path in _command_paths(group):
+            command = group
+            for name in path:
+                command = command.commands[name]
+            if not hasattr(command, "commands"):
+                yield " ".join((prog, *path)), command
+
+
+@pytest.mark.parametrize("usage, command", list(_leaf_commands()),
+                         ids=[usage for usage, _ in _leaf_commands()])
+def test_readme_usage_lists_every_option(usage, command):
+    # a user reads the README's usage block first: simulate's --spec and --size-factor,
+    # synth's --coolant and most commands' --quiet were in --help only
+    from pathlib import Path
+
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    block = readme.split("## Usage", 1)[1].split("```")[1]
+    lines, inside = [], False
+    for line in block.splitlines():
+        inside = line.startswith(usage + " ") or (inside and line.startswith(" "))
+        if inside:
+            lines.append(line)
+    text = " ".join(lines)
+    assert text, f"{usage} is not in the README's usage block"
+    for param in command.params:
+        names = [o for o in (*param.opts, *getattr(param, "secondary_opts", ()))
+                 if o.startswith("--")]
+        if names and "--help" not in names:
+            assert any(n in text for n in names), f"{usage}: {names[0]} is not in the README"
+
+
 def _loaded_modules(code: str) -> set[str]:
     """The modules a fresh interpreter has loaded after running `code`."""
     probe = code + "\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))"
