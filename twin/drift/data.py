@@ -132,6 +132,19 @@ def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]]) -> li
     return out
 
 
+def _check_distinct(tables: Sequence[RawTable]) -> None:
+    """Refuse a file given twice, or a copy of one: time-blocked validation holds one
+    file out per block, and would score each against a model fitted on its twin."""
+    for k, table in enumerate(tables):
+        for other in tables[:k]:
+            if table.columns.keys() == other.columns.keys() and all(
+                    np.array_equal(table.columns[name], other.columns[name], equal_nan=True)
+                    for name in table.columns):
+                raise InputError(f"holds the same data as {other.file}; give each file once "
+                                 "(validation would score it against a model fitted on its "
+                                 "copy)", file=table.file)
+
+
 def drift_data(
     tables: Sequence[RawTable],
     sensors: Sequence[str] | None = None,
@@ -146,6 +159,7 @@ def drift_data(
     """
     if not tables:
         raise InputError("no data file given")
+    _check_distinct(tables)
     first = tables[0]
     if sensors is None:
         sensors = temperature_columns(first)
