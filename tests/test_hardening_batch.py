@@ -62,6 +62,22 @@ def test_defect4_failed_rerun_leaves_no_stale_result(replayed, runs, tmp_path):
     assert [f["run"] for f in summary_of(out)["failed"]] == ["a"]
 
 
+def test_a_file_where_a_run_folder_goes_is_kept_and_the_run_refused(runs, tmp_path):
+    # the run folder was swapped in over the user's file DIR/a, which was renamed to
+    # .a.PID.HEX.old, left beside it, and deleted by the next batch as an orphan
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a").write_text("my notes")
+    result = replay([runs / "a.csv", runs / "b.csv"], out)
+    assert result.exit_code == 2
+    assert [f["run"] for f in result.failed] == ["a"]
+    assert f"{out / 'a'}: is not a folder" in result.failed[0]["error"]
+    assert [a["run"] for a in result.accuracies] == ["b"]  # the others go on
+    replay([runs / "b.csv"], out)
+    assert (out / "a").read_text() == "my notes"
+    assert sorted(p.name for p in out.iterdir()) == ["a", "b", "summary.json"]
+
+
 def test_defect4_run_folder_replaced_as_a_whole(tmp_path):
     target = tmp_path / "run"
     (target / "decks").mkdir(parents=True)

@@ -110,6 +110,8 @@ def replay_batch(
                                   "path": str(path)})
     names = [n for _, n in named]
     check_distinct_names(named)  # refused before anything is written
+    named = [(path, name) for path, name in named
+             if not _refused_folder(out_root / name, path, result)]
     out_root.mkdir(parents=True, exist_ok=True)
     remove_orphans(out_root)
     todo: list[ReplayJob] = []
@@ -134,6 +136,19 @@ def replay_batch(
     result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
     write_summary(out_root, result.failed, attempted=names)
     return result
+
+
+def _refused_folder(folder: Path, path: str, result: BatchResult) -> bool:
+    """A run whose folder's name is taken by something that is not a folder (a user's
+    file) is refused before any work: replacing the run folder as a whole renamed that
+    file to a temporary name, which the next batch removed as a killed run's leftover."""
+    if not (folder.is_symlink() or folder.exists()) or folder.is_dir():
+        return False
+    error = InputError("is not a folder, and this run's results go to a folder of that "
+                       "name: move it away or choose another --out", file=str(folder))
+    result.failed.append({"error": str(error), "kind": "input", "run": folder.name,
+                          "path": path})
+    return True
 
 
 def _finished(out_dir: Path, path: str, methods: Sequence[str],
