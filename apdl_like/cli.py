@@ -66,7 +66,7 @@ def run(
                              "nodes)")
         regular_file_info(start, use="read start state")
     check_out_dir(out, inputs=[deck, *([start] if start is not None else [])],
-                  owned=["params.json", "log.txt"])
+                  files=["params.json", "log.txt"])
     session = _spindle_session(deck.parent, strict) if spindle else Session(
         base_dir=deck.parent, strict=strict)
     if start is not None:

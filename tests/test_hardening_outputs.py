@@ -144,6 +144,29 @@ def test_defect6_folder_outputs_refuse_a_file(tmp_path, run_file, command):
     assert target.read_text() == "keep"
 
 
+@pytest.mark.parametrize("command, name", [
+    (["twin", "simulate", "--speed", 9000, "--minutes", 0.2, "--ambient", 25], "summary.json"),
+    (["twin", "simulate", "--speed", 9000, "--minutes", 0.2, "--ambient", 25], "fields.pvd"),
+    (["twin", "replay", "RUN", "--methods", "open_loop"], "summary.json"),
+    (["twin", "replay", "RUN", "--methods", "open_loop"], "report.html"),
+    (["apdl-like", "run", "DECK"], "params.json"),
+])
+def test_a_folder_where_an_output_file_goes_is_refused_before_any_work(tmp_path, run_file,
+                                                                       command, name):
+    # simulate unlinked its summary.json first: 'internal error: IsADirectoryError'; replay
+    # and apdl-like refused the folder only when writing there, after all the work
+    deck = tmp_path / "d.inp"
+    deck.write_text("A = 1\n")
+    out = tmp_path / "out"
+    (out / name).mkdir(parents=True)
+    cli = {"twin": app, "apdl-like": apdl_app}[command[0]]
+    args = [{"RUN": run_file, "DECK": deck}.get(a, a) for a in command[1:]]
+    result = run_cli(cli, [*args, "--out", out])
+    assert result.exit_code == 2, result.output
+    assert f"{out / name}, column '--out': is a folder, not a file" in result.output
+    assert [p.name for p in out.iterdir()] == [name]  # nothing written, nothing removed
+
+
 def test_defect1_apdl_outputs_refuse_special_files_and_inputs(tmp_path, fifo):
     deck = tmp_path / "d.inp"
     deck.write_text("A = 1\n")

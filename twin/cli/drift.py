@@ -167,7 +167,7 @@ def report(
     from twin.drift.report import write_drift_report
     from twin.io.destinations import check_out_dir
 
-    check_out_dir(out, inputs=[model_file, *data], owned=["metrics.json", "report.html"])
+    check_out_dir(out, inputs=[model_file, *data], files=["metrics.json", "report.html"])
     _check_inputs([model_file, *data])
     model = load_drift_model(model_file)
     drift_data = read_drift_data(data, sensors=model.spec.sensors, targets=model.targets,

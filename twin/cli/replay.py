@@ -55,8 +55,8 @@ def replay(
     if not paths:
         where = [str(p) for p in runs] if runs else [str(bundled_runs_dir())]
         raise InputError("no recorded runs (CSV/Parquet) found", file=", ".join(where))
-    check_out_dir(out, inputs=[*paths, model], owned=[
-        *(Path(p).stem for p in paths), "summary.json", "report.html"])
+    check_out_dir(out, inputs=[*paths, model], owned=[Path(p).stem for p in paths],
+                  files=["summary.json", "report.html"])
     model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
     console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")

@@ -51,7 +51,7 @@ def simulate_command(
         raise InputError(f"must be at most {MAX_DURATION_S / 60.0:g} minutes (one day), got "
                          f"{minutes:g}", column="--minutes")
     check_out_dir(out, inputs=[spec],
-                  owned=["keypoints.csv", "fields.pvd", "fields", "summary.json"])
+                  owned=["fields"], files=["keypoints.csv", "fields.pvd", "summary.json"])
     # validate the operating point before the (slower) model build
     check_operating_options(load_spec(spec), speed, ambient, coolant)
     model = SpindleModel.load(spec, size_factor=size_factor)

@@ -76,15 +76,19 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
 
 
 def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                  option: str = "--out", owned: Iterable[str] = ()) -> Path:
+                  option: str = "--out", owned: Iterable[str] = (),
+                  files: Iterable[str] = ()) -> Path:
     """`out` as a Path if a command may write its output folder there.
 
     The folder may exist (its other contents stay) or not (it is created).  `owned` are
     the names inside it the command replaces (files or whole folders): no input may lie
-    there.
+    there.  `files` are owned names the command writes as files: a folder (or device,
+    fifo) there is refused now, not once the work is done.
     """
     target = Path(out)
     _check_ancestors(target, option)
+    files = list(files)
+    owned = [*owned, *files]
     if target.exists() or target.is_symlink():
         try:
             info = target.stat()
@@ -95,6 +99,8 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
             kind = "a file" if stat.S_ISREG(info.st_mode) else "not a folder"
             raise InputError(f"is {kind}; a folder is expected", file=str(target),
                              column=option)
+        for name in files:
+            refuse_special(target / name, option)
     for source in (Path(p) for p in inputs if p is not None):
         for name in owned:
             place = target / name
