@@ -42,19 +42,21 @@ def _toy_simulator(run, anchored=True):
 def runs(tmp_path, monkeypatch):
     monkeypatch.setattr(training, "training_simulator",
                         lambda rule="fit", spindle=None: _toy_simulator)
-    paths = []
-    for i, speed in enumerate((6000.0, 8000.0, 11000.0)):
-        t = np.arange(0, 901, 5.0)
-        H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
-        T = PLANT.simulate(t, speed, 25.0, H * 1.1, R * 1.2)
-        T += np.random.default_rng(i).normal(0, 0.05, T.shape)
-        cols = {"time_s": t, "speed_rpm": np.full(t.size, speed),
-                "ambient_C": np.full(t.size, 25.0)}
-        cols.update({f"T{j + 1}_C": T[:, j] for j in range(5)})
-        path = tmp_path / f"run_{speed:.0f}.csv"
-        write_run(path, cols)
-        paths.append(path)
-    return paths
+    return [_toy_run(tmp_path / f"run_{speed:.0f}.csv", speed, seed=i)
+            for i, speed in enumerate((6000.0, 8000.0, 11000.0))]
+
+
+def _toy_run(path, speed, seed):
+    """A 15-min run of the toy plant at `speed` with the sensor noise drawn from `seed`."""
+    t = np.arange(0, 901, 5.0)
+    H, R = PLANT.nominal_heat_W_m3(speed), PLANT.nominal_resistance_m2K_W(speed)
+    T = PLANT.simulate(t, speed, 25.0, H * 1.1, R * 1.2)
+    T += np.random.default_rng(seed).normal(0, 0.05, T.shape)
+    cols = {"time_s": t, "speed_rpm": np.full(t.size, speed),
+            "ambient_C": np.full(t.size, 25.0)}
+    cols.update({f"T{j + 1}_C": T[:, j] for j in range(5)})
+    write_run(path, cols)
+    return path
 
 
 def _invoke(args):
@@ -67,8 +69,8 @@ def _invoke(args):
 def test_train_writes_model_and_report(runs, tmp_path):
     out = tmp_path / "model" / "m.safetensors"
     before = [p.read_bytes() for p in runs]
-    gate = tmp_path / "gate_6000.csv"  # a run only the closed-loop check replays
-    gate.write_bytes(runs[0].read_bytes())
+    # a run only the closed-loop check replays (another recording, not a copy of a run)
+    gate = _toy_run(tmp_path / "gate_6000.csv", 6000.0, seed=9)
     result = _invoke(["train", *map(str, runs), "--out", str(out), "--epochs", "60",
                       "--seed", "3", "--gate-runs", str(gate), "--quiet"])
     assert result.exit_code == 0, result.output
@@ -176,7 +178,7 @@ def test_runs_too_short_or_stopped_to_train_on_exit_2_saying_so(tmp_path, monkey
         for k, (speed, seconds) in enumerate(specs):
             keep = t <= seconds
             cols = {"time_s": t[keep], "speed_rpm": np.full(keep.sum(), speed),
-                    "ambient_C": np.full(keep.sum(), 25.0)}
+                    "ambient_C": np.full(keep.sum(), 25.0 + 0.1 * k)}  # three runs, no copy
             cols.update({f"T{j + 1}_C": 25.0 + 0.01 * j + 0.001 * t[keep] for j in range(5)})
             paths.append(tmp_path / f"{case}_{k}.csv")
             write_run(paths[-1], cols)
@@ -198,3 +200,19 @@ def test_a_gate_run_that_is_also_a_training_run_is_refused(runs, tmp_path, monke
     assert str(runs[1]) in result.output and "--gate-runs" in result.output
     assert "trained on" in result.output and len(result.output.strip().splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize("as_gate", [False, True])
+def test_a_copy_of_a_run_is_refused(runs, tmp_path, monkeypatch, as_gate):
+    # a run copied under another name was trained on twice, and as --gate-runs it passed
+    # the gate's "never trained on" check (made on the path); other line ends, same data
+    monkeypatch.setattr(training, "training_simulator", lambda *a, **k: pytest.fail("ran"))
+    copy = tmp_path / "copy.csv"
+    copy.write_text(runs[1].read_text().replace("\n", "\r\n"))
+    out = tmp_path / "m.safetensors"
+    given = [*map(str, runs), "--gate-runs", str(copy)] if as_gate else [*map(str, runs),
+                                                                        str(copy)]
+    result = _invoke(["train", *given, "--out", str(out), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{copy}: holds the same data as {runs[1]}" in " ".join(result.output.split())
+    assert len(result.output.strip().splitlines()) == 1 and not out.exists()

@@ -154,8 +154,12 @@ def test_replay_and_quality_handle_a_stop(stop_run, tmp_path):
 @pytest.mark.slow
 def test_training_on_a_run_with_a_stop(stop_run, tmp_path):
     out = tmp_path / "m.safetensors"
-    again = tmp_path / "stop_again.csv"  # a second run (one file twice is refused: one name)
-    again.write_bytes(stop_run.read_bytes())
+    # a second run of the same profile (one file twice, or a copy, is refused)
+    again = tmp_path / "stop_again.csv"
+    made = invoke("synth", "--profile", str(stop_run.with_name("stop.profile.csv")),
+                  "--minutes", "9", "--ambient", "24", "--seed", "4", "--rate", "0.5",
+                  "--out", str(again), "--quiet")
+    assert made.exit_code == 0, made.output
     result = invoke("train", str(stop_run), str(again), "--out", str(out), "--epochs", "20",
                     "--quiet")
     assert result.exit_code == 0, result.output

@@ -55,7 +55,8 @@ def train(
     from twin.io.destinations import check_out_file
     from twin.loop.runfiles import check_distinct_names, run_name
     from twin.loop.training import gate_networks, training_simulator
-    from twin.runs import read_run
+    from twin.runs import read_table, run_from_table
+    from twin.runs.table import check_distinct_tables
     from twin.spindle.model import SpindleModel
 
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
@@ -71,12 +72,16 @@ def train(
                          column="--out")
     named = [(str(path), run_name(path)) for path in runs]
     check_distinct_names(named)
+    tables = [read_table(path) for path in [*runs, *gate_runs]]
+    check_distinct_tables(tables, "a copy would be trained on twice, or held out or "
+                          "gated on as a run the networks never saw while trained on")
     spindle = SpindleModel.load()  # the networks train on that spindle
+    limit = spindle.spec.spindle.max_speed_rpm
     simulator = training_simulator(targets, spindle=spindle)
     sets, recorded = [], {}
-    for path, (_, name) in zip(runs, named, strict=True):
+    for path, (_, name), table in zip(runs, named, tables[:len(runs)], strict=True):
         # known by its file name: the held-out split is by run
-        run = read_run(path, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
+        run = run_from_table(table, max_speed_rpm=limit)
         run = dataclasses.replace(run, name=name)
         recorded[name] = run
         if not quiet:
@@ -104,8 +109,8 @@ def train(
         if not quiet:
             typer.echo("checking the networks in closed loop on the held-out runs …", err=True)
         held_out = [recorded[name] for name in model.metadata["held_out_runs"]]
-        held_out += [read_run(p, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
-                     for p in gate_runs]
+        held_out += [run_from_table(table, max_speed_rpm=limit)
+                     for table in tables[len(runs):]]
         model, gate = gate_networks(model, held_out, spindle)
         model.metadata.update(networks_kept=gate["kept"], held_out_temperature_accuracy_pct=(
             gate.get("held_out_temperature_accuracy_pct", {})),

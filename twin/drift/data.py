@@ -23,7 +23,7 @@ import numpy as np
 from twin.errors import InputError
 from twin.runs import read_table
 from twin.runs.schema import SPEED, TIME
-from twin.runs.table import RawTable
+from twin.runs.table import RawTable, check_distinct_tables
 
 TEMPERATURE_SUFFIX = "_C"
 DISPLACEMENT_SUFFIX = "_um"
@@ -132,19 +132,6 @@ def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]]) -> li
     return out
 
 
-def _check_distinct(tables: Sequence[RawTable]) -> None:
-    """Refuse a file given twice, or a copy of one: time-blocked validation holds one
-    file out per block, and would score each against a model fitted on its twin."""
-    for k, table in enumerate(tables):
-        for other in tables[:k]:
-            if table.columns.keys() == other.columns.keys() and all(
-                    np.array_equal(table.columns[name], other.columns[name], equal_nan=True)
-                    for name in table.columns):
-                raise InputError(f"holds the same data as {other.file}; give each file once "
-                                 "(validation would score it against a model fitted on its "
-                                 "copy)", file=table.file)
-
-
 def drift_data(
     tables: Sequence[RawTable],
     sensors: Sequence[str] | None = None,
@@ -159,7 +146,8 @@ def drift_data(
     """
     if not tables:
         raise InputError("no data file given")
-    _check_distinct(tables)
+    check_distinct_tables(tables, "validation holds one file out per block and would "
+                          "score it against a model fitted on its copy")
     first = tables[0]
     if sensors is None:
         sensors = temperature_columns(first)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -64,3 +65,15 @@ def parse_cell(cell: str, file: str, row: int, column: str) -> float:
     if math.isinf(value):
         raise InputError(f"{cell!r} is not a finite number", file=file, row=row, column=column)
     return value
+
+
+def check_distinct_tables(tables: Sequence[RawTable], why: str) -> None:
+    """Refuse a file given twice, or a copy of one under another name or with other line
+    ends (the same columns and values): `why` says what the command would get wrong."""
+    for k, table in enumerate(tables):
+        for other in tables[:k]:
+            if table.columns.keys() == other.columns.keys() and all(
+                    np.array_equal(table.columns[name], other.columns[name], equal_nan=True)
+                    for name in table.columns):
+                raise InputError(f"holds the same data as {other.file}; give each file once "
+                                 f"({why})", file=table.file)
