@@ -255,6 +255,20 @@ def test_synth_profile_over_the_speed_limit_names_its_row(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.csv"]
 
 
+def test_synth_tells_the_profile_columns_it_does_not_read(tmp_path):
+    # a coolant_C or a misspelt ambient column was read past without a word: the run was
+    # emulated at --ambient and the inlet at the ambient, not what the file gave
+    profile = tmp_path / "p.csv"
+    profile.write_text("time_s,speed_rpm,Ambient_C,coolant_C\n0,6000,21,19\n")
+    args = ["synth", "--profile", str(profile), "--minutes", "2", "--ambient", "25",
+            "--seed", "1", "--out", str(tmp_path / "run.csv")]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert f"note: {profile}: column(s) Ambient_C, coolant_C ignored" in result.output
+    quiet = CliRunner().invoke(app, [*args, "--quiet"])
+    assert quiet.exit_code == 0 and quiet.output == ""
+
+
 @pytest.mark.parametrize("address", ["notanaddress", "tcp://127.0.0.1:port", "tcp://"])
 def test_replay_refuses_a_malformed_dask_address_before_any_work(address, tmp_path):
     run = tmp_path / "run.csv"

@@ -93,6 +93,10 @@ def synth(
                          column="--out")
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
     speed_profile = None if profile is None else read_speed_profile(profile)
+    if speed_profile is not None and speed_profile.ignored and not quiet:
+        typer.echo(f"note: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
+                   "speed profile sets time_s, speed_rpm and ambient_C only (the coolant: a "
+                   "scenario's [coolant])", err=True)
     truth = load_scenario(scenario, duration_s=60.0 * minutes)
     profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
     if profile_ambient and truth.ambient is not None:

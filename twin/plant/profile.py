@@ -32,6 +32,9 @@ class SpeedProfile:
     rows: tuple[int, ...] = ()
     """The file line of each step (so a check made later, the spindle's speed limit, can
     name it); empty for a profile not read from a file."""
+    ignored: tuple[str, ...] = ()
+    """Header columns the profile does not read (a recorded run's T1_C.., a coolant_C or a
+    misspelt ambient), for the command to tell."""
 
     def row_of(self, step: int) -> int | None:
         """The file line of step `step`, or None."""
@@ -93,4 +96,5 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
                              "the twin models", file=file, row=number, column="ambient_C")
     ambient = StepTable(values[:, 0], values[:, 2]) if len(wanted) == 3 else None
     return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient,
-                        tuple(number for number, _ in rows))
+                        tuple(number for number, _ in rows),
+                        tuple(name for name in header if name not in wanted))
