@@ -269,6 +269,18 @@ def test_synth_tells_the_profile_columns_it_does_not_read(tmp_path):
     assert quiet.exit_code == 0 and quiet.output == ""
 
 
+@pytest.mark.parametrize("name", ["run.truth.csv", "run.profile.csv"])
+def test_synth_refuses_a_run_named_as_a_companion_file(tmp_path, name):
+    # --out run.truth.csv wrote the run over the truth of run.csv, and 'twin replay DIR'
+    # then left the new run out as the truth it is named after
+    result = CliRunner().invoke(app, [
+        "synth", "--speed", "9000", "--minutes", "2", "--ambient", "25", "--seed", "1",
+        "--out", str(tmp_path / name), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{tmp_path / name}, column '--out': a run may not be named" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("address", ["notanaddress", "tcp://127.0.0.1:port", "tcp://"])
 def test_replay_refuses_a_malformed_dask_address_before_any_work(address, tmp_path):
     run = tmp_path / "run.csv"

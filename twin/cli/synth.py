@@ -65,7 +65,7 @@ def synth(
                                    "not write (without it they are an error)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
-    from twin.cli.inputs import check_operating_options
+    from twin.cli.inputs import COMPANION_SUFFIXES, check_operating_options
     from twin.io.destinations import check_out_file
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
@@ -91,6 +91,10 @@ def synth(
     if out.suffix.lower() not in (".csv", ".parquet"):
         raise InputError("the run must be written as .csv or .parquet", file=str(out),
                          column="--out")
+    if out.name.endswith(COMPANION_SUFFIXES):
+        raise InputError(f"a run may not be named *{'/*'.join(COMPANION_SUFFIXES)}: those are "
+                         "the files synth writes beside a run, which 'twin replay FOLDER' "
+                         "leaves out", file=str(out), column="--out")
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
     speed_profile = None if profile is None else read_speed_profile(profile)
     if speed_profile is not None and speed_profile.ignored and not quiet:
