@@ -126,6 +126,13 @@ class _NumberedTable:
         self.flush()
         self.arrays["selected"] = mask
 
+    def selected_ids(self) -> np.ndarray:
+        """The numbers of the selected entities.  `ids[selected]` read `ids` before
+        `selected` flushed the pending additions: an N, E or NGEN just before a CM, NGEN
+        or *GET,,NODE,0,COUNT gave mismatched arrays (an internal error)."""
+        mask = self.selected  # flushes first
+        return self.ids[mask]
+
     def index(self, numbers: np.ndarray | int) -> np.ndarray:
         """Positions of node or element numbers; -1 for numbers that do not exist."""
         self.flush()

@@ -33,6 +33,19 @@ def test_fields_comments_and_case():
     assert com.name == "/COM" and com.fields == (" keep ! this, text",)
 
 
+@pytest.mark.parametrize("deck, name, value", [
+    ("N,1,0,0\nN,2,1,0\n*GET,C,NODE,0,COUNT\n", "C", 2.0),
+    ("N,1,0,0\nN,2,1,0\nCM,EDGE,NODE\n*GET,C,NODE,0,COUNT\n", "C", 2.0),
+    ("N,1,0,0\nN,2,1,0\nNGEN,2,10,ALL,,,0,1\n*GET,C,NODE,0,COUNT\n", "C", 4.0),
+    ("N,1,0,0\nN,2,1,0\nN,3,1,1\nN,4,0,1\nET,1,PLANE55\nE,1,2,3,4\nCM,ONE,ELEM\n"
+     "*GET,C,ELEM,0,COUNT\n", "C", 1.0),
+])
+def test_selection_right_after_new_entities(deck, name, value):
+    # ids[selected] read the ids before `selected` merged the nodes just added: a CM,
+    # NGEN or *GET,,NODE,0,COUNT right after N ended in 'internal error: IndexError'
+    assert run("/PREP7\n" + deck).params[name] == value
+
+
 @pytest.mark.parametrize("text, value", [
     ("1+2*3", 7.0), ("-2**2", -4.0), ("2**3**2", 512.0), ("(1+2)*3/4", 2.25),
     ("1.5D3", 1500.0), (".5e-1", 0.05), ("2*-3", -6.0), ("SQRT(16)+ABS(-1)", 5.0),

@@ -103,7 +103,7 @@ def star_get(s: SessionState, c: Call) -> None:
         item, sub = "NUM", "COUNT"
     if item == "NUM":
         table = db.nodes if entity == "NODE" else db.elements
-        ids = table.ids[table.selected]
+        ids = table.selected_ids()
         if sub == "COUNT":
             value = float(ids.size)
         elif sub in ("MAX", "MIN"):

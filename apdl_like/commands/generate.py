@@ -148,7 +148,7 @@ def ngen(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     nodes.flush()
     if c.label(3) == "ALL" or not c.given(3):
-        pattern = nodes.ids[nodes.selected]
+        pattern = nodes.selected_ids()
     else:
         n1 = c.int(3, what="NODE1")
         n2 = c.int(4, n1, what="NODE2")
@@ -343,7 +343,7 @@ def cp(s: SessionState, c: Call) -> None:
     label = _coupling_label(c, 2)
     nodes = s.db.nodes
     if c.label(3) == "ALL":
-        numbers = nodes.ids[nodes.selected]
+        numbers = nodes.selected_ids()
     else:
         numbers = np.array([c.int(i, what="NODE") for i in range(3, c.count() + 1)
                             if c.given(i)], np.int64)

@@ -226,10 +226,9 @@ def cm(s: SessionState, c: Call) -> None:
     name = _component_name(c, 1)
     entity = c.label(2)
     if entity == "NODE":
-        s.db.components[name] = Component("NODE", s.db.nodes.ids[s.db.nodes.selected].copy())
+        s.db.components[name] = Component("NODE", s.db.nodes.selected_ids().copy())
     elif entity == "ELEM":
-        s.db.components[name] = Component("ELEM",
-                                          s.db.elements.ids[s.db.elements.selected].copy())
+        s.db.components[name] = Component("ELEM", s.db.elements.selected_ids().copy())
     else:
         raise ApdlError(f"field 2: entity must be NODE or ELEM, got {entity or '(empty)'!r}")
 
