@@ -86,6 +86,29 @@ def _strip_comment(line: str) -> str:
     return line
 
 
+def commands_on(line: str) -> list[str]:
+    """The commands of one deck line: MAPDL runs `A $ B` as two.  A `$` inside quotes, in
+    a `!` comment or in a text command's text (/COM, /TITLE, C***) separates nothing."""
+    if "$" not in line:
+        return [line]
+    head = line.lstrip().upper()
+    if head.startswith(("C***", *_TEXT_COMMANDS)):
+        return [line]
+    commands, start, quoted = [], 0, False
+    for i, ch in enumerate(line):
+        if ch == "'":
+            quoted = not quoted
+        elif quoted:
+            continue
+        elif ch == "!":
+            break
+        elif ch == "$":
+            commands.append(line[start:i])
+            start = i + 1
+    commands.append(line[start:])
+    return commands
+
+
 def split_fields(body: str, separators: str = ",", kept: str = "") -> list[str]:
     """Split at commas outside parentheses and quotes: `*GET,T,NODE,NODE(0.1,0),TEMP` has 5
     fields, `L(1) = 'T,F(AT X','q'` has 2 values.  Other `separators` may split too; those
@@ -244,13 +267,21 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
     statements = []
     lines = text.splitlines()
     number = 0
-    while number < len(lines):
-        raw = lines[number]
-        number += 1
+    queued: list[str] = []  # the further commands of a line with `$`
+    while queued or number < len(lines):
+        if not queued:
+            queued = commands_on(lines[number])
+            number += 1
+        raw = queued.pop(0)
         st = lex_line(raw, file, number)
         if st is None:
             continue
         if st.name == "/EOF":
+            break
+        if queued and st.name in (*BLOCK_COMMANDS, *FORMAT_COMMANDS):
+            # its data or format are the next lines, not the rest of this one
+            statements.append(Statement(file, st.line, BAD_LINE, (
+                "no command may follow it after '$': its data lines come next", st.name)))
             break
         if st.name in BLOCK_COMMANDS:
             try:

@@ -46,6 +46,24 @@ def test_selection_right_after_new_entities(deck, name, value):
     assert run("/PREP7\n" + deck).params[name] == value
 
 
+def test_dollar_separates_commands_on_one_line():
+    # MAPDL runs `A $ B` as two commands (NSEL,S,LOC,X,0 $ D,ALL,TEMP,20 in many a macro);
+    # the line stopped with "unexpected character '$'" or "element PLANE55 $ MP"
+    s = run("A = 1 $ B = A+1 ! B $ C = 9 is a comment\n"
+            "/PREP7\nET,1,PLANE55 $ MP,KXX,1,50\nN,1,0,0 $ N,2,1,0 $ N,3,1,1\n"
+            "*SET,T,'a$b' $ *GET,NN,NODE,0,COUNT\n/COM, costs $5 $ D = 1\n")
+    assert s.params["A"] == 1.0 and s.params["B"] == 2.0 and "C" not in s.params
+    assert s.params["NN"] == 3.0 and s.params["T"] == "a$b"
+    assert "D" not in s.params  # /COM takes the rest of its line as text
+    program = parse_deck("X = 1 $ Y = 2\nZ = 3 $ FOO\n*VWRITE,X\n('a $ b',F5.1)\n", "d.inp")
+    assert [(st.line, st.name) for st in program.statements] == [
+        (1, "="), (1, "="), (2, "="), (2, "FOO"), (3, "*VWRITE")]
+    assert program.statements[-1].block == ("('a $ b',F5.1)",)  # a format line is text
+    with pytest.raises(ApdlError, match="data lines come next") as info:
+        run("X = 1\n*VWRITE,X $ Y = 2\n(F5.1)\n")
+    assert info.value.line == 2
+
+
 @pytest.mark.parametrize("text, value", [
     ("1+2*3", 7.0), ("-2**2", -4.0), ("2**3**2", 512.0), ("(1+2)*3/4", 2.25),
     ("1.5D3", 1500.0), (".5e-1", 0.05), ("2*-3", -6.0), ("SQRT(16)+ABS(-1)", 5.0),
