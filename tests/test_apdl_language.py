@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -44,6 +45,16 @@ def test_selection_right_after_new_entities(deck, name, value):
     # ids[selected] read the ids before `selected` merged the nodes just added: a CM,
     # NGEN or *GET,,NODE,0,COUNT right after N ended in 'internal error: IndexError'
     assert run("/PREP7\n" + deck).params[name] == value
+
+
+def test_ic_right_after_new_nodes_is_kept():
+    # IC indexed the node arrays it had read before its targets merged the nodes just
+    # added: the value went into the discarded arrays (lost without a word) or past
+    # their end ('internal error: IndexError' for N,,1,1 then IC,ALL)
+    s = run("/PREP7\nN,1,0,0\nN,2,1,0\n*GET,C,NODE,0,COUNT\nN,3,1,1\nIC,1,TEMP,100\n")
+    np.testing.assert_array_equal(s.db.nodes.arrays["ic_temp"], [100.0, np.nan, np.nan])
+    s = run("/PREP7\nN,,1,1\nIC,ALL,TEMP,100\n")
+    np.testing.assert_array_equal(s.db.nodes.arrays["ic_temp"], [100.0])
 
 
 def test_dollar_separates_commands_on_one_line():

@@ -496,7 +496,9 @@ def ic(s: SessionState, c: Call) -> None:
     if lab != "TEMP":
         raise ApdlError(f"field 2: initial condition must be TEMP, got {lab!r}")
     value = c.num(3, 0.0, what="VALUE")
-    s.db.nodes.arrays["ic_temp"][node_targets(s, c, 1)] = value
+    # the targets first: they merge nodes just added, which replaces the arrays
+    idx = node_targets(s, c, 1)
+    s.db.nodes.arrays["ic_temp"][idx] = value
 
 
 @command("TUNIF", LOADS, 1)
