@@ -170,6 +170,17 @@ def _part(xy: np.ndarray, node_ids: np.ndarray, node_dof: np.ndarray, corners: n
         bad = int(node_ids[corners[int(np.argmin(np.abs(area2))), 0]])
         raise ApdlError(f"an element at node {bad} has zero area (check its node order and "
                         "coordinates)")
+    if not is_tri:
+        # a bilinear quad's Jacobian keeps its sign only where every corner turns the way
+        # of the whole: a re-entrant or crossed quad (a node moved after meshing) passed the
+        # area check and failed in scikit-fem's inverse mapping, an internal error
+        turn = ((np.roll(x, -1, axis=0) - x) * (np.roll(y, 1, axis=0) - y)
+                - (np.roll(y, -1, axis=0) - y) * (np.roll(x, 1, axis=0) - x))
+        bent = np.any(turn * np.sign(area2) < -1e-12, axis=0)
+        if np.any(bent):
+            bad = int(node_ids[corners[int(np.argmax(bent)), 0]])
+            raise ApdlError(f"an element at node {bad} is not convex (its Jacobian changes "
+                            "sign; check its node order and coordinates)")
     flip = area2 < 0
     t[:, flip] = t[::-1][:, flip]
     if is_tri:

@@ -74,3 +74,15 @@ def test_a_deck_does_not_write_over_a_file_it_read_by_input(tmp_path, written):
     assert f"{sub}, column '--out': is also an input" in result.output
     assert sub.read_text() == "X = 1\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["main.inp", "sub.inp"]
+
+
+@pytest.mark.parametrize("moved", ["N,1,0.05,0.2", "N,3,0.1,0.2"])
+def test_a_quad_bent_by_a_moved_node_is_refused_at_solve(tmp_path, moved):
+    # a node redefined after AMESH made a quad re-entrant or crossed: its area passed the
+    # check, and scikit-fem's inverse mapping raised 'Zero Jacobian determinant' or
+    # 'Newton iteration didn't converge' (an internal error, exit 1)
+    deck = ("/PREP7\nET,1,PLANE55,,,1\nMP,KXX,1,10\nRECTNG,0.1,0.2,0,0.1\nESIZE,0.05\n"
+            f"AMESH,ALL\n{moved}\nSF,ALL,CONV,100,20\n/SOLU\nSOLVE\n")
+    with pytest.raises(ApdlError, match="not convex") as info:
+        Session(base_dir=tmp_path).run_text(deck, "deck.inp")
+    assert info.value.line == 10
