@@ -128,6 +128,10 @@ def _wrapped_app(error: BaseException) -> typer.Typer:
     [
         (InputError("speed must be >= 0", file="run.csv", row=3, column="speed_rpm"), 2,
          "error: run.csv, row 3, column 'speed_rpm': speed must be >= 0"),
+        # an option is not a column of the file (the message said "option '--time'")
+        (InputError("time 400 s is outside the replayed span", file="run.csv",
+                    column="--time"), 2,
+         "error: run.csv, option '--time': time 400 s is outside the replayed span"),
         (RuntimeError("boom"), 1, "internal error: RuntimeError: boom"),
         (KeyboardInterrupt(), 130, "interrupted"),
     ],
@@ -277,7 +281,7 @@ def test_synth_refuses_a_run_named_as_a_companion_file(tmp_path, name):
         "synth", "--speed", "9000", "--minutes", "2", "--ambient", "25", "--seed", "1",
         "--out", str(tmp_path / name), "--quiet"])
     assert result.exit_code == 2, result.output
-    assert f"{tmp_path / name}, column '--out': a run may not be named" in result.output
+    assert f"{tmp_path / name}, option '--out': a run may not be named" in result.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -332,7 +336,7 @@ def test_model_info_names_no_option_it_does_not_have(tmp_path, monkeypatch):
     assert result.output == ("error: absent.safetensors: cannot read file: No such file or "
                              "directory\n")
     result = CliRunner().invoke(app, ["replay", "--model", "absent.safetensors", "--out", "o"])
-    assert result.exit_code == 2 and "column '--model'" in result.output
+    assert result.exit_code == 2 and "option '--model'" in result.output
 
 
 def test_apdl_like_run_says_why_a_deck_cannot_be_read(tmp_path):
@@ -392,7 +396,7 @@ def test_train_refuses_a_model_file_not_named_safetensors(tmp_path):
     out = tmp_path / "model.txt"
     result = CliRunner().invoke(app, ["train", str(tmp_path / "run.csv"), "--out", str(out)])
     assert result.exit_code == 2, result.output
-    assert f"{out}, column '--out'" in result.output and ".safetensors" in result.output
+    assert f"{out}, option '--out'" in result.output and ".safetensors" in result.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -481,7 +485,7 @@ def test_an_impossible_operating_point_names_the_option(command, options, option
     argv = [*command, *options] + (["--minutes", "3"] if command[0] == "simulate" else [])
     result = CliRunner().invoke(app, argv)
     assert result.exit_code == 2, result.output
-    assert result.output.startswith(f"error: column '{option}': ") and words in result.output
+    assert result.output.startswith(f"error: option '{option}': ") and words in result.output
     assert list(tmp_path.iterdir()) == []
 
 
@@ -513,7 +517,7 @@ def test_a_model_given_is_checked_whatever_the_methods(argv, tmp_path, monkeypat
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(app, [*argv, "--model", "modle.safetensors"])
     assert result.exit_code == 2, result.output
-    assert "modle.safetensors, column '--model': model file not found" in result.output
+    assert "modle.safetensors, option '--model': model file not found" in result.output
     (tmp_path / "notes.safetensors").write_text("not a model")
     result = CliRunner().invoke(app, [*argv, "--model", "notes.safetensors"])
     assert result.exit_code == 2, result.output

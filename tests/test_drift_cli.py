@@ -170,7 +170,7 @@ def test_a_target_must_be_a_displacement_column(machine, tmp_path, command):
     result = run(command, str(data), "--target", "drift_um,A_C",
                  "--out", str(tmp_path / ("m.safetensors" if command == "fit" else "s.json")))
     assert result.exit_code == 2, result.output
-    assert "column '--target'" in result.output and "'A_C'" in result.output
+    assert "option '--target'" in result.output and "'A_C'" in result.output
     assert "_um" in result.output and "Traceback" not in result.output
     assert list(tmp_path.iterdir()) == []
 

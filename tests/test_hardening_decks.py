@@ -71,7 +71,7 @@ def test_a_deck_does_not_write_over_a_file_it_read_by_input(tmp_path, written):
     deck.write_text("/INPUT,sub,inp\n" + written)
     result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path)])
     assert result.exit_code == 2, result.output
-    assert f"{sub}, column '--out': is also an input" in result.output
+    assert f"{sub}, option '--out': is also an input" in result.output
     assert sub.read_text() == "X = 1\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["main.inp", "sub.inp"]
 

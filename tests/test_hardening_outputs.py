@@ -163,7 +163,7 @@ def test_a_folder_where_an_output_file_goes_is_refused_before_any_work(tmp_path,
     args = [{"RUN": run_file, "DECK": deck}.get(a, a) for a in command[1:]]
     result = run_cli(cli, [*args, "--out", out])
     assert result.exit_code == 2, result.output
-    assert f"{out / name}, column '--out': is a folder, not a file" in result.output
+    assert f"{out / name}, option '--out': is a folder, not a file" in result.output
     assert [p.name for p in out.iterdir()] == [name]  # nothing written, nothing removed
 
 

@@ -383,7 +383,7 @@ def test_snapshot_tells_a_time_outside_the_run_from_an_internal_error(runs_dir, 
             "open_loop", "--time")
     late = CliRunner().invoke(app, [*args, "400"])
     assert late.exit_code == 2, late.output
-    assert "column '--time'" in late.output and "(0, 300] s" in late.output
+    assert "option '--time'" in late.output and "(0, 300] s" in late.output
 
     def broken(*args, **kwargs):
         raise ValueError("a window at t = 0 starts from a uniform temperature (TUNIF)")

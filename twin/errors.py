@@ -39,14 +39,17 @@ class InputError(ValueError):
         self.column = column
 
     def where(self) -> str:
-        """The location as the message shows it (`data.csv, row 3, column 'T_C'`), or ''."""
+        """The location as the message shows it (`data.csv, row 3, column 'T_C'`), or ''.
+        A command-line option in the column's place is called one (`RUN.csv, option
+        '--time'`): a user reading "column '--out'" looked for it in a file."""
         where = []
         if self.file is not None:
             where.append(str(self.file))
         if self.row is not None:
             where.append(f"row {self.row}")
         if self.column is not None:
-            where.append(f"column {self.column!r}")
+            kind = "option" if self.column.startswith("--") else "column"
+            where.append(f"{kind} {self.column!r}")
         return ", ".join(where)
 
     def located(self, file: str | None = None, row: int | None = None,
