@@ -273,6 +273,16 @@ def test_synth_tells_the_profile_columns_it_does_not_read(tmp_path):
     assert quiet.exit_code == 0 and quiet.output == ""
 
 
+def test_synth_suite_refuses_a_run_file_name_for_its_folder(tmp_path):
+    # --suite 2 --out runs.csv made a folder named runs.csv holding the suite
+    result = CliRunner().invoke(app, ["synth", "--suite", "2", "--seed", "1", "--minutes",
+                                      "2", "--out", str(tmp_path / "runs.csv"), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert f"{tmp_path / 'runs.csv'}, option '--out': --suite writes a folder" in " ".join(
+        result.output.split())
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("name", ["run.truth.csv", "run.profile.csv"])
 def test_synth_refuses_a_run_named_as_a_companion_file(tmp_path, name):
     # --out run.truth.csv wrote the run over the truth of run.csv, and 'twin replay DIR'

@@ -148,6 +148,11 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     if clash:
         raise InputError("--suite draws every run's conditions itself; leave this out",
                          column=clash)
+    if out.suffix.lower() in (".csv", ".parquet") and not (out.exists() or out.is_symlink()):
+        # a run file's name: made a folder of that name, which 'twin replay' of its parent
+        # then passes over (it lists files)
+        raise InputError("--suite writes a folder of runs, not a run file: name a folder "
+                         "(or leave --suite out for one run)", file=str(out), column="--out")
     check_out_dir(out)
     # one nominal truth model for the whole suite (each run adds its own material factors)
     model = SpindleModel.load(size_factor=Scenario().model.size_factor)
