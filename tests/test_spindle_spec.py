@@ -118,3 +118,20 @@ def test_bad_spec_via_cli_exits_2(tmp_path, raw):
     assert "neg.toml" in result.output and "r_outer_mm" in result.output
     assert "Traceback" not in result.output
     assert not (tmp_path / "m.msh").exists()
+
+
+@pytest.mark.parametrize("old, new, field", [
+    ("max_speed_rpm = 15000.0", "max_speed_rpm = -5", "spindle.max_speed_rpm"),
+    ('region = "shaft"', 'region = "shaftt"', "parts[0].region"),  # the first [[parts]]
+    ("r_outer_mm = 55.0", "r_outer_mm = -55.0", "r_outer_mm"),
+])
+def test_spec_errors_name_the_line(tmp_path, old, new, field):
+    # a scenario's errors named their line, a spec's (twin simulate/mesh --spec) only the
+    # field: with 30 [[parts]] a user had to count tables to find parts[17]
+    text = DEFAULT_SPEC_PATH.read_text()
+    path = tmp_path / "spec.toml"
+    path.write_text(text.replace(old, new, 1))
+    line = text[:text.index(old)].count("\n") + 1
+    with pytest.raises(InputError) as info:
+        load_spec(path)
+    assert info.value.row == line and field in str(info.value)

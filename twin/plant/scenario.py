@@ -45,7 +45,6 @@ values (the `twin synth --suite` files).
 from __future__ import annotations
 
 import os
-import re
 from typing import Annotated, ClassVar, Self
 
 from pydantic import (
@@ -60,7 +59,7 @@ from pydantic import (
 
 from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
 from twin.errors import InputError
-from twin.paths import parse_toml, read_input_text
+from twin.paths import parse_toml, read_input_text, toml_line_of
 from twin.plant.timetable import TimeTable
 
 SENSOR_COLUMNS = {
@@ -230,97 +229,6 @@ class Scenario(_Strict):
     model: ModelOptions = ModelOptions()
 
 
-def _line_of(text: str, loc: tuple) -> int | None:
-    """Best-effort line of a location (`faults.dropouts.1.sensor`) in TOML text: the line of
-    a list's item itself (tomllib keeps no positions, so the text is searched), else of its
-    key, else of its table's header."""
-    lines = text.split("\n")
-    path = [str(k) for k in loc]
-    header_at, body_from, used = None, 0, 0
-    for n in range(len(path), 0, -1):  # the deepest [a.b] or k-th [[a.b]] header there is
-        dotted = r"\s*\.\s*".join(map(re.escape, path[:n]))
-        if n < len(path) and path[n].isdigit():  # an item of an array of tables
-            hits = [i for i, ln in enumerate(lines)
-                    if re.match(r"^\s*\[\[\s*" + dotted + r"\s*\]\]", ln)]
-            if len(hits) > int(path[n]):
-                header_at, used = hits[int(path[n])], n + 1
-                break
-        hit = next((i for i, ln in enumerate(lines)
-                    if re.match(r"^\s*\[\s*" + dotted + r"\s*\]", ln)), None)
-        if hit is not None:
-            header_at, used = hit, n
-            break
-    if header_at is not None:
-        body_from = header_at + 1
-    rest = path[used:]
-    if rest and not rest[0].isdigit():
-        key = re.compile(r"^\s*" + re.escape(rest[0]) + r"\s*=")
-        for i in range(body_from, len(lines)):
-            if header_at is not None and lines[i].lstrip().startswith("["):
-                break
-            if key.match(lines[i]):
-                if len(rest) > 1 and rest[1].isdigit():
-                    offset = sum(len(ln) + 1 for ln in lines[:i]) + lines[i].index("=") + 1
-                    item = _array_item_offset(text, offset, int(rest[1]))
-                    if item is not None:
-                        return text.count("\n", 0, item) + 1
-                return i + 1
-    return None if header_at is None else header_at + 1
-
-
-def _array_item_offset(text: str, offset: int, index: int) -> int | None:
-    """Offset in `text` of item `index` of the TOML array whose value starts after
-    `offset` (just past its key's `=`); None if no array, or fewer items, is there.
-    Strings and comments are skipped: a `,` or `[` inside them separates nothing."""
-    i = offset
-    while i < len(text) and text[i] in " \t":
-        i += 1
-    if i >= len(text) or text[i] != "[":
-        return None
-    depth, count, expecting = 0, -1, False
-    while i < len(text):
-        c = text[i]
-        if c == "#":
-            i = text.find("\n", i)
-            if i < 0:
-                return None
-            continue
-        if depth == 1 and expecting and c not in " \t\r\n,]":
-            count, expecting = count + 1, False
-            if count == index:
-                return i
-        if c in "\"'":
-            i = _string_end(text, i)
-            continue
-        if c in "[{":
-            depth += 1
-            expecting = expecting or depth == 1
-        elif c in "]}":
-            depth -= 1
-            if depth == 0:
-                return None
-        elif c == "," and depth == 1:
-            expecting = True
-        i += 1
-    return None
-
-
-def _string_end(text: str, i: int) -> int:
-    """Offset just past the TOML string starting at `i` (basic or literal, one-line or
-    triple-quoted); the text's end for an unterminated one."""
-    quote = text[i]
-    delimiter = quote * 3 if text.startswith(quote * 3, i) else quote
-    j = i + len(delimiter)
-    while j < len(text):
-        if quote == '"' and text[j] == "\\":
-            j += 2
-            continue
-        if text.startswith(delimiter, j):
-            return j + len(delimiter)
-        j += 1
-    return len(text)
-
-
 def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
     """Parse scenario TOML text; errors name the file, line and dotted key."""
     data = parse_toml(text, file)
@@ -332,7 +240,7 @@ def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
         message = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             message = "unknown key (check the spelling)"
-        raise InputError(message, file=file, row=_line_of(text, loc),
+        raise InputError(message, file=file, row=toml_line_of(text, loc),
                          column=".".join(str(k) for k in loc) or None) from None
 
 
@@ -371,4 +279,4 @@ def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) 
     if late:
         loc, what = late[0]
         raise InputError(f"{what} is after the run's end ({duration_s:g} s)", file=file,
-                         row=_line_of(text, loc), column=".".join(map(str, loc)))
+                         row=toml_line_of(text, loc), column=".".join(map(str, loc)))

@@ -19,6 +19,7 @@ field (e.g. `parts[3].r_outer_mm`).
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Literal
 
@@ -27,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from twin.contract import SENSOR_NAMES
 from twin.data import bundled_path
 from twin.errors import InputError
-from twin.paths import read_toml
+from twin.paths import parse_toml, read_input_text, toml_line_of
 
 DEFAULT_SPEC_PATH = bundled_path("meshes", "reference_spindle.toml").resolve()
 """The bundled reference spindle (package data, `twin.data`)."""
@@ -382,8 +383,9 @@ def _field_path(loc: tuple) -> str:
     return path or "<top>"
 
 
-def parse_spec(data: dict, source: str = "<spec>") -> SpindleSpec:
-    """Validate a spec given as a dict (e.g. parsed TOML); errors name the field."""
+def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> SpindleSpec:
+    """Validate a spec given as a dict (e.g. parsed TOML); errors name the field, and with
+    the TOML `text` its line."""
     try:
         return SpindleSpec.model_validate(data)
     except ValidationError as exc:
@@ -400,10 +402,14 @@ def parse_spec(data: dict, source: str = "<spec>") -> SpindleSpec:
                 message = "unknown field (check the spelling and the unit in the name)"
             more = exc.error_count() - 1
         suffix = f" (and {more} more problem{'s' if more > 1 else ''})" if more > 0 else ""
-        raise InputError(f"field {field_name}: {message}{suffix}", file=source) from None
+        row = None if text is None else toml_line_of(text, tuple(re.findall(r"[^.\[\]]+",
+                                                                             field_name)))
+        raise InputError(f"field {field_name}: {message}{suffix}", file=source,
+                         row=row) from None
 
 
 def load_spec(path: str | Path | None = None) -> SpindleSpec:
     """Read and validate a spindle spec TOML (None: the bundled reference spindle)."""
     path = Path(path) if path is not None else DEFAULT_SPEC_PATH
-    return parse_spec(read_toml(path), str(path))
+    text = read_input_text(path, max_bytes=2**20)
+    return parse_spec(parse_toml(text, str(path)), str(path), text)
