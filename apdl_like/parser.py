@@ -94,19 +94,7 @@ def commands_on(line: str) -> list[str]:
     head = line.lstrip().upper()
     if head.startswith(("C***", *_TEXT_COMMANDS)):
         return [line]
-    commands, start, quoted = [], 0, False
-    for i, ch in enumerate(line):
-        if ch == "'":
-            quoted = not quoted
-        elif quoted:
-            continue
-        elif ch == "!":
-            break
-        elif ch == "$":
-            commands.append(line[start:i])
-            start = i + 1
-    commands.append(line[start:])
-    return commands
+    return split_fields(_strip_comment(line), separators="$")
 
 
 def split_fields(body: str, separators: str = ",", kept: str = "") -> list[str]:
