@@ -194,3 +194,21 @@ def test_the_same_data_given_twice_is_bad_input(machine, tmp_path, command):
         assert f"{second}: holds the same data as {data}" in " ".join(result.output.split())
         assert "Traceback" not in result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["copy.csv"]
+
+
+def test_a_probe_that_never_moves_is_bad_input_and_reports_still_work(machine, tmp_path):
+    # a dead probe (every row 0 µm) had NaN grades for every sensor: select printed 'nan',
+    # fit wrote a model, and its report ended in 'internal error: Axis limits cannot be NaN'
+    folder, _, model = machine
+    columns = synthetic_columns(hours=3.0)
+    columns["drift_um"] = np.zeros_like(columns["drift_um"])
+    dead = tmp_path / "dead.csv"
+    write_csv(dead, columns)
+    for command, out in (("fit", "m.safetensors"), ("select", "s.json")):
+        result = run(command, str(dead), "--target", "drift_um", "--out", str(tmp_path / out))
+        assert result.exit_code == 2, result.output
+        assert f"{dead}, column 'drift_um': never changes" in " ".join(result.output.split())
+    # a good model's report on a stretch where the probe reads flat is no error
+    result = run("report", str(model), str(dead), "--out", str(tmp_path / "report"))
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dead.csv", "report"]

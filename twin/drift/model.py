@@ -87,8 +87,13 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
 def sensor_ranking(data: DriftData) -> SensorRanking:
     """Rank the data's temperature sensors for its targets (rows with every target)."""
     rows = measured_rows(data)
-    return rank_sensors(data.sensors, data.T_C[rows],
-                        {t: data.targets_um[rows, j] for j, t in enumerate(data.targets)})
+    targets = {t: data.targets_um[rows, j] for j, t in enumerate(data.targets)}
+    for name, values in targets.items():
+        if np.ptp(values) == 0:  # no grade, no correlation, no fit: every grade was NaN
+            raise InputError(f"never changes (every row {values[0]:g} µm): a probe that does "
+                             "not move leaves nothing to model", file=", ".join(data.files),
+                             column=name)
+    return rank_sensors(data.sensors, data.T_C[rows], targets)
 
 
 def measured_rows(data: DriftData) -> np.ndarray:

@@ -39,6 +39,14 @@ def _finite_or_none(value: object) -> object:
     return value
 
 
+def _finite_mean(values: list[float]) -> float:
+    """Mean of the finite values, NaN (null in the JSON) for none: R² of a probe that reads
+    flat is undefined, and nanmean of nothing warned."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    return float(finite.mean()) if finite.size else float("nan")
+
+
 def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
                   hi: np.ndarray) -> dict:
     """metrics.json: per target rmse_um, mae_um, max_abs_um, r2, coverage_90_pct."""
@@ -47,7 +55,7 @@ def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.n
     per_target = {t: target_metrics(data.targets_um[:, j], mean[:, j], lo[:, j], hi[:, j])
                   for j, t in enumerate(model.targets)}
     keys = ("rmse_um", "mae_um", "max_abs_um", "r2", "coverage_90_pct")
-    mean_of = {k: float(np.nanmean([m[k] for m in per_target.values()])) for k in keys}
+    mean_of = {k: _finite_mean([m[k] for m in per_target.values()]) for k in keys}
     validation = model.metadata.get("validation", {})
     return _finite_or_none({
         "method": model.method, "files": list(data.files), "n_rows": data.n_samples,
