@@ -86,7 +86,8 @@ HOW_TO_RUN = (
 
 def window_deck(loads: LoadSet, layout: DeckLayout,
                 start_temperature_C: float | None = None,
-                load_step: tuple[int, int] | None = None, notes: tuple[str, ...] = ()) -> str:
+                load_step: tuple[int, int] | None = None, notes: tuple[str, ...] = (),
+                after: LoadSet | None = None) -> str:
     """The APDL text of one window, or of one load step of a window written as several.
 
     start_temperature_C  the uniform field a run's first window (start 0 s) starts from,
@@ -96,6 +97,10 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
     load_step            (i, n): this text is load step i of the window's n (1-based): the
                          title says so, and only the first says how the deck runs
     notes                comment lines (without "! ") saying where the step's loads come from
+    after                the load set of the load step this text follows in the same deck
+                         (i > 1): a load it holds with the same value is not restated, as
+                         loads stay until changed (in MAPDL and here).  Where the two name
+                         different regions, boundaries or interfaces, all is written.
     """
     for name in loads.heat_generation:
         if name not in layout.regions:
@@ -119,9 +124,20 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
                f"! ---- window {loads.window}, load step {i} of {n}: "
                f"t = {loads.start_s:g} .. {end:g} s, {steps}"]
     out += [f"! {line}" for line in notes]
-    if loads.contact_resistance:
+    heat, films, contacts = (loads.heat_generation, loads.convection,
+                             loads.contact_resistance)
+    if after is not None and load_step is not None and load_step[0] > 1 and (
+            heat.keys() == after.heat_generation.keys()
+            and films.keys() == after.convection.keys()
+            and contacts.keys() == after.contact_resistance.keys()):
+        # what load step i-1 set and this one keeps stays set: only the changes are written
+        heat = {k: v for k, v in heat.items() if after.heat_generation[k] != v}
+        films = {k: v for k, v in films.items() if after.convection[k] != v}
+        contacts = {k: v for k, v in contacts.items() if after.contact_resistance[k] != v}
+        out.append("! loads not restated here stay as the load step before set them")
+    if contacts:
         out.append("/PREP7")
-        for name, r in sorted(loads.contact_resistance.items()):
+        for name, r in sorted(contacts.items()):
             out.append(f"RMODIF,{layout.interfaces[name]},14,{_num(1.0 / r)}"
                        f"   ! {name}: TCC = 1/R, R = {r:.6g} m2K/W")
         out.append("FINISH")
@@ -138,9 +154,9 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
         f"TIME,{_num(end)}",
         "OUTRES,ALL,ALL",
     ]
-    for name, q in sorted(loads.heat_generation.items()):
+    for name, q in sorted(heat.items()):
         out += [f"CMSEL,S,{layout.regions[name]}", f"BFE,ALL,HGEN,,{_num(q)}   ! W/m3"]
-    for name, (h, tb) in sorted(loads.convection.items()):
+    for name, (h, tb) in sorted(films.items()):
         out += [f"CMSEL,S,{layout.boundaries[name]}",
                 f"SF,ALL,CONV,{_num(h)},{_num(tb)}   ! W/m2K, C"]
     out += ["ALLSEL", "SOLVE", "FINISH", ""]
