@@ -190,8 +190,8 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
     # the load step this session solved last: (window, (i, n), its load set).  Load step
     # i + 1 of the same deck then writes only the loads that changed (the others stay
     # set), as a deck of 15 load steps whose bearing loads follow the rings would be
-    # written by hand: 24 instead of 54 commands a step, and the interpreter's time per
-    # replayed window roughly halved.
+    # written by hand: 24 instead of 54 commands a step (a ring-following method's replay
+    # of a 30-min run: 0.47 -> 0.40 s CPU).  Any other call in between resets it.
     last: list = [None]
 
     def solve(
