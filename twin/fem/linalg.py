@@ -84,6 +84,17 @@ class WoodburySolver:
         return y - base.Z @ sla.lu_solve(self._lu, self._W @ (base.Ut @ y))
 
 
+def kept(cache: dict, key: Hashable, make: Callable[[], object], max_items: int) -> object:
+    """`cache[key]`, made by `make()` on a miss; at most `max_items` are kept, the oldest
+    dropped first (bounded memory for values a loop asks for again and again)."""
+    value = cache.get(key)
+    if value is None:
+        if len(cache) >= max_items:
+            cache.pop(next(iter(cache)))
+        value = cache[key] = make()
+    return value
+
+
 class LowRankUpdate:
     """Solvers of A₀ + U W Uᵀ for fixed update columns U (n × m, m small).
 
@@ -105,9 +116,5 @@ class LowRankUpdate:
         self, key: Hashable, base: Callable[[], DirichletSolver], W: np.ndarray
     ) -> WoodburySolver:
         """The solver of A₀(key) + U W Uᵀ; `base()` factorizes A₀ on a cache miss."""
-        cached = self._bases.get(key)
-        if cached is None:
-            if len(self._bases) >= self.max_bases:  # bound memory: drop the oldest
-                self._bases.pop(next(iter(self._bases)))
-            cached = self._bases[key] = _Base(base(), self.U)
+        cached = kept(self._bases, key, lambda: _Base(base(), self.U), self.max_bases)
         return WoodburySolver(cached, W)

@@ -26,12 +26,16 @@ from twin.fem.balance import HeatBalance
 from twin.fem.combine import PatternCombination
 from twin.fem.elements import element_for
 from twin.fem.forms import capacity, conduction, unit_load, unit_load_weighted
-from twin.fem.linalg import DirichletSolver, LowRankUpdate, WoodburySolver
+from twin.fem.linalg import DirichletSolver, LowRankUpdate, WoodburySolver, kept
 from twin.fem.loads import ThermalLoads, field_values
 from twin.fem.materials import Material
 from twin.fem.mesh import AxiMesh
 from twin.fem.probes import probe_matrix
 from twin.fem.stepper import ThermalStepper
+
+KEPT_FILM_SETS = 8
+"""Film loads and heat-balance row sums kept per set of film coefficients (the newest; they
+change with the speed only), as `LowRankUpdate` keeps its factorizations."""
 
 
 class ThermalProblem:
@@ -236,11 +240,7 @@ class ThermalProblem:
         bulk temperatures it is kept per set of (h, T∞) in the boundaries' order, the order
         of the sum (a loop re-evaluating the bearing loads every step keeps its films):
         a hit is the vector made anew, to the bit."""
-        key = None
-        if not any(callable(t_inf) for _, t_inf in convection.values()):
-            key = tuple((b, float(h), float(t)) for b, (h, t) in convection.items())
-        load = None if key is None else self._convection_loads.get(key)
-        if load is None:
+        def make() -> np.ndarray:
             load = np.zeros(self.n_dofs)
             for boundary, (h, t_inf) in convection.items():
                 self._boundary_terms(boundary)
@@ -251,11 +251,12 @@ class ThermalProblem:
                     f"boundary {boundary!r}",
                 )
             load.flags.writeable = False
-            if key is not None:
-                if len(self._convection_loads) >= 8:  # bound memory: drop the oldest
-                    self._convection_loads.pop(next(iter(self._convection_loads)))
-                self._convection_loads[key] = load
-        return load
+            return load
+
+        if any(callable(t_inf) for _, t_inf in convection.values()):
+            return make()
+        key = tuple((b, float(h), float(t)) for b, (h, t) in convection.items())
+        return kept(self._convection_loads, key, make, KEPT_FILM_SETS)
 
     def system(self, loads: ThermalLoads) -> tuple[np.ndarray, np.ndarray]:
         """Conductance data K (on the shared pattern, W/K) and load vector f (W)."""
@@ -368,14 +369,12 @@ class ThermalProblem:
     def _film_row_sums(self, films: dict[str, float]) -> np.ndarray:
         """Σ h M_film·1 (W/K per dof) of film coefficients `films`; read-only.  Keyed in
         the films' order, the order of the sum: a hit is the vector made anew, to the bit."""
-        key = tuple(films.items())
-        rows = self._film_rows.get(key)
-        if rows is None:
-            if len(self._film_rows) >= 8:  # bound memory: drop the oldest
-                self._film_rows.pop(next(iter(self._film_rows)))
-            rows = self._film_rows[key] = self.ops.matrix(films) @ np.ones(self.n_dofs)
+        def make() -> np.ndarray:
+            rows = self.ops.matrix(films) @ np.ones(self.n_dofs)
             rows.flags.writeable = False
-        return rows
+            return rows
+
+        return kept(self._film_rows, tuple(films.items()), make, KEPT_FILM_SETS)
 
     def energy_balance(
         self,
