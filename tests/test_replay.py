@@ -436,3 +436,32 @@ def test_snapshot_png_with_an_upper_case_suffix(spindle_model, tmp_path):
     render_snapshot(spindle_model, T, out, section=True, window_size=(300, 200))
     assert Image.open(out).format == "PNG"
     assert [p.name for p in tmp_path.iterdir()] == ["S.PNG"]  # no temporary file left
+
+
+def test_a_dead_thermocouple_is_left_out_as_a_stuck_one_is(tmp_path, spindle_model):
+    """A thermocouple column with no value in the whole run (a dead channel) is excluded
+    like a sensor frozen from the start: every method's outputs are the stuck run's, byte
+    for byte, and the run is no longer refused (it was: "column has no values")."""
+
+    def frozen(t, temps):
+        temps[:, 1] = temps[0, 1]
+
+    def dead(t, temps):
+        temps[:, 1] = np.nan
+
+    make_recorded_run(tmp_path / "stuck.csv", spindle_model, edit=frozen)
+    make_recorded_run(tmp_path / "dead.csv", spindle_model, edit=dead)
+    methods = "open_loop,ratio,bpnn,estimator"
+    result = replay(tmp_path / "stuck.csv", tmp_path / "dead.csv", out=tmp_path / "out",
+                    methods=methods)
+    assert result.exit_code == 0, result.output
+    out = {name: tmp_path / "out" / name for name in ("stuck", "dead")}
+    kinds = {name: {(f["column"], f["kind"]) for f in
+                    json.loads((d / "quality.json").read_text())["findings"]}
+             for name, d in out.items()}
+    assert ("T2_C", "stuck") in kinds["stuck"] and ("T2_C", "dead") in kinds["dead"]
+    for name in ("keypoints.csv", "corrections.csv"):
+        assert (out["dead"] / name).read_bytes() == (out["stuck"] / name).read_bytes(), name
+    acc = {n: json.loads((d / "accuracy.json").read_text())["methods"] for n, d in out.items()}
+    assert acc["dead"] == acc["stuck"]
+    assert all(m["rmse_C"]["T2"] is None for m in acc["dead"].values())

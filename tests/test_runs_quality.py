@@ -179,6 +179,18 @@ def test_stuck_sensor_flat_with_noise(tmp_path):
     assert not run.valid["T3_C"].any()
 
 
+def test_a_thermocouple_without_values_is_dead_and_excluded(tmp_path):
+    cols = noisy_warmup()
+    cols["T3_C"][:] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "dead", "T3_C")
+    assert f["count"] == 600 and f["spans_s"] == [[0.0, 599.0]]
+    assert "excluded" in f["action"]
+    assert not run.valid["T3_C"].any() and all(run.valid[f"T{i}_C"].all() for i in (1, 2, 4, 5))
+    assert np.isfinite(run.T_C).all()  # a stand-in nothing reads, never NaN in a solver
+    assert kinds(run) == {"dead"}
+
+
 def test_noisy_sensor_smoothed(tmp_path):
     cols = noisy_warmup()
     truth = warmup(n=600)["T5_C"]

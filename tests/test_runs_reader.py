@@ -189,6 +189,13 @@ def test_required_column_without_values(tmp_path):
     expect_error(write(tmp_path, csv_text(cols)), 2, "ambient_C", "no values")
 
 
+def test_a_run_without_any_temperature_is_refused(tmp_path):
+    cols = warmup()
+    for i in range(1, 6):
+        cols[f"T{i}_C"][:] = np.nan
+    expect_error(write(tmp_path, csv_text(cols)), 2, "T1_C", "no temperature sensor")
+
+
 def test_missing_time(tmp_path):
     text = csv_text(warmup()).splitlines()
     text[3] = "," + text[3].split(",", 1)[1]

@@ -3,7 +3,8 @@
 Repaired here, in this order: duplicate timestamps (merged), spikes (robust Hampel-type
 filter), NaN dropouts and short time gaps (linear interpolation up to `max_gap_s`; longer
 ones are interpolated for continuity but excluded from the metrics), noisy sensors
-(centred moving average), stuck sensors (flat while the others move: excluded).  A
+(centred moving average), stuck sensors (flat while the others move: excluded), dead
+thermocouples (no value in the whole run: excluded).  A
 finding is a plain JSON-serialisable dict:
 
     {"column": "T2_C", "kind": "stuck", "count": 1800, "rows": [3, 4, ...],
@@ -19,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.runs.schema import DISPLACEMENTS, SPEED, TEMPERATURES, TIME
+from twin.runs.schema import AMBIENT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
 
 MAX_LISTED = 20
@@ -345,10 +346,17 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
                                 detail=f"first sample at {time[0]:g} s"))
         time = time - time[0]
 
+    dead = [n for n in TEMPERATURES if np.isnan(columns[n]).all()]
     for name in [n for n in columns if np.isnan(columns[n]).all()]:
-        # Only optional columns can be empty here (validation rejects empty required ones).
-        findings.append(finding(name, "empty_column", "column ignored", count=time.size,
-                                detail="no values in the whole run"))
+        # Only optional columns and thermocouples can be empty here (validation rejects
+        # the other required ones and a run without any temperature).
+        if name in dead:
+            findings.append(finding(name, "dead", "excluded from metrics and correction "
+                                    "inputs", count=time.size, spans_s=[(time[0], time[-1])],
+                                    detail="no values in the whole run"))
+        else:
+            findings.append(finding(name, "empty_column", "column ignored", count=time.size,
+                                    detail="no values in the whole run"))
         del columns[name]
     raw = {n: v.copy() for n, v in columns.items()}
     valid: dict[str, np.ndarray] = {}
@@ -377,5 +385,11 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
     findings += found
     for name, mask in stuck.items():
         valid[name] &= ~mask
+    for name in dead:
+        # A dead channel keeps its place in T1..T5, never valid.  Its values are the
+        # ambient's, a finite stand-in that nothing reads (every consumer masks by
+        # `valid`; the outputs write NaN there), so no NaN reaches a solver or a filter.
+        columns[name] = columns[AMBIENT].copy()
+        valid[name] = np.zeros(time.size, dtype=bool)
     return Repaired(time_s=time, rows=rows, columns=columns, valid=valid, gaps_s=gaps,
                     findings=findings)

@@ -32,15 +32,21 @@ to the second is Fahrenheit: 45–130 °F is 7–54 °C, any room or coolant log
 
 
 def check_structure(table: RawTable) -> None:
-    """Required columns present, each with values, time readable and non-decreasing."""
+    """Required columns present, each with values (but for dead thermocouples, while one
+    is left), time readable and non-decreasing."""
     for name in REQUIRED:
         if name not in table.columns:
             raise InputError("missing required column", file=table.file, row=table.header_row,
                              column=name)
     for name in REQUIRED:
-        if np.isnan(table.columns[name]).all():
+        # a thermocouple with no value in the whole run is a dead channel, which the
+        # repair excludes; the run is refused only when no temperature sensor is left
+        if name not in TEMPERATURES and np.isnan(table.columns[name]).all():
             raise InputError("column has no values", file=table.file,
                              row=int(table.rows[0]), column=name)
+    if all(np.isnan(table.columns[name]).all() for name in TEMPERATURES):
+        raise InputError("no temperature sensor has a value (T1_C..T5_C all empty)",
+                         file=table.file, row=int(table.rows[0]), column=TEMPERATURES[0])
     time = table.columns[TIME]
     missing = np.flatnonzero(np.isnan(time))
     if missing.size:
