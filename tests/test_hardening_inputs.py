@@ -16,6 +16,7 @@ from twin.cli import app
 from twin.correction.modelfile import load_model
 from twin.errors import InputError
 from twin.plant.scenario import parse_scenario
+from twin.runs import read_run
 from twin.spindle.spec import load_spec
 
 
@@ -86,14 +87,24 @@ def test_deeply_nested_spec_toml_refused(tmp_path):
         load_spec(spec)
 
 
-def test_defect12_synth_refuses_a_dropout_that_empties_a_sensor(tmp_path):
+def test_defect12_synth_refuses_dropouts_that_empty_every_sensor(tmp_path):
+    """A scenario that empties every thermocouple makes a run replay refuses; synth says so
+    and writes nothing.  One emptied sensor is a dead channel replay leaves out."""
     scenario = tmp_path / "s.toml"
+    every = ", ".join(f'{{sensor = "T{i}", start_s = 0, end_s = 100000}}' for i in range(1, 6))
+    scenario.write_text(f"[faults]\ndropouts = [{every}]\n")
+    result = cli("synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
+                 "--scenario", scenario, "--out", tmp_path / "r.csv", "--quiet")
+    assert result.exit_code == 2 and "s.toml" in result.output and "T1_C" in result.output
+    assert "refused by replay" in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
     scenario.write_text('[faults]\ndropouts = [{sensor = "T4", start_s = 0, end_s = 100000}]\n')
     result = cli("synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
                  "--scenario", scenario, "--out", tmp_path / "r.csv", "--quiet")
-    assert result.exit_code == 2 and "s.toml" in result.output and "T4_C" in result.output
-    assert "refused by replay" in result.output
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+    assert result.exit_code == 0, result.output
+    run = read_run(tmp_path / "r.csv")
+    assert not run.valid["T4_C"].any()
+    assert [f["kind"] for f in run.quality if f["column"] == "T4_C"] == ["dead"]
 
 
 def test_defect15_warnings_go_to_the_log_not_the_terminal(tmp_path):
