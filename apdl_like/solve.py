@@ -148,8 +148,7 @@ def adopt_thermal_problem(session: SessionState, problem: ThermalProblem) -> Non
 
 def _check_axisymmetric(session: SessionState, physics: str) -> None:
     db = session.db
-    types = {int(t) for t in np.unique(db.elements.type)}
-    for t in types:
+    for t in db.elements.type_numbers():
         et = db.element_types[t]
         if et.physics == "unsupported":
             raise ApdlError(f"element type {t} ({et.name}) is not supported: redefine it, e.g. "
