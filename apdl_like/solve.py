@@ -14,6 +14,7 @@ always stepped.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING
@@ -23,7 +24,6 @@ import numpy as np
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
 from apdl_like.model import RecordPartition, record_groups
-from apdl_like.plane_solve import deck_faces, solve_plane_structural, solve_plane_thermal
 from apdl_like.state import TCC_LOCATION, StepResult
 from apdl_like.tabular_loads import in_use
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
@@ -192,7 +192,7 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
     for idx, name in _load_sets(session, fem, "conv", faces.conv_record,
                                 None if fprev is None else fprev["conv_h"], boundary):
         h, tb = float(faces.conv_h[idx[0]]), float(faces.conv_bulk[idx[0]])
-        if np.isnan(h) or np.isnan(tb):
+        if math.isnan(h) or math.isnan(tb):
             raise ApdlError("a face has CONV with only one of film coefficient and bulk "
                             "temperature (SFE KVAL 1 and 2)")
         if fprev is not None:
@@ -286,6 +286,8 @@ def face_table(session: SessionState):  # noqa: ANN201 - FemModel | plane_solve.
     """The exterior faces SF/SFE load: the AxiMesh's (a twin session) or the deck mesh's."""
     if session.fem.external_mesh:
         return fem_model(session)
+    from apdl_like.plane_solve import deck_faces  # a deck's own mesh: imported when used
+
     return deck_faces(session)
 
 
@@ -295,6 +297,8 @@ def solve_thermal(session: SessionState) -> StepResult:
         raise ApdlError("radiation between RDSF surfaces is not solved (apdl_like computes "
                         "their view factors only: /AUX12, VFQUERY)")
     if not session.fem.external_mesh:
+        from apdl_like.plane_solve import solve_plane_thermal
+
         return solve_plane_thermal(session)
     refuse_deck_mesh_loads(session, "solved")
     fem = fem_model(session)
@@ -373,6 +377,8 @@ def _constraints(session: SessionState, fem: FemModel) -> dict[str, str]:
 def solve_structural(session: SessionState) -> StepResult:
     """A static thermo-elastic load step: twin.fem for a twin session, else the deck mesh."""
     if not session.fem.external_mesh:
+        from apdl_like.plane_solve import solve_plane_structural
+
         return solve_plane_structural(session)
     fem = fem_model(session)
     _check_axisymmetric(session, "structural")
