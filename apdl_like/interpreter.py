@@ -25,6 +25,10 @@ MAX_STATEMENTS = 2_000_000
 MAX_INPUT_DEPTH = 8
 IF_OPERATORS = ("EQ", "NE", "LT", "GT", "LE", "GE", "ABLT", "ABGT")
 EQ_TOLERANCE = 1e-10  # APDL compares *IF values with this absolute tolerance
+# statements `execute` runs itself (assignments, control flow, /INPUT, *REPEAT, bad lines);
+# every other name is a command for `_dispatch`
+_CONTROL = frozenset((BAD_LINE, "=", "*DO", "*ENDDO", "*IF", "*ELSEIF", "*ELSE", "*ENDIF",
+                      "*EXIT", "*CYCLE", "/INPUT", "*REPEAT"))
 
 
 class _Exit(Exception):
@@ -117,6 +121,11 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
         if session.budget.statements_run > MAX_STATEMENTS:
             raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
         name = st.name
+        if name not in _CONTROL:  # a command: the usual statement, one set lookup
+            _dispatch(session, st)
+            previous = st
+            i += 1
+            continue
         try:
             if name == BAD_LINE:
                 raise st.error(st.fields[0])

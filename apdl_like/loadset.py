@@ -34,9 +34,12 @@ def canonical_resistance(r: float) -> float:
     return 1.0 / (1.0 / float(r))
 
 
-def _finite(value: float, what: str) -> float:
+def _finite(value: float, what: str, of: object = None) -> float:
+    """`value` as a float; ValueError naming `what` (of `of`, when given) unless finite.
+    The message is made on failure only: the loop makes a load set every solver step."""
     value = float(value)
     if not math.isfinite(value):
+        what = what if of is None else f"{what} of {of!r}"
         raise ValueError(f"{what} must be finite, got {value!r}")
     return value
 
@@ -65,17 +68,17 @@ class LoadSet:
                              f"got {self.n_steps!r}")
         object.__setattr__(self, "window", int(self.window))
         object.__setattr__(self, "n_steps", int(self.n_steps))
-        heat = {str(k): _finite(v, f"heat generation of {k!r}")
+        heat = {str(k): _finite(v, "heat generation", k)
                 for k, v in self.heat_generation.items()}
         conv = {}
         for k, hc in self.convection.items():
             h, tb = hc
-            if not (_finite(h, f"film coefficient of {k!r}") >= 0.0):
+            if not (_finite(h, "film coefficient", k) >= 0.0):
                 raise ValueError(f"film coefficient of {k!r} must be ≥ 0, got {h!r}")
-            conv[str(k)] = (float(h), _finite(tb, f"bulk temperature of {k!r}"))
+            conv[str(k)] = (float(h), _finite(tb, "bulk temperature", k))
         contact = {}
         for k, r in self.contact_resistance.items():
-            if not (_finite(r, f"contact resistance of {k!r}") > 0.0):
+            if not (_finite(r, "contact resistance", k) > 0.0):
                 raise ValueError(f"contact resistance of {k!r} must be > 0, got {r!r}")
             contact[str(k)] = canonical_resistance(r)
         object.__setattr__(self, "heat_generation", heat)

@@ -247,6 +247,16 @@ class ElementTable(_NumberedTable):
     def add(self, number: int, etype: int, mat: int, real: int, nodes: tuple[int, ...]) -> None:
         self.pending[number] = (etype, mat, real, nodes)
 
+    def type_numbers(self) -> list[int]:
+        """The element type numbers in use, ascending (`np.unique` of `type`).  A mesh of
+        one type, the usual case, is told by one comparison: np.unique sorts (or hashes)
+        the whole column, which every SOLVE of a window deck read twice."""
+        self.flush()
+        t = self.type
+        if t.size and bool((t == t[0]).all()):
+            return [int(t[0])]
+        return [int(x) for x in np.unique(t)]
+
     def flush(self) -> None:
         if not self.pending:
             return
@@ -292,13 +302,68 @@ def record_groups(record: np.ndarray, extra: np.ndarray | None = None) -> list[n
         return []
     if extra is None:
         order = has[np.argsort(record[has], kind="stable")]
-        return np.split(order, np.nonzero(np.diff(record[order]))[0] + 1)
+        return _split(order, np.nonzero(np.diff(record[order]))[0] + 1)
     keys = np.column_stack([record[has].astype(float), np.nan_to_num(extra[has], nan=-1e300)])
     _, inverse = np.unique(keys, axis=0, return_inverse=True)
     inverse = inverse.ravel()
     order = np.argsort(inverse, kind="stable")
     splits = np.nonzero(np.diff(inverse[order]))[0] + 1
-    return [has[s] for s in np.split(order, splits)]
+    return [has[s] for s in _split(order, splits)]
+
+
+def _split(a: np.ndarray, at: np.ndarray) -> list[np.ndarray]:
+    """`np.split(a, at)` for ascending indices `at` (the same views, without np.split's
+    per-piece overhead)."""
+    bounds = [0, *at.tolist(), a.size]
+    return [a[i:j] for i, j in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+@dataclass(eq=False)
+class RecordPartition:
+    """`record_groups(record)` of one record array, kept to be reused while a later record
+    array partitions the entities the same way (`order_of`).
+
+    Every load command gives its entities a new record id, so a window deck's load step
+    that restates the bearing heat on the same components leaves new ids but the same
+    groups; telling that takes a few vector comparisons, where grouping anew sorts the
+    records.  `names` holds what the owner (`owner`, the FemModel it was made for) names
+    each group, filled in by the owner as it needs them.
+    """
+
+    owner: object
+    has: np.ndarray  # record >= 0
+    members: np.ndarray  # np.nonzero(has)[0]
+    label: np.ndarray  # the group (index into groups) of each member
+    first: np.ndarray  # the position in `members` of each group's first member
+    groups: list[np.ndarray]
+    names: list[str | None]
+
+    @classmethod
+    def of(cls, record: np.ndarray, owner: object) -> RecordPartition:
+        has = record >= 0
+        members = np.nonzero(has)[0]
+        groups = record_groups(record)
+        label = np.empty(members.size, np.int64)
+        for i, g in enumerate(groups):
+            label[np.searchsorted(members, g)] = i
+        first = np.searchsorted(members, [int(g[0]) for g in groups]).astype(np.int64)
+        return cls(owner, has, members, label, first, groups, [None] * len(groups))
+
+    def order_of(self, record: np.ndarray, owner: object) -> list[int] | None:
+        """The groups of `record` as `record_groups` gives them (ascending record), as
+        indices into `groups`, if `record` (of the same `owner`) partitions the entities
+        as this one does; else None.  The same partition: the same entities have a record,
+        every group's members share one record, and no two groups share one."""
+        if owner is not self.owner or not np.array_equal(record >= 0, self.has):
+            return None
+        r = record[self.members]
+        rep = r[self.first]
+        if not np.array_equal(r, rep[self.label]):
+            return None
+        order = np.argsort(rep, kind="stable")
+        if rep.size > 1 and not bool(np.all(np.diff(rep[order]) > 0)):
+            return None
+        return order.tolist()
 
 
 @dataclass

@@ -211,6 +211,7 @@ def _if_is_block(st: Statement) -> bool:
 
 BLOCK_COMMANDS = ("NBLOCK", "EBLOCK", "CMBLOCK")
 FORMAT_COMMANDS = ("*VWRITE", "*MWRITE", "*VREAD", "*MSG")  # the next line is their format
+_DATA_COMMANDS = frozenset((*BLOCK_COMMANDS, *FORMAT_COMMANDS))  # data or format follows
 MAX_BLOCK_LINES = 5_000_000
 
 
@@ -266,7 +267,10 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
             continue
         if st.name == "/EOF":
             break
-        if queued and st.name in (*BLOCK_COMMANDS, *FORMAT_COMMANDS):
+        if st.name not in _DATA_COMMANDS:
+            statements.append(st)
+            continue
+        if queued:
             # its data or format are the next lines, not the rest of this one
             statements.append(Statement(file, st.line, BAD_LINE, (
                 "no command may follow it after '$': its data lines come next", st.name)))

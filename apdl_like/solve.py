@@ -14,14 +14,16 @@ always stepped.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, build_model
-from apdl_like.model import record_groups
-from apdl_like.plane_solve import deck_faces, solve_plane_structural, solve_plane_thermal
+from apdl_like.model import RecordPartition, record_groups
 from apdl_like.state import TCC_LOCATION, StepResult
 from apdl_like.tabular_loads import in_use
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
@@ -148,8 +150,7 @@ def adopt_thermal_problem(session: SessionState, problem: ThermalProblem) -> Non
 
 def _check_axisymmetric(session: SessionState, physics: str) -> None:
     db = session.db
-    types = {int(t) for t in np.unique(db.elements.type)}
-    for t in types:
+    for t in db.elements.type_numbers():
         et = db.element_types[t]
         if et.physics == "unsupported":
             raise ApdlError(f"element type {t} ({et.name}) is not supported: redefine it, e.g. "
@@ -174,19 +175,24 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
     cell_rec = el["hgen_record"][fem.cell_element]
     cell_prev = prev["hgen"][fem.cell_element] if prev is not None else None
     sources = {}
-    for cells in record_groups(cell_rec, cell_prev):
+    for cells, name in _load_sets(session, fem, "hgen", cell_rec, cell_prev, fem.region_for):
         q = float(cell_hgen[cells[0]])
         if prev is not None:
             q0 = float(np.nan_to_num(cell_prev[cells[0]]))
             q = q0 + fraction * (q - q0)
         if q != 0.0:
-            sources[fem.region_for(cells)] = q
+            sources[name()] = q
     faces = db.faces
     convection, flux = {}, {}
     fprev = prev["faces"] if prev is not None else None
-    for idx in record_groups(faces.conv_record, None if fprev is None else fprev["conv_h"]):
+
+    def boundary(idx: np.ndarray) -> str:
+        return fem.boundary_for(fem.face_facets[idx])
+
+    for idx, name in _load_sets(session, fem, "conv", faces.conv_record,
+                                None if fprev is None else fprev["conv_h"], boundary):
         h, tb = float(faces.conv_h[idx[0]]), float(faces.conv_bulk[idx[0]])
-        if np.isnan(h) or np.isnan(tb):
+        if math.isnan(h) or math.isnan(tb):
             raise ApdlError("a face has CONV with only one of film coefficient and bulk "
                             "temperature (SFE KVAL 1 and 2)")
         if fprev is not None:
@@ -195,14 +201,15 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
             tb0 = tunif if np.isnan(tb0) else float(tb0)
             h, tb = h0 + fraction * (h - h0), tb0 + fraction * (tb - tb0)
         if h != 0.0:
-            convection[fem.boundary_for(fem.face_facets[idx])] = (h, tb)
-    for idx in record_groups(faces.hflux_record, None if fprev is None else fprev["hflux"]):
+            convection[name()] = (h, tb)
+    for idx, name in _load_sets(session, fem, "hflux", faces.hflux_record,
+                                None if fprev is None else fprev["hflux"], boundary):
         q = float(faces.hflux[idx[0]])
         if fprev is not None:
             q0 = float(np.nan_to_num(fprev["hflux"][idx[0]]))
             q = q0 + fraction * (q - q0)
         if q != 0.0:
-            flux[fem.boundary_for(fem.face_facets[idx])] = q
+            flux[name()] = q
     d = db.nodes.arrays["d_temp"]
     fixed = np.nonzero(~np.isnan(d) & (fem.thermal_dof >= 0))[0]
     values = d[fixed]
@@ -221,6 +228,33 @@ def thermal_loads(session: SessionState, fem: FemModel, fraction: float = 1.0) -
     return ThermalLoads(sources=sources, convection=convection, flux=flux,
                         contact_resistance=contact,
                         fixed_dofs=(fem.thermal_dof[fixed], values) if fixed.size else None)
+
+
+def _load_sets(session: SessionState, fem: FemModel, kind: str, record: np.ndarray,
+               extra: np.ndarray | None, name_of: Callable[[np.ndarray], str]
+               ) -> list[tuple[np.ndarray, Callable[[], str]]]:
+    """`record_groups(record, extra)`, each group with a function giving its region or
+    boundary name (`name_of`, called when the group's load is not zero, as it adds a set
+    the mesh does not have yet).  Without `extra` (a load step that is not ramped) the
+    groups and their names are kept in the session by `kind` and reused while the
+    record array partitions the entities as the last one of `kind` did
+    (`RecordPartition.order_of`): a window deck's load steps restate their loads on the
+    same components."""
+    if extra is not None:
+        return [(g, partial(name_of, g)) for g in record_groups(record, extra)]
+    kept = session.fem.partitions.get(kind)
+    order = kept.order_of(record, fem) if kept is not None else None
+    if kept is None or order is None:
+        kept = session.fem.partitions[kind] = RecordPartition.of(record, fem)
+        order = list(range(len(kept.groups)))
+
+    def named(i: int) -> str:
+        name = kept.names[i]
+        if name is None:
+            name = kept.names[i] = name_of(kept.groups[i])
+        return name
+
+    return [(kept.groups[i], partial(named, i)) for i in order]
 
 
 def _first_step_loads(session: SessionState) -> dict:
@@ -252,6 +286,8 @@ def face_table(session: SessionState):  # noqa: ANN201 - FemModel | plane_solve.
     """The exterior faces SF/SFE load: the AxiMesh's (a twin session) or the deck mesh's."""
     if session.fem.external_mesh:
         return fem_model(session)
+    from apdl_like.plane_solve import deck_faces  # a deck's own mesh: imported when used
+
     return deck_faces(session)
 
 
@@ -261,6 +297,8 @@ def solve_thermal(session: SessionState) -> StepResult:
         raise ApdlError("radiation between RDSF surfaces is not solved (apdl_like computes "
                         "their view factors only: /AUX12, VFQUERY)")
     if not session.fem.external_mesh:
+        from apdl_like.plane_solve import solve_plane_thermal
+
         return solve_plane_thermal(session)
     refuse_deck_mesh_loads(session, "solved")
     fem = fem_model(session)
@@ -339,6 +377,8 @@ def _constraints(session: SessionState, fem: FemModel) -> dict[str, str]:
 def solve_structural(session: SessionState) -> StepResult:
     """A static thermo-elastic load step: twin.fem for a twin session, else the deck mesh."""
     if not session.fem.external_mesh:
+        from apdl_like.plane_solve import solve_plane_structural
+
         return solve_plane_structural(session)
     fem = fem_model(session)
     _check_axisymmetric(session, "structural")

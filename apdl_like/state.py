@@ -32,7 +32,7 @@ import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel, nearest_node
-from apdl_like.model import Database
+from apdl_like.model import Database, RecordPartition
 
 if TYPE_CHECKING:
     from twin.fem import ElasticProblem, ThermalProblem
@@ -83,6 +83,9 @@ class FemCache:
     thermal_inputs: tuple | None = None  # the MP/ANTYPE inputs `thermal` was checked against
     elastic: ElasticProblem | None = None
     elastic_key: tuple | None = None
+    # the load groups of the last thermal SOLVE by kind (hgen, conv, hflux) and the regions
+    # and boundaries they were named: reused while a load step loads the same sets
+    partitions: dict[str, RecordPartition] = field(default_factory=dict)
     # a deck's own mesh (apdl_like.plane_solve): exterior faces, scikit-fem mesh, solver
     faces: Any = None
     faces_key: tuple | None = None

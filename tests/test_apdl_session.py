@@ -8,6 +8,7 @@ import json
 import math
 import subprocess
 import sys
+from unittest.mock import ANY
 
 import numpy as np
 import pytest
@@ -27,6 +28,10 @@ BRONZE = Material(k=60.0, rho=8800.0, c=380.0)
 
 @pytest.fixture(scope="module")
 def mesh() -> AxiMesh:
+    return _mesh()
+
+
+def _mesh() -> AxiMesh:
     r = np.linspace(0.0, 0.04, 13)
     z = np.linspace(0.0, 0.08, 25)
     return AxiMesh.structured(
@@ -373,3 +378,77 @@ def test_a_later_load_step_restates_only_what_changed_and_solves_the_same(mesh):
         runs.append(s.advance(T, 64.0, deck)[-1])
     np.testing.assert_array_equal(runs[0], runs[1])
     assert np.abs(runs[0] - T).max() > 0.01  # the step moved the field
+
+
+def _load_step(time_s: float, loads: str) -> str:
+    return f"/SOLU\nANTYPE,TRANS,REST\nKBC,1\nDELTIM,4.0\nTIME,{time_s!r}\n{loads}\nALLSEL\nSOLVE\n"
+
+
+# load steps after a window deck (bearing_front, bearing_rear heated; coolant, nose_face
+# films): each keeps or changes how the loads group the elements and faces
+LATER_LOAD_STEPS = (
+    "CMSEL,S,BEARING_FRONT\nBFE,ALL,HGEN,,1.2e6",  # new records, the same groups
+    "CMSEL,S,BEARING_FRONT\nBFE,ALL,HGEN,,1.25e6\nCMSEL,S,BEARING_REAR\nBFE,ALL,HGEN,,5e5",
+    "CMSEL,S,BEARING_FRONT\nBFE,ALL,HGEN,,1.3e6",  # the records' order turns, and back
+    "ESEL,S,CENT,Y,0.07,0.08\nCMSEL,R,BEARING_FRONT\nBFE,ALL,HGEN,,2e6",  # a group split
+    "CMSEL,S,BEARING_FRONT\nCMSEL,A,BEARING_REAR\nBFE,ALL,HGEN,,9e5",  # groups merged
+    "CMSEL,S,BEARING_REAR\nBFE,ALL,HGEN,,0",  # no heat there: not a source
+    "CMSEL,S,COOLANT\nSF,ALL,CONV,500,23",  # a film's values change, its faces not
+    "NSEL,S,LOC,Y,0.08\nSF,ALL,CONV,15,24\nCMSEL,S,COOLANT\nSF,ALL,CONV,0,23",
+    "CMSEL,S,SHAFT\nBFE,ALL,HGEN,,1e5",  # a set no load named before
+)
+
+
+def test_load_groups_kept_between_load_steps_follow_every_change():
+    """The session keeps the last SOLVE's load groups (`RecordPartition`) and reuses them
+    while a load step loads the same sets with new records: every load step below solves
+    to the bits and loads, in the same order, of a session that groups every step anew."""
+    from apdl_like.solve import fem_model, thermal_loads
+
+    mats = {"shaft": STEEL, "sleeve": BRONZE}
+    # a mesh each: a session names the new sets it loads in its mesh
+    kept, fresh = (Session.from_mesh(_mesh(), mats, T_initial_C=20.0) for _ in range(2))
+    for s in (kept, fresh):
+        s.run_text(window_deck(dataclasses.replace(loadset(0), n_steps=1), s.layout), "w0.inp")
+    partitions = kept.state.fem.partitions
+    hgen = partitions["hgen"]
+    order = []  # the heated regions of each load step, in the order of their loads
+    for i, loads in enumerate(LATER_LOAD_STEPS):
+        deck = _load_step(4.0 * (i + 2), loads)
+        fresh.state.fem.partitions.clear()  # groups anew
+        kept.run_text(deck, f"ls{i}.inp")
+        fresh.run_text(deck, f"ls{i}.inp")
+        np.testing.assert_array_equal(kept.state.solution.temperature,
+                                      fresh.state.solution.temperature)
+        fresh.state.fem.partitions.clear()
+        got, want = (thermal_loads(s.state, fem_model(s.state)) for s in (kept, fresh))
+        assert list(got.sources.items()) == list(want.sources.items())
+        assert list(got.convection.items()) == list(want.convection.items())
+        if i < 3:  # the same elements heated in the same groups: the groups were reused
+            assert partitions["hgen"] is hgen
+        order.append(list(got.sources))
+    assert order[:4] == [["bearing_rear", "bearing_front"], ["bearing_front", "bearing_rear"],
+                         ["bearing_rear", "bearing_front"], ["bearing_rear", ANY, ANY]]
+    assert len(order[4]) == 1 and order[5] == ["bearing_front"]
+    assert list(got.sources.items()) == [("bearing_front", 9e5), ("shaft", 1e5)]
+    assert list(got.convection.items()) == [("nose_face", (15.0, 24.0))]
+
+
+def test_a_record_partition_is_reused_only_for_the_same_groups_of_the_same_owner():
+    from apdl_like.model import RecordPartition, record_groups
+
+    record = np.array([-1, 7, 7, 3, -1, 3, 9])
+    owner = object()
+    p = RecordPartition.of(record, owner)
+    assert [g.tolist() for g in p.groups] == [[3, 5], [1, 2], [6]]
+    assert p.order_of(record, owner) == [0, 1, 2]
+    relabelled = np.array([-1, 20, 20, 31, -1, 31, 12])  # new ids, other order
+    assert p.order_of(relabelled, owner) == [2, 1, 0]
+    assert [p.groups[i].tolist() for i in p.order_of(relabelled, owner)] == \
+        [g.tolist() for g in record_groups(relabelled)]
+    assert p.order_of(record, object()) is None  # another mesh's groups
+    for changed in ([-1, 7, 8, 3, -1, 3, 9],  # a group split
+                    [-1, 7, 7, 3, -1, 3, 3],  # two groups merged
+                    [-1, 7, 7, 3, 4, 3, 9],  # one more loaded entity
+                    [-1, 7, 7, 3, -1, 3, -1]):  # one fewer
+        assert p.order_of(np.array(changed), owner) is None

@@ -144,3 +144,32 @@ def test_thermal_stepper_is_theta_step_with_fixed_operators(theta):
                        lambda A, rhs: spla.spsolve(A.tocsc(), rhs), False)
         assert np.abs(T - T_fixed).max() < 1e-9 * np.abs(T_fixed - 20.0).max()
     assert fixed[-1].max() > 21.0  # the disk did heat up
+
+
+def test_capacity_rate_kept_per_time_step_gives_a_fresh_problems_bits():
+    """ThermalProblem keeps C/Δt per Δt (backward Euler's explicit side, asked for every
+    step of a loop that re-evaluates its loads): steps of Δt = 2, 4, 2 s and Crank–Nicolson
+    after them are those of a problem that never stepped before, to the bit, and the kept
+    matrix cannot be changed through a stepper."""
+    def make() -> ThermalProblem:  # a shaft in a sleeve: the contact's low-rank solver
+        mesh = AxiMesh.structured(
+            np.linspace(0.0, 0.05, 11), np.linspace(0.0, 0.02, 5),
+            regions={"shaft": lambda r, z: r < 0.025, "sleeve": lambda r, z: r > 0.025},
+            boundaries={"rim": lambda r, z: np.isclose(r, 0.05)},
+            interfaces={"fit": lambda r, z: np.isclose(r, 0.025)})
+        steel = Material(k=50.0, rho=7800.0, c=460.0)
+        return ThermalProblem(mesh, {"shaft": steel, "sleeve": steel})
+
+    loads = ThermalLoads(sources={"shaft": 2e6}, convection={"rim": (500.0, 20.0)},
+                         contact_resistance={"fit": 2e-4})
+    problem = make()
+    T = np.full(problem.n_dofs, 20.0)
+    for dt, theta in ((2.0, 1.0), (4.0, 1.0), (2.0, 1.0), (2.0, 0.5)):
+        stepper = problem.transient(loads, dt, theta=theta)
+        fresh = make().transient(loads, dt, theta=theta)
+        np.testing.assert_array_equal(stepper.step(T), fresh.step(T))
+        np.testing.assert_array_equal(stepper.explicit.toarray(), fresh.explicit.toarray())
+        T = stepper.step(T)
+    assert sorted(problem._capacity_rates) == [2.0, 4.0]
+    with pytest.raises(ValueError, match="read-only"):
+        problem.transient(loads, 2.0).explicit.data[0] = 0.0

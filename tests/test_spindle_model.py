@@ -103,3 +103,25 @@ def test_loads_kept_between_steps_give_the_bits_a_fresh_model_gives(spindle_mode
         for got in (seen[i], seen[3]) if i == 0 else (seen[i],):
             np.testing.assert_array_equal(got[0], fresh[0])
             assert got[1] == fresh[1]
+
+
+def test_film_coefficients_kept_per_operating_point_are_a_fresh_evaluation(spindle_model):
+    """SpecConstants keeps the film coefficients of each (speed, film ambient) it was asked
+    for: after others, every operating point's films are those of a spec evaluated afresh
+    (a bare SpindleSpec: new constants each call), and a new speed or film ambient after a
+    kept one is evaluated, not served from it."""
+    from twin.spindle.conditions import SpecConstants
+
+    model = type(spindle_model).load()  # constants of its own: no earlier test's films
+    points = ((9000.0, 25.0, 25.0), (14000.0, 25.0, 25.0), (9000.0, 25.0, 35.0),
+              (0.0, 25.0, 25.0), (9000.0, 30.0, 25.0), (9000.0, 25.0, 25.0))
+    got = [nominal_conditions(model, s, a, film_ambient_C=f).convection for s, a, f in points]
+    want = [nominal_conditions(model.spec, s, a, film_ambient_C=f).convection
+            for s, a, f in points]
+    assert got == want
+    assert got[1] != got[0] and got[2] != got[0] and got[3] != got[0]  # each one's own films
+    assert got[4] != got[0] and {k: h for k, (h, _) in got[4].items()} == \
+        {k: h for k, (h, _) in got[0].items()}  # the sink moves, the films stay
+    assert got[5] == got[0]
+    assert len(model.constants.films) == 4  # kept: the four (speed, film ambient) points
+    assert not SpecConstants.of(model.spec).films  # another spec's constants: their own

@@ -19,8 +19,6 @@ import numpy as np
 from apdl_like.call import AUX12, MODEL, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.commands.selection import component, component_mask
 from apdl_like.errors import ApdlError
-from apdl_like.plane_solve import analysis_mode, corners_and_midside, deck_faces
-from apdl_like.radiation import average_view_factor, view_factors
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -41,6 +39,9 @@ def _faces(s: SessionState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
                                      np.ndarray]:
     """The RDSF faces: ends a, b (m, 2), unit normals out of their element (m, 2), owning
     element indices (m,) and enclosure numbers (m,)."""
+    # the solvers of a deck's own mesh load with the first command that needs them
+    from apdl_like.plane_solve import corners_and_midside, deck_faces
+
     db = s.db
     table = deck_faces(s)
     rad = np.nonzero(~np.isnan(db.faces.rdsf_emis))[0]
@@ -60,6 +61,9 @@ def _faces(s: SessionState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
 
 def _factors(s: SessionState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(F, face areas, owning element indices) of the RDSF faces, cached for the model."""
+    from apdl_like.plane_solve import analysis_mode
+    from apdl_like.radiation import view_factors
+
     axisymmetric = s.radiation.axisymmetric
     if axisymmetric is None:
         axisymmetric = analysis_mode(s.db) == "axisymmetric"
@@ -93,6 +97,8 @@ def _element_set(s: SessionState, c: Call, i: int) -> np.ndarray:
 def vfquery(s: SessionState, c: Call) -> None:
     """VFQUERY,SRCELEM,TARGELEM: the area-weighted average view factor from the radiating
     faces of the source elements to those of the target elements (*GET,,RAD,,VFAVG)."""
+    from apdl_like.radiation import average_view_factor
+
     source_elements, target_elements = _element_set(s, c, 1), _element_set(s, c, 2)
     F, area, owner = _factors(s)
     source, target = source_elements[owner], target_elements[owner]

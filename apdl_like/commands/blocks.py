@@ -7,7 +7,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import MAX_ENTITY_NUMBER, PREP7, Call, command, specs_of
-from apdl_like.cdb import parse_cmblock, parse_eblock, parse_nblock
 from apdl_like.errors import ApdlError
 from apdl_like.model import Component
 
@@ -17,6 +16,8 @@ if TYPE_CHECKING:
 
 @command("NBLOCK", PREP7, 6)
 def nblock(s: SessionState, c: Call) -> None:
+    from apdl_like.cdb import parse_nblock  # archive blocks: loaded with the first one
+
     ids, xyz = parse_nblock(c.statement.block)
     if ids.size and (ids.min() < 1 or ids.max() > MAX_ENTITY_NUMBER):
         raise ApdlError("NBLOCK node number out of range")
@@ -29,6 +30,8 @@ def nblock(s: SessionState, c: Call) -> None:
 
 @command("EBLOCK", PREP7, 6)
 def eblock(s: SessionState, c: Call) -> None:
+    from apdl_like.cdb import parse_eblock
+
     db = s.db
     rows = parse_eblock(c.statement.block)
     for num, etype, mat, real, nodes in rows:
@@ -50,6 +53,8 @@ def eblock(s: SessionState, c: Call) -> None:
 
 @command("CMBLOCK", PREP7 | {"BEGIN", "SOLU"}, 4)
 def cmblock(s: SessionState, c: Call) -> None:
+    from apdl_like.cdb import parse_cmblock
+
     name = c.raw(1).upper()
     if not name or not name[0].isalpha() or len(name) > 32:
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid component name")

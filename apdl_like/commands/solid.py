@@ -14,14 +14,6 @@ import numpy as np
 
 from apdl_like.call import PREP7, Call, CommandSpec, command, existing, ignored, specs_of
 from apdl_like.errors import ApdlError
-from apdl_like.meshing import (
-    line_points,
-    mapped_grid,
-    mesh_areas,
-    mesh_mapped,
-    place_nodes,
-    side_fractions,
-)
 from apdl_like.model import Line
 
 if TYPE_CHECKING:
@@ -230,6 +222,8 @@ def _range_of(c: Call, table: dict, what: str, field: str) -> list[int]:
 
 @command("AMESH", PREP7, 3)
 def amesh(s: SessionState, c: Call) -> None:
+    from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped  # loaded when used
+
     areas = s.db.areas
     chosen = _range_of(c, areas, "area", "NA")
     chosen = [num for num in chosen if num not in s.db.meshed_areas]
@@ -259,6 +253,8 @@ def lmesh(s: SessionState, c: Call) -> None:
     """LMESH,NL1,NL2,NINC: line elements (LINK33, LINK34 ...) along lines, NDIV from LESIZE
     (with its spacing ratio) or ESIZE.  Node numbering as MAPDL's: a line's end keypoints
     first (when they have no node yet), then its interior nodes from k1 to k2."""
+    from apdl_like.meshing import line_points, place_nodes, side_fractions
+
     db = s.db
     lines = db.lines
     chosen = _range_of(c, lines, "line", "NL")

@@ -164,9 +164,8 @@ def ldread(s: SessionState, c: Call) -> None:
 @command("SOLVE", SOLU, 0)
 def solve(s: SessionState, c: Call) -> None:
     s.budget.unsolved = None
-    s.db.elements.flush()
-    physics = {s.db.element_types[int(t)].physics for t in np.unique(s.db.elements.type)
-               if int(t) in s.db.element_types}
+    physics = {s.db.element_types[t].physics for t in s.db.elements.type_numbers()
+               if t in s.db.element_types}
     # SURF151 only carries loads; thermal links and masses join a thermal model
     types = physics - {"surface", "line"} or ({"thermal"} if "line" in physics else set())
     if s.record_only:

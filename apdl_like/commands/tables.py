@@ -17,7 +17,6 @@ import numpy as np
 from apdl_like.call import ANY, Call, CommandSpec, command, specs_of
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import compile_expression, element_index
-from apdl_like.fortran_format import format_c_line, format_line, parse_format
 from apdl_like.params import (
     column,
     dimension,
@@ -91,6 +90,8 @@ def star_vfill(s: SessionState, c: Call) -> None:
 @command("*VWRITE", ANY, 19)
 def star_vwrite(s: SessionState, c: Call) -> None:
     """*VWRITE,Par1,...: one line per row of the array arguments, by the format line."""
+    from apdl_like.fortran_format import format_c_line, format_line, parse_format
+
     params, funcs = s.params, s.model_functions
     columns: list[list[float | str]] = []
     arrays = []

@@ -8,12 +8,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
-def _finite(value: float, what: str) -> float:
+def _finite(value: float, what: str, name: str) -> float:
+    """`value` as a float, ValueError naming `what` of `name` unless finite (the message is
+    made on failure only: a loop builds a load set every solver step)."""
     if callable(value):  # a field f(r, z): checked where it is evaluated
         return 0.0
     value = float(value)
     if not math.isfinite(value):
-        raise ValueError(f"{what} must be finite, got {value!r}")
+        raise ValueError(f"{what} {name!r} must be finite, got {value!r}")
     return value
 
 
@@ -41,19 +43,19 @@ class ThermalLoads:
 
     def __post_init__(self) -> None:
         for name, q in self.sources.items():
-            _finite(q, f"heat source of region {name!r}")
+            _finite(q, "heat source of region", name)
         for name, hc in self.convection.items():
             h, t_inf = hc
-            if not (_finite(h, f"film coefficient of boundary {name!r}") >= 0.0):
+            if not (_finite(h, "film coefficient of boundary", name) >= 0.0):
                 raise ValueError(f"film coefficient of boundary {name!r} must be ≥ 0, got {h!r}")
-            _finite(t_inf, f"bulk temperature of boundary {name!r}")
+            _finite(t_inf, "bulk temperature of boundary", name)
         for name, q in self.flux.items():
-            _finite(q, f"heat flux of boundary {name!r}")
+            _finite(q, "heat flux of boundary", name)
         for name, r in self.contact_resistance.items():
-            if not (_finite(r, f"contact resistance of interface {name!r}") > 0.0):
+            if not (_finite(r, "contact resistance of interface", name) > 0.0):
                 raise ValueError(f"contact resistance of interface {name!r} must be > 0, got {r!r}")
         for name, t in self.fixed_temperature.items():
-            _finite(t, f"fixed temperature of boundary {name!r}")
+            _finite(t, "fixed temperature of boundary", name)
 
 
 def field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001

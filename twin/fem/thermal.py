@@ -36,6 +36,7 @@ from twin.fem.stepper import ThermalStepper
 KEPT_FILM_SETS = 8
 """Film loads and heat-balance row sums kept per set of film coefficients (the newest; they
 change with the speed only), as `LowRankUpdate` keeps its factorizations."""
+KEPT_STEP_SIZES = 8  # time steps whose C/Δt a ThermalProblem keeps
 
 
 class ThermalProblem:
@@ -105,6 +106,9 @@ class ThermalProblem:
         # factorizations in `contact_update`
         self._film_rows: dict[tuple[tuple[str, float], ...], np.ndarray] = {}
         self._convection_loads: dict[tuple[tuple[str, float, float], ...], np.ndarray] = {}
+        # C/Δt (read-only data on the pattern, and as a matrix) per Δt: backward Euler's
+        # explicit side, asked for by every step of a loop that re-evaluates its loads
+        self._capacity_rates: dict[float, tuple[np.ndarray, sp.csr_matrix]] = {}
 
     # ------------------------------------------------------------ operators
     def _check_materials(self) -> None:
@@ -280,7 +284,8 @@ class ThermalProblem:
             raise ValueError(f"theta must lie in [0.5, 1], got {theta!r}")
         dt, theta = float(dt), float(theta)
         coeff, parts = self.load_parts(loads)
-        c_data = self.capacity_data / dt
+        c_data, c_matrix = kept(self._capacity_rates, dt, partial(self._capacity_rate, dt),
+                                KEPT_STEP_SIZES)
         dofs, values = self.fixed(loads)
         # K on the pattern only where it is used: backward Euler's explicit side is C/Δt
         # (C/Δt − 0·K is C/Δt to the bit), and a solver by low-rank update builds its own
@@ -289,12 +294,18 @@ class ThermalProblem:
             k_data = self.conduction_data + self.ops.data(coeff)
         return ThermalStepper(
             self._step_solver(coeff, c_data, k_data, (dofs, values), dt, theta),
-            self.ops.csr(c_data if k_data is None else c_data - (1.0 - theta) * k_data),
+            c_matrix if k_data is None else self.ops.csr(c_data - (1.0 - theta) * k_data),
             sum(parts.values()),
             dt,
             theta,
             balance=partial(self._heat_balance, coeff, parts, dofs, dt, theta),
         )
+
+    def _capacity_rate(self, dt: float) -> tuple[np.ndarray, sp.csr_matrix]:
+        """C/Δt on the pattern (read-only) and as a CSR matrix sharing that data."""
+        c_data = self.capacity_data / dt
+        c_data.flags.writeable = False
+        return c_data, self.ops.csr(c_data)
 
     def _step_solver(
         self,

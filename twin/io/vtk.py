@@ -20,7 +20,6 @@ import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -91,6 +90,10 @@ def _add_field_data(path: Path, field_data: dict[str, np.ndarray]) -> None:
 
 def write_pvd(path: str | os.PathLike[str], entries: Sequence[tuple[float, str]]) -> Path:
     """ParaView collection, atomically: (time s, .vtu path relative to the .pvd) per entry."""
+    # here, not at the top: xml.sax.saxutils imports urllib.request, http and ssl (about
+    # 10 ms of a cold replay, whose fields a forked child writes)
+    from xml.sax.saxutils import quoteattr
+
     lines = [
         '<?xml version="1.0"?>',
         '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',

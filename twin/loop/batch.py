@@ -9,7 +9,6 @@ matches.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -193,6 +192,8 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
             _tell(progress, outcome)
             yield outcome
         return
+    from concurrent.futures import ProcessPoolExecutor, as_completed  # --jobs only
+
     with ProcessPoolExecutor(max_workers=min(jobs, len(todo))) as pool:
         futures = [pool.submit(run_job, job) for job in todo]
         for fut in as_completed(futures):

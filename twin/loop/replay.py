@@ -494,11 +494,12 @@ def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
     def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
         # the nominal loads at this piece's own temperatures (they follow the rings every
         # LOAD_UPDATE_STEPS), times the window's correction and model-form factors
-        bc = conditions(speed, ambient, coolant, model.sensor_matrix @ T)
+        at_sensors = model.sensor_matrix @ T
+        bc = conditions(speed, ambient, coolant, at_sensors)
         if window.thermal_factors:
             bc = bc.scaled(window.thermal_factors)
         corr = Correction(*(factors * np.array([bc.H_front, bc.H_rear, bc.R_front, bc.R_rear])))
-        rings = model.sensor_matrix[:4] @ T
+        rings = at_sensors[:4]  # the same rows' sums (slicing the matrix cost a copy a step)
         notes = (
             f"{'re-run at the recorded speed' if rerun else 'speed'} {speed:g} rpm; bearing "
             "heat and contact resistance follow the rings:",

@@ -155,7 +155,6 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     """Replay and write every file but accuracy.json and the .done token; `plots` is
     started once keypoints.csv and corrections.csv (what the figures show) are written."""
     from twin.correction.methods import make_corrector
-    from twin.estimation.method import EstimatorConfig
     from twin.runs import read_run, write_quality
     from twin.spindle.model import SpindleModel
 
@@ -163,7 +162,11 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
     run = replace(run, name=run_name(run_path))  # as its folder and accuracy.json know it
     token = resume_token(run_path, methods, model_path, assimilate_drift)
-    config = EstimatorConfig(assimilate_drift=assimilate_drift)
+    config = None
+    if "estimator" in methods:  # its modules load only for the method that uses them
+        from twin.estimation.method import EstimatorConfig
+
+        config = EstimatorConfig(assimilate_drift=assimilate_drift)
     correctors = [
         make_corrector(m, model_path if m == "bpnn" else None, spindle=model,
                        estimator_config=config)

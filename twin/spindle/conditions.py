@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
 from twin.fem import ThermalLoads
+from twin.fem.linalg import kept
 from twin.physics import (
     air_gap_h,
     bearing_heat_W,
@@ -45,6 +46,7 @@ from twin.physics.contact import harmonic_mean, thermal_interference_um
 from twin.spindle.spec import BearingSpec, ConvectionSpec, SpindleSpec
 
 SIDES = ("front", "rear")
+KEPT_FILM_POINTS = 64  # operating points whose film coefficients SpecConstants keeps
 
 FILM_GROUPS: dict[str, tuple[str, ...]] = {
     "coolant": ("coolant",),
@@ -274,6 +276,12 @@ class SpecConstants:
 
     bearings: dict[str, BearingConstants]
     motor_volume_m3: dict[str, float]
+    films: dict[tuple[str, str], dict[str, float]] = field(
+        default_factory=dict, compare=False, repr=False)
+    """The film coefficients at each (speed, film ambient) seen, by their exact bits (hex),
+    at most `KEPT_FILM_POINTS` (`nominal_conditions`; the oldest dropped): they depend on
+    the spec and those two only, and a replay re-evaluates the conditions every solver step
+    at one speed and one film ambient for minutes."""
 
     @classmethod
     def of(cls, spec: SpindleSpec) -> SpecConstants:
@@ -364,11 +372,12 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
     motor_heat = {m.rotor: split["rotor"] / volumes[m.rotor],
                   m.stator: split["stator"] / volumes[m.stator]}
 
-    convection = {}
-    for name, conv in spec.convection.items():
-        h = film_coefficient(conv, spec, speed_rpm,
-                             ambient_C if film_ambient_C is None else film_ambient_C)
-        convection[name] = (h, coolant if conv.fluid == "coolant" else float(ambient_C))
+    film_ambient = ambient_C if film_ambient_C is None else film_ambient_C
+    films = kept(constants.films, (float(speed_rpm).hex(), float(film_ambient).hex()),
+                 lambda: {name: film_coefficient(conv, spec, speed_rpm, film_ambient)
+                          for name, conv in spec.convection.items()}, KEPT_FILM_POINTS)
+    convection = {name: (films[name], coolant if conv.fluid == "coolant" else float(ambient_C))
+                  for name, conv in spec.convection.items()}
 
     return BoundaryConditions(
         speed_rpm=float(speed_rpm), ambient_C=float(ambient_C), coolant_C=coolant, **values,
