@@ -41,7 +41,7 @@ import tempfile
 from collections import defaultdict
 from pathlib import Path
 
-from bench.child import run_measured
+from bench.child import fresh_env, run_measured
 
 ROOT = Path(__file__).resolve().parent.parent
 RUN = ROOT / "examples" / "runs" / "spindle_9000rpm_30min.csv"
@@ -52,17 +52,6 @@ TARGET_S = 1.5
 def _command(out: Path) -> list[str]:
     return [sys.executable, "-m", "twin", "replay", str(RUN), "--out", str(out),
             "--snapshots", "none", "--quiet", "--methods", METHODS]
-
-
-def _env(pycache: Path) -> dict[str, str]:
-    """The children's environment: they import the same tree as this process (a worktree or
-    the installed package), and they keep compiled bytecode, as a user's runs do, but in
-    `pycache` (a temporary folder) rather than beside the sources."""
-    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
-    env = {**os.environ, "PYTHONPATH": path, "PYVISTA_OFF_SCREEN": "true",
-           "PYTHONPYCACHEPREFIX": str(pycache)}
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    return env
 
 
 def cold_replay(out: Path, env: dict[str, str]) -> dict[str, float]:
@@ -109,7 +98,7 @@ def import_breakdown(out: Path, env: dict[str, str], top: int = 12) -> dict:
 def run(repeats: int = 5) -> dict:
     samples = []
     with tempfile.TemporaryDirectory() as tmp:
-        env = _env(Path(tmp) / "pycache")
+        env = fresh_env(Path(tmp) / "pycache")
         cold_replay(Path(tmp) / "warm-up", env)  # compiles the bytecode, fills OS caches
         for i in range(repeats):
             samples.append(cold_replay(Path(tmp) / f"out{i}", env))
