@@ -249,7 +249,7 @@ def _load_sets(session: SessionState, fem: FemModel, kind: str, record: np.ndarr
                ) -> list[tuple[np.ndarray, Callable[[], str]]]:
     """`record_groups(record, extra)`, each group with a function giving its region or
     boundary name (`name_of`, called when the group's load is not zero, as it adds a set
-    the mesh does not have yet).  Without `extra` (a load step that is not ramped) the
+    the session's mesh does not have yet).  Without `extra` (a load step that is not ramped) the
     groups and their names are kept in the session by `kind` and reused while the
     record array partitions the entities as the last one of `kind` did
     (`RecordPartition.order_of`): a window deck's load steps restate their loads on the
