@@ -11,12 +11,13 @@ Load sets map onto twin.fem by *entity sets*: the cells of one HGEN record becom
 the faces of one CONV/HFLUX record a boundary.  A set is named once (an existing region or
 boundary with exactly the same members keeps its name, e.g. the spindle's "bearing_front"),
 so a window deck that re-applies loads on the same components reuses every operator that
-`ThermalProblem` already assembled.
+`ThermalProblem` already assembled.  The sets a model names are its own: the first one
+makes its mesh a view of the one it was given (`AxiMesh.view`), so the spindle model's
+mesh, which the loop's sessions share, holds its own regions and boundaries only, and a
+session's names never depend on what another session loaded.
 """
 
 from __future__ import annotations
-
-from collections.abc import Callable, Mapping
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -44,6 +45,10 @@ class FemModel:
         midside       (3, m) rows: node index, vertex a, vertex b of each mid-side node
         """
         self.mesh = mesh
+        # False while `mesh` is the mesh given; the first set this model names makes it a
+        # view of that mesh with registries of its own (`AxiMesh.view`): a mesh shared by
+        # several sessions (the loop's spindle model) never holds one session's sets
+        self.own_sets = False
         self.order = order
         self.vertex_node = vertex_node
         self.cell_element = cell_element
@@ -99,23 +104,26 @@ class FemModel:
     # -------------------------------------------------------------- named sets
     def region_for(self, cells: np.ndarray) -> str:
         """A region name for exactly these cells (existing name if the set is known)."""
-        return self._named(cells, self._region_names, "_cells", self.mesh.regions,
-                           self.mesh.add_region)
+        return self._named(cells, self._region_names, "_cells", "region")
 
     def boundary_for(self, facets: np.ndarray) -> str:
         """A boundary name for exactly these facets (existing name if the set is known)."""
-        return self._named(facets, self._boundary_names, "_faces", self.mesh.boundaries,
-                           self.mesh.add_boundary)
+        return self._named(facets, self._boundary_names, "_faces", "boundary")
 
     def _named(self, indices: np.ndarray, names: dict[bytes, str], prefix: str,
-               taken: Mapping[str, object], add: Callable[[str, np.ndarray], object]) -> str:
+               kind: str) -> str:
         key = self._key(indices)
         name = names.get(key)
         if name is None:
+            if not self.own_sets:  # the mesh others may share stays as it was given
+                self.mesh = self.mesh.view()
+                self.own_sets = True
+            mesh = self.mesh
+            taken = mesh.regions if kind == "region" else mesh.boundaries
             name = f"{prefix}{len(names)}"
             while name in taken:
                 name += "_"
-            add(name, indices)
+            (mesh.add_region if kind == "region" else mesh.add_boundary)(name, indices)
             names[key] = name
         return name
 

@@ -17,6 +17,13 @@ re-uses them.  For the twin, `Session.from_mesh` loads an `AxiMesh` directly:
                constant 14, W/m²K) is
                the thermal contact conductance 1/R, mapped onto
                `ThermalLoads.contact_resistance[name] = 1/TCC`
+    load sets  a load on elements or faces that no region or boundary holds exactly falls
+               on a set the session names itself (_cellsN / _facesN, N the number of
+               sets it knew by name, the mesh's own included), on its own view of the
+               mesh (`apdl_like.fem_bridge`): the AxiMesh given, which the loop's
+               sessions share, keeps its own sets only, the ThermalProblem given holds
+               no load of the session's sets, and no session's names depend on another's
+               decks
 """
 
 from __future__ import annotations

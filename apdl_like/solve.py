@@ -125,14 +125,28 @@ def thermal_problem(session: SessionState, fem: FemModel) -> ThermalProblem:
     cache = session.fem
     inputs = _material_inputs(session, fem)
     if cache.thermal is not None and cache.thermal_inputs == inputs:
-        return cache.thermal
+        return on_model_mesh(session, fem)
     mats = _materials(session, fem, "thermal")
     key = (id(fem), _material_key(mats), fem.order)
     if cache.thermal_key != key:
         cache.thermal = ThermalProblem(fem.mesh, mats, order=fem.order)
         cache.thermal_key = key
     cache.thermal_inputs = inputs
-    return cache.thermal  # type: ignore[return-value]
+    return on_model_mesh(session, fem)
+
+
+def on_model_mesh(session: SessionState, fem: FemModel) -> ThermalProblem:
+    """The session's ThermalProblem on `fem`'s mesh.  Once `fem` named a set of its own,
+    its mesh is a view of the one the problem was assembled or adopted on (which the
+    loop's sessions share, `Session.from_mesh`): the session then goes on with a copy of
+    the problem on that view (`ThermalProblem.on_mesh`: the operators shared, the named
+    sets' loads and factorizations its own), made once; call it after naming loads."""
+    cache = session.fem
+    problem = cache.thermal
+    assert problem is not None
+    if problem.mesh is not fem.mesh:
+        problem = cache.thermal = problem.on_mesh(fem.mesh)
+    return problem
 
 
 def adopt_thermal_problem(session: SessionState, problem: ThermalProblem) -> None:
@@ -235,7 +249,7 @@ def _load_sets(session: SessionState, fem: FemModel, kind: str, record: np.ndarr
                ) -> list[tuple[np.ndarray, Callable[[], str]]]:
     """`record_groups(record, extra)`, each group with a function giving its region or
     boundary name (`name_of`, called when the group's load is not zero, as it adds a set
-    the mesh does not have yet).  Without `extra` (a load step that is not ramped) the
+    the session's mesh does not have yet).  Without `extra` (a load step that is not ramped) the
     groups and their names are kept in the session by `kind` and reused while the
     record array partitions the entities as the last one of `kind` did
     (`RecordPartition.order_of`): a window deck's load steps restate their loads on the
@@ -317,6 +331,7 @@ def solve_thermal(session: SessionState) -> StepResult:
     if s.antype == "STATIC" or s.timint is False:
         end = s.time if s.time is not None else sol.time + 1.0
         loads = thermal_loads(session, fem)
+        problem = on_model_mesh(session, fem)
         try:
             T = problem.steady(loads)
         except ValueError as exc:
@@ -331,7 +346,7 @@ def solve_thermal(session: SessionState) -> StepResult:
         for k in range(1, n + 1):
             if stepper is None or ramped:
                 loads = thermal_loads(session, fem, k / n if ramped else 1.0)
-                stepper = problem.transient(loads, dt)
+                stepper = on_model_mesh(session, fem).transient(loads, dt)
             T = stepper.step(T)
             steps_T.append(T)
             steps_t.append(sol.time + k * dt if k < n else s.time)

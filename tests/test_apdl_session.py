@@ -406,8 +406,9 @@ def test_load_groups_kept_between_load_steps_follow_every_change():
     from apdl_like.solve import fem_model, thermal_loads
 
     mats = {"shaft": STEEL, "sleeve": BRONZE}
-    # a mesh each: a session names the new sets it loads in its mesh
-    kept, fresh = (Session.from_mesh(_mesh(), mats, T_initial_C=20.0) for _ in range(2))
+    # one mesh: the sets a session names are its own (the other names the same ones)
+    shared = _mesh()
+    kept, fresh = (Session.from_mesh(shared, mats, T_initial_C=20.0) for _ in range(2))
     for s in (kept, fresh):
         s.run_text(window_deck(dataclasses.replace(loadset(0), n_steps=1), s.layout), "w0.inp")
     partitions = kept.state.fem.partitions
@@ -452,3 +453,75 @@ def test_a_record_partition_is_reused_only_for_the_same_groups_of_the_same_owner
                     [-1, 7, 7, 3, 4, 3, 9],  # one more loaded entity
                     [-1, 7, 7, 3, -1, 3, -1]):  # one fewer
         assert p.order_of(np.array(changed), owner) is None
+
+
+def _partial_loads(time_s: float, heated_z: tuple[float, float],
+                   cooled_z: tuple[float, float], restart: bool) -> str:
+    """A load step of the spindle that heats part of the housing and cools part of its
+    outer face: sets that are no region or boundary of the mesh."""
+    return (f"/SOLU\nANTYPE,TRANS{',REST' if restart else ''}\nTIMINT,ON\nKBC,1\n"
+            f"DELTIM,4.0\nTIME,{time_s!r}\n"
+            f"ESEL,S,CENT,Y,{heated_z[0]!r},{heated_z[1]!r}\nCMSEL,R,HOUSING\n"
+            "BFE,ALL,HGEN,,2e5\n"
+            f"NSEL,S,LOC,Y,{cooled_z[0]!r},{cooled_z[1]!r}\nCMSEL,R,HOUSING_OUTER\n"
+            "SF,ALL,CONV,15,22\nALLSEL\nSOLVE\nFINISH\n")
+
+
+def test_sessions_sharing_a_spindle_model_keep_the_sets_they_name_to_themselves():
+    """A session names each set a load falls on that the mesh has no name for; on the
+    shared spindle model those names went onto the model's mesh, so two sessions named
+    one set twice (_cells15 / _cells15_), a session's names depended on what another one
+    had run, and every later session and archive of the mesh saw the other's sets.  Each
+    session here solves and names its sets as a session on a model of its own, bit for
+    bit, and the shared model (mesh, operators, field files, later sessions) is as
+    loaded."""
+    from apdl_like.cdb import cdb_text
+    from apdl_like.solve import fem_model, thermal_loads
+    from twin.loop.replay import spindle_session
+    from twin.spindle.fields import field_mesh
+    from twin.spindle.model import SpindleModel
+
+    model = SpindleModel.load()
+    mesh = model.mesh
+    regions = {k: v.copy() for k, v in mesh.regions.items()}
+    boundaries = {k: v.copy() for k, v in mesh.boundaries.items()}
+    layout = DeckLayout.for_mesh(mesh)
+    archive = cdb_text(mesh, model.materials)
+    T0 = np.full(model.n_dofs, 20.0)
+    field_regions = field_mesh(model, T0).cell_data["region"][0].copy()
+    later = spindle_session(model)
+    components = sorted(later.db.components)
+
+    x = ((0.10, 0.20), (0.20, 0.30))  # heated and cooled z ranges
+    y = ((0.25, 0.35), (0.05, 0.15))
+    shared = {"a": spindle_session(model), "b": spindle_session(model)}
+    own = {"a": spindle_session(SpindleModel.load()), "b": spindle_session(SpindleModel.load())}
+    decks = {"a": (x, y), "b": (y, x)}
+    for step in range(2):  # a, b, a, b: each session's sets after the other's
+        for who in ("a", "b"):
+            heated, cooled = decks[who][step]
+            deck = _partial_loads(4.0 * (step + 1), heated, cooled, restart=step > 0)
+            names = []
+            for s in (shared[who], own[who]):
+                s.run_text(deck, f"{who}{step}.inp")
+                loads = thermal_loads(s.state, fem_model(s.state))
+                names.append((list(loads.sources), list(loads.convection)))
+            np.testing.assert_array_equal(shared[who].state.solution.temperature,
+                                          own[who].state.solution.temperature)
+            assert names[0] == names[1]
+            assert len(names[0][0]) == step + 1 and len(names[0][1]) == step + 1
+    # both sessions named a set of their own first: the same name, other cells
+    assert thermal_loads(shared["a"].state, fem_model(shared["a"].state)).sources == \
+        {"_cells15": 2e5, "_cells16": 2e5}
+    # the shared model is as loaded
+    assert mesh.regions.keys() == regions.keys() and mesh.boundaries.keys() == boundaries.keys()
+    for now, before in ((mesh.regions, regions), (mesh.boundaries, boundaries)):
+        for name, members in before.items():
+            np.testing.assert_array_equal(now[name], members)
+    assert set(model.thermal._source_vectors) <= set(regions)
+    assert {t.split(":", 1)[1] for t in model.thermal.ops._terms if t.startswith("film:")} \
+        <= set(boundaries)
+    assert DeckLayout.for_mesh(mesh) == layout and cdb_text(mesh, model.materials) == archive
+    np.testing.assert_array_equal(field_mesh(model, T0).cell_data["region"][0], field_regions)
+    assert sorted(spindle_session(model).db.components) == components
+    assert sorted(later.db.components) == components

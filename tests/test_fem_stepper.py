@@ -173,3 +173,54 @@ def test_capacity_rate_kept_per_time_step_gives_a_fresh_problems_bits():
     assert sorted(problem._capacity_rates) == [2.0, 4.0]
     with pytest.raises(ValueError, match="read-only"):
         problem.transient(loads, 2.0).explicit.data[0] = 0.0
+
+
+def test_a_problem_on_mesh_views_keeps_each_views_sets_apart():
+    """ThermalProblem.on_mesh: two owners name a set "hot" and "cold" on views of one
+    mesh (other cells and faces each) and step through copies of one problem that has
+    stepped before: each solves to the bits of a problem assembled on a mesh holding its
+    sets, and the shared mesh and problem hold neither set; a mesh that is no view of the
+    problem's is refused."""
+    def make_mesh() -> AxiMesh:
+        return AxiMesh.structured(
+            np.linspace(0.0, 0.05, 11), np.linspace(0.0, 0.02, 5),
+            regions={"shaft": lambda r, z: r < 0.025, "sleeve": lambda r, z: r > 0.025},
+            boundaries={"rim": lambda r, z: np.isclose(r, 0.05)},
+            interfaces={"fit": lambda r, z: np.isclose(r, 0.025)})
+
+    steel = {"shaft": Material(k=50.0, rho=7800.0, c=460.0),
+             "sleeve": Material(k=40.0, rho=7800.0, c=460.0)}
+    mesh = make_mesh()
+    problem = ThermalProblem(mesh, steel)
+    loads = ThermalLoads(sources={"shaft": 2e6}, convection={"rim": (500.0, 20.0)},
+                         contact_resistance={"fit": 2e-4})
+    T = problem.transient(loads, 2.0).step(np.full(problem.n_dofs, 20.0))
+    centroid_z = mesh.thermal.p[1, mesh.thermal.t].mean(axis=0)
+    outer = mesh.thermal.boundary_facets()
+    bottom = outer[np.isclose(mesh.thermal.p[1, mesh.thermal.facets[:, outer]].mean(axis=0), 0)]
+    sets = [(np.nonzero(centroid_z < 0.01)[0], bottom[:4]),
+            (np.nonzero(centroid_z > 0.01)[0], bottom[4:])]
+    terms, sources = set(problem.ops._terms), set(problem._source_vectors)
+    hot = ThermalLoads(sources={"shaft": 2e6, "hot": 1e6},
+                       convection={"rim": (500.0, 20.0), "cold": (80.0, 15.0)},
+                       contact_resistance={"fit": 2e-4})
+    for cells, facets in sets:
+        view = mesh.view()
+        view.add_region("hot", cells)
+        view.add_boundary("cold", facets)
+        copy = problem.on_mesh(view)
+        assert copy.conduction_data is problem.conduction_data  # nothing assembled anew
+        own = make_mesh()
+        own.add_region("hot", cells)
+        own.add_boundary("cold", facets)
+        for dt in (2.0, 4.0):
+            np.testing.assert_array_equal(copy.transient(hot, dt).step(T),
+                                          ThermalProblem(own, steel).transient(hot, dt).step(T))
+    assert set(mesh.regions) == {"shaft", "sleeve"} and set(mesh.boundaries) == {"rim"}
+    assert set(problem.ops._terms) == terms and set(problem._source_vectors) == sources
+    with pytest.raises(ValueError, match="not a view"):
+        problem.on_mesh(make_mesh())
+    replaced = mesh.view()
+    replaced.add_region("shaft", sets[0][0])
+    with pytest.raises(ValueError, match="not a view"):
+        problem.on_mesh(replaced)

@@ -26,6 +26,14 @@ class PatternCombination:
         self._keys = rows * pat.shape[1] + pat.indices.astype(np.int64)
         self._terms: dict[str, np.ndarray] = {}
 
+    def copy(self) -> PatternCombination:
+        """The same pattern and terms (the same arrays) with a registry of its own: terms
+        added to the copy are not added here."""
+        other = object.__new__(PatternCombination)
+        other.__dict__.update(self.__dict__)
+        other._terms = dict(self._terms)
+        return other
+
     @property
     def nnz(self) -> int:
         return self._keys.size

@@ -108,6 +108,14 @@ class LowRankUpdate:
         self.max_bases = max_bases
         self._bases: dict[Hashable, _Base] = {}
 
+    def copy(self) -> LowRankUpdate:
+        """The same U and the factorizations held so far, in a cache of its own: what the
+        copy factorizes later (keyed by names that may mean other sets to its owner) is not
+        kept here."""
+        other = LowRankUpdate(self.U, self.max_bases)
+        other._bases = dict(self._bases)
+        return other
+
     def __len__(self) -> int:
         """Number of factorized A₀ held."""
         return len(self._bases)

@@ -133,6 +133,14 @@ class AxiMesh:
             raise ValueError(f"boundary {name!r}: facet index out of range")
         self.boundaries[name] = facets
 
+    def view(self) -> AxiMesh:
+        """This mesh with registries of named sets of its own: the same triangles, node
+        map, interfaces and, to start with, the same regions and boundaries (the same
+        arrays), while `add_region` / `add_boundary` on the view leave this mesh as it is
+        (an owner that names sets of its own on a mesh others share)."""
+        return AxiMesh(self.thermal, self.glued, self.node_map, dict(self.regions),
+                       dict(self.boundaries), dict(self.interfaces))
+
     def facets_on_nodes(self, nodes: np.ndarray) -> np.ndarray:
         """Boundary facets of the thermal mesh whose two nodes are both in `nodes`."""
         mask = np.zeros(self.thermal.p.shape[1], dtype=bool)

@@ -110,6 +110,35 @@ class ThermalProblem:
         # explicit side, asked for by every step of a loop that re-evaluates its loads
         self._capacity_rates: dict[float, tuple[np.ndarray, sp.csr_matrix]] = {}
 
+    def on_mesh(self, mesh: AxiMesh) -> ThermalProblem:
+        """This problem on `mesh`, a view of its own mesh (`AxiMesh.view`) that may name
+        more sets: the assembled operators are shared, while the operators, loads and
+        factorizations of named sets (those held so far included) are kept apart from here
+        on.  An owner that names sets of its own on a view can then use a problem others
+        share, and neither sees the other's names; nothing is assembled anew.
+
+        ValueError unless `mesh` has this mesh's triangles, interfaces and every one of
+        its regions and boundaries (the same arrays)."""
+        own = self.mesh
+        same = mesh.thermal is own.thermal and mesh.interfaces.keys() == own.interfaces.keys() \
+            and all(mesh_sets.get(name) is members
+                    for mesh_sets, own_sets in ((mesh.regions, own.regions),
+                                                (mesh.boundaries, own.boundaries),
+                                                (mesh.interfaces, own.interfaces))
+                    for name, members in own_sets.items())
+        if not same:
+            raise ValueError("the mesh is not a view of this problem's mesh (AxiMesh.view)")
+        other = object.__new__(ThermalProblem)
+        other.__dict__.update(self.__dict__)
+        other.mesh = mesh
+        other.ops = self.ops.copy()
+        for cache in ("_facet_bases", "_source_vectors", "_region_bases", "_facet_loads",
+                      "_film_rows", "_convection_loads", "_capacity_rates"):
+            setattr(other, cache, dict(getattr(self, cache)))
+        if self.contact_update is not None:
+            other.contact_update = self.contact_update.copy()
+        return other
+
     # ------------------------------------------------------------ operators
     def _check_materials(self) -> None:
         if not self.materials:
