@@ -465,3 +465,11 @@ def test_a_dead_thermocouple_is_left_out_as_a_stuck_one_is(tmp_path, spindle_mod
     acc = {n: json.loads((d / "accuracy.json").read_text())["methods"] for n, d in out.items()}
     assert acc["dead"] == acc["stuck"]
     assert all(m["rmse_C"]["T2"] is None for m in acc["dead"].values())
+
+
+def test_a_snapshots_marker_names_the_shown_fields_largest_value():
+    from twin.loop.snapshot import field_marker
+
+    values = np.array([3.0, 96.42, 12.0])
+    assert field_marker("displacement", values) == (1, "max 96.4 µm")
+    assert field_marker("temperature", np.array([25.0, 50.83, 40.0])) == (1, "max 50.8 °C")

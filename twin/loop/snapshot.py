@@ -2,8 +2,9 @@
 
 The axisymmetric section is revolved by 270° about the spindle axis into a 3-D cut-away,
 so the section itself shows on the two cut faces; `section=True` draws the flat r–z
-view instead.  The scalar bar carries units; the hottest point and the nose drift are
-annotated.  `twin replay --snapshots` and `twin snapshot` both use `render_snapshot`.
+view instead.  The scalar bar carries units; the shown field's largest value is marked
+(the hottest point, or the largest displacement) and the hottest point and the nose
+drift are stated.  `twin replay --snapshots` and `twin snapshot` both use `render_snapshot`.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ import numpy as np
 
 FIELDS = {
     "temperature": ("temperature_C", "Temperature [°C]", "inferno"),
-    "displacement": ("displacement_um", "Displacement |u| [µm]", "viridis"),
+    # "|u|" came out of VTK's title font as a raised "u": the word says it
+    "displacement": ("displacement_um", "Displacement magnitude [µm]", "viridis"),
 }
 
 
@@ -86,9 +88,10 @@ def render_snapshot(
     hot_xyz = points[hot]
     t_max = float(arrays["temperature_C"][hot])
     drift_z = float(arrays["displacement_um"][:, 1][_nose_vertex(model)])
+    top, marker = field_marker(field, values)
     plotter.add_point_labels(
-        [hot_xyz],
-        [f"max {t_max:.1f} °C"],
+        [points[top]],
+        [marker],
         point_size=14,
         font_size=16,
         point_color="red",
@@ -124,6 +127,15 @@ def render_snapshot(
     finally:
         plotter.close()
     return Path(out_png)
+
+
+def field_marker(field: str, values: np.ndarray) -> tuple[int, str]:
+    """The vertex of the shown field's largest value and its label, in the field's unit:
+    the marker names what the colours show (a displacement picture marked the hottest
+    point in °C)."""
+    top = int(np.argmax(values))
+    unit = "°C" if field == "temperature" else "µm"
+    return top, f"max {float(values[top]):.1f} {unit}"
 
 
 def _nose_vertex(model) -> int:  # noqa: ANN001
