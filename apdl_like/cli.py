@@ -123,7 +123,7 @@ def export_cdb(
     from apdl_like.cdb import write_cdb
     from twin.fem import AxiMesh
 
-    check_out_file(out, inputs=[mesh])
+    check_out_file(out, inputs=[mesh], suffixes=(".cdb",))
 
     from twin.spindle.spec import load_spec
 

@@ -194,3 +194,38 @@ def test_apdl_run_leaves_no_result_of_an_earlier_run_beyond_its_own_steps(tmp_pa
     assert run_cli(apdl_app, ["run", one, "--out", out, "--quiet"]).exit_code == 0
     assert sorted(p.name for p in out.iterdir()) == [
         "log.txt", "notes", "params.json", "result_001.vtu", "result_notes.txt"]
+
+
+@pytest.mark.parametrize(("command", "suffixes"), [
+    (["twin", "synth", "--speed", 9000, "--minutes", 3, "--ambient", 25, "--seed", 1],
+     ".csv or .parquet"),
+    (["twin", "mesh"], ".msh"),
+    (["twin", "train", "RUN", "--epochs", 1], ".safetensors"),
+    (["twin", "snapshot", "RUN", "--time", 100, "--method", "open_loop"], ".png"),
+    (["twin", "drift", "fit", "RUN", "--target", "disp_z_um"], ".safetensors"),
+    (["twin", "drift", "predict", "RUN", "RUN"], ".csv"),
+    (["twin", "drift", "select", "RUN", "--target", "disp_z_um"], ".json"),
+    (["apdl-like", "export-cdb"], ".cdb"),
+])
+@pytest.mark.parametrize("name", ["out.txt", "out", "out.msh.bak"])
+def test_an_output_file_of_another_suffix_is_refused_before_any_work(tmp_path, run_file,
+                                                                    command, suffixes, name):
+    # each command checked the suffix in its own words, after other work (train, snapshot),
+    # without naming the option (mesh), not at all (export-cdb wrote any name as CDB) or
+    # case-sensitively (mesh refused OUT.MSH, which the others take)
+    before = run_file.read_bytes()
+    out = tmp_path / name
+    cli = {"twin": app, "apdl-like": apdl_app}[command[0]]
+    args = [run_file if a == "RUN" else a for a in command[1:]]
+    result = run_cli(cli, [*args, "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output == f"error: {out}, option '--out': must end in {suffixes}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+    assert run_file.read_bytes() == before
+
+
+def test_an_output_suffix_is_checked_in_any_case(tmp_path):
+    out = tmp_path / "MESH.MSH"
+    with pytest.raises(InputError, match="must end in .png"):
+        check_out_file(out, suffixes=(".png",))
+    assert check_out_file(out, suffixes=(".msh",)) == out

@@ -88,14 +88,12 @@ def synth(
     # the range replay reads (twin.contract.OPERATING_TEMPERATURE_C; NaN too): synth must
     # not write what replay refuses
     check_operating_options(load_spec(None), speed or 0.0, ambient, coolant)
-    if out.suffix.lower() not in (".csv", ".parquet"):
-        raise InputError("the run must be written as .csv or .parquet", file=str(out),
-                         column="--out")
     if out.name.endswith(COMPANION_SUFFIXES):
         raise InputError(f"a run may not be named *{'/*'.join(COMPANION_SUFFIXES)}: those are "
                          "the files synth writes beside a run, which 'twin replay FOLDER' "
                          "leaves out", file=str(out), column="--out")
-    check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
+    check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)],
+                   suffixes=(".csv", ".parquet"))
     speed_profile = None if profile is None else read_speed_profile(profile)
     if speed_profile is not None and speed_profile.ignored and not quiet:
         typer.echo(f"note: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "

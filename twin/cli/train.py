@@ -60,16 +60,14 @@ def train(
     from twin.spindle.model import SpindleModel
 
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
-    check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
+    check_out_file(out, inputs=runs + gate_runs, also=report_paths(out),
+                   suffixes=(".safetensors",))  # what replay --model and model-info read
     trained = {path.resolve() for path in runs}
     for path in gate_runs:  # the gate measures the networks on runs they never saw
         if path.resolve() in trained:
             raise InputError("is also a training run; the gate replays runs never trained "
                              "on: leave it out of the RUN list or of --gate-runs",
                              file=str(path), column="--gate-runs")
-    if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
-        raise InputError("the model file must end in .safetensors", file=str(out),
-                         column="--out")
     named = [(str(path), run_name(path)) for path in runs]
     check_distinct_names(named)
     tables = [read_table(path) for path in [*runs, *gate_runs]]

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 import stat
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from twin.errors import InputError
@@ -57,11 +57,14 @@ def refuse_special(target: Path, option: str = "--out") -> None:
 
 
 def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                   option: str = "--out", also: Iterable[StrPath] = ()) -> Path:
+                   option: str = "--out", also: Iterable[StrPath] = (),
+                   suffixes: Sequence[str] = ()) -> Path:
     """`out` as a Path if a command may write the file there (see the module doc).
 
     `inputs` are the files the command reads; `also` are further files it writes beside
-    `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.
+    `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.  `suffixes`, if
+    given, are the ones `out` may end in, in any case (`S.PNG` too): another name was
+    written in a format it does not name, or refused by the writer after the work.
     """
     target = Path(out)
     _check_ancestors(target, option)
@@ -72,6 +75,9 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
             if _same(written, source):
                 raise InputError(f"is also an input of this command ({source}); refusing to "
                                  "overwrite it", file=str(written), column=option)
+    if suffixes and target.suffix.lower() not in suffixes:
+        raise InputError(f"must end in {' or '.join(suffixes)}", file=str(target),
+                         column=option)
     return target
 
 
