@@ -210,6 +210,14 @@ def test_cli_choices_match_the_modules_that_act_on_them():
           "--out", "OUT.csv"], "--minutes"),
         (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "-2",
           "--out", "OUT.csv"], "--seed"),
+        # numpy takes any seed >= 0; a suite's runs are seeded below 2**32, and a longer
+        # suite seed made file names the file system refused after the draw
+        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed",
+          str(2**32), "--out", "OUT.csv"], "--seed"),
+        (["synth", "--suite", "2", "--minutes", "3", "--seed", "9" * 300, "--out", "OUT"],
+         "--seed"),
+        (["synth", "--suite", "2", "--minutes", "3", "--seed", "-1", "--out", "OUT"],
+         "--seed"),
         (["synth", "--speed", "-5", "--minutes", "3", "--ambient", "25", "--seed", "1",
           "--out", "OUT.csv"], "--speed"),
         (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1",

@@ -53,9 +53,12 @@ MAX_SIZE_FACTOR = 100.0
 """Mesh element size multiplier: above this the spindle is no longer resolved at all."""
 
 MAX_SEED = 2**32 - 1
-"""Largest --seed of the commands that seed torch or scikit-learn (k-means takes seeds
-below 2**32, torch below 2**64): beyond it a run ended in an internal error after its
-work, where typer can refuse the option before any."""
+"""Largest --seed of every command.  k-means takes seeds below 2**32 and torch below
+2**64: beyond, `train` and `drift fit` ended in an internal error after their work, where
+typer can refuse the option before any.  numpy's generators behind `synth` take any seed
+≥ 0, but a suite's runs get seeds below 2**32 (`twin.plant.suite`, the seeds their
+scenarios reproduce them with), and a longer suite seed, in every file name, made names
+the file system refused once the suite was drawn."""
 
 
 def bundled_runs_dir() -> Path:

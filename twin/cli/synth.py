@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import RANGE_C
+from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError
 
 SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
@@ -39,7 +39,7 @@ def synth(
     out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
                              "RUN.parquet; the truth goes to RUN.truth.csv beside it), or "
                              "with --suite the folder of the suite's files."),
-    seed: int = typer.Option(..., "--seed", min=0,
+    seed: int = typer.Option(..., "--seed", min=0, max=MAX_SEED,
                              help="Seed of every random choice (deterministic)."),
     minutes: float | None = typer.Option(None, "--minutes", min=2.0, max=24 * 60.0,
                                          help="Run length, minutes (two 60 s windows at "
