@@ -13,7 +13,7 @@ import stat
 import tomllib
 from pathlib import Path
 
-from twin.errors import InputError
+from twin.errors import InputError, TomlError
 
 MAX_INPUT_BYTES = 512 * 2**20
 """Largest input file read (512 MiB): a day of 10 Hz samples as CSV is under 100 MiB."""
@@ -85,9 +85,9 @@ def parse_toml(text: str, file: str, column: str | None = None) -> dict:
         row = int(match.group(1)) if match else None
         if row is None and "end of document" in str(exc):
             row = text.rstrip("\n").count("\n") + 1
-        raise InputError(f"not valid TOML: {exc}", file=file, row=row, column=column) from None
+        raise TomlError(f"not valid TOML: {exc}", file=file, line=row, key=column) from None
     except RecursionError:
-        raise InputError("not valid TOML: nested too deeply", file=file, column=column) from None
+        raise TomlError("not valid TOML: nested too deeply", file=file, key=column) from None
 
 
 def toml_line_of(text: str, loc: tuple) -> int | None:

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from twin.cli.inputs import MAX_SEED, RANGE_C
-from twin.errors import InputError
+from twin.errors import InputError, TomlError
 
 SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
 
@@ -103,8 +103,8 @@ def synth(
     profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
     if profile_ambient and truth.ambient is not None:
         # the scenario's table won and the profile's column was read for nothing
-        raise InputError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
-                         "the ambient: keep one of them", file=str(scenario), column="ambient")
+        raise TomlError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
+                        "the ambient: keep one of them", file=str(scenario), key="ambient")
     run = synthesize(
         speed_rpm=speed, profile=speed_profile,
         minutes=minutes, ambient_C=ambient, seed=seed, scenario=truth, rate_hz=rate,
