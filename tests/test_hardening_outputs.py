@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import stat
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -229,3 +230,45 @@ def test_an_output_suffix_is_checked_in_any_case(tmp_path):
     with pytest.raises(InputError, match="must end in .png"):
         check_out_file(out, suffixes=(".png",))
     assert check_out_file(out, suffixes=(".msh",)) == out
+
+
+def _unwritable_folders(tmp_path):
+    """Folders the test's user may not write in: a read-only folder (root writes there
+    anyway) and /proc, which refuses root too."""
+    folders = []
+    if os.geteuid() != 0:
+        locked = tmp_path / "locked"
+        locked.mkdir()
+        locked.chmod(0o555)
+        folders.append(locked)
+    if os.path.isdir("/proc/self"):
+        folders.append(Path("/proc"))
+    if not folders:
+        pytest.skip("no folder here that the test's user may not write in")
+    return folders
+
+
+@pytest.mark.parametrize(("command", "name"), [
+    (["twin", "synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
+      "--quiet"], "new/run.csv"),
+    (["twin", "mesh", "--quiet"], "m.msh"),
+    (["twin", "replay", "RUN", "--methods", "open_loop", "--quiet"], "new"),
+    (["twin", "simulate", "--speed", 9000, "--minutes", 0.2, "--ambient", 25, "--quiet"], ""),
+    (["twin", "drift", "select", "RUN", "--target", "disp_z_um"], "ranking.json"),
+    (["apdl-like", "run", "DECK", "--quiet"], "out"),
+])
+def test_an_unwritable_out_is_refused_before_any_work(tmp_path, run_file, command, name):
+    # the write failed after all the work: 'internal error: PermissionError', exit 1
+    deck = tmp_path / "d.inp"
+    deck.write_text("A = 1\n")
+    cli = {"twin": app, "apdl-like": apdl_app}[command[0]]
+    args = [{"RUN": run_file, "DECK": deck}.get(a, a) for a in command[1:]]
+    for folder in _unwritable_folders(tmp_path):
+        out = folder / name if name else folder
+        result = run_cli(cli, [*args, "--out", out])
+        assert result.exit_code == 2, result.output
+        assert result.output.startswith(f"error: {out}, option '--out': cannot write in "
+                                        f"{folder}: "), result.output
+        assert "\n" not in result.output.rstrip("\n")
+        if name:
+            assert not (folder / name.split("/")[0]).exists()

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import stat
+import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -42,12 +43,27 @@ def _inside(path: Path, folder: Path) -> bool:
 
 
 def _check_ancestors(target: Path, option: str) -> None:
-    """The nearest existing ancestor of `target` must be a folder (mkdir would fail)."""
+    """The nearest existing ancestor of `target` must be a folder (mkdir would fail) the
+    command may write in."""
     for parent in target.absolute().parents:
         if parent.exists():
             if not parent.is_dir():
                 raise InputError(f"{parent} is not a folder", file=str(target), column=option)
+            _check_writable(parent, target, option)
             return
+
+
+def _check_writable(folder: Path, target: Path, option: str) -> None:
+    """InputError unless a file can be made in `folder`.  Tried, with an unnamed temporary
+    file where the system has them (nothing to see or leave behind): `os.access` says yes
+    to root on a mount that refuses it (/sys), and the write failed after all the work as
+    an internal error."""
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise InputError(f"cannot write in {folder}: {exc.strerror or exc}",
+                         file=str(target), column=option) from None
 
 
 def refuse_special(target: Path, option: str = "--out") -> None:
@@ -92,10 +108,11 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
     fifo) there is refused now, not once the work is done.
     """
     target = Path(out)
-    _check_ancestors(target, option)
     files = list(files)
     owned = [*owned, *files]
-    if target.exists() or target.is_symlink():
+    if not (target.exists() or target.is_symlink()):
+        _check_ancestors(target, option)
+    else:
         try:
             info = target.stat()
         except OSError as exc:
@@ -105,6 +122,7 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
             kind = "a file" if stat.S_ISREG(info.st_mode) else "not a folder"
             raise InputError(f"is {kind}; a folder is expected", file=str(target),
                              column=option)
+        _check_writable(target, target, option)  # not its parent: the files go inside
         for name in files:
             refuse_special(target / name, option)
     for source in (Path(p) for p in inputs if p is not None):
