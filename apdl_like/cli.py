@@ -135,8 +135,7 @@ def export_cdb(
         materials = {region: fem_material(spec, region) for region in spec.regions}
         title = spec.spindle.name
     else:
-        if not mesh.is_file():
-            raise InputError("mesh file not found", file=str(mesh))
+        regular_file_info(mesh, use="read mesh", column="--mesh")
         try:  # a spindle mesh (`twin mesh`) keeps its contact faces apart, as the default
             axi = AxiMesh.from_msh(mesh, interfaces=spec.interfaces(), present_only=True)
         except ValueError as exc:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -535,9 +536,31 @@ def test_a_model_given_is_checked_whatever_the_methods(argv, tmp_path, monkeypat
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(app, [*argv, "--model", "modle.safetensors"])
     assert result.exit_code == 2, result.output
-    assert "modle.safetensors, option '--model': model file not found" in result.output
+    assert ("modle.safetensors, option '--model': cannot read file: No such file or "
+            "directory") in result.output
+    (tmp_path / "models").mkdir()  # 'model file not found' of a folder that is there
+    result = CliRunner().invoke(app, [*argv, "--model", "models"])
+    assert result.exit_code == 2, result.output
+    assert "models, option '--model': is a folder, not a file" in result.output
+    (tmp_path / "models").rmdir()
     (tmp_path / "notes.safetensors").write_text("not a model")
     result = CliRunner().invoke(app, [*argv, "--model", "notes.safetensors"])
     assert result.exit_code == 2, result.output
     assert "notes.safetensors: not a readable safetensors model file" in result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.safetensors"]
+
+
+def test_export_cdb_names_what_is_wrong_with_its_mesh(tmp_path):
+    # a folder or a fifo given as --mesh was 'mesh file not found', naming no option
+    from apdl_like.cli import app as apdl_app
+
+    (tmp_path / "meshes").mkdir()
+    os.mkfifo(tmp_path / "pipe.msh")
+    for name, words in (("meshes", "is a folder, not a file"),
+                        ("pipe.msh", "is not a regular file"),
+                        ("none.msh", "cannot read mesh: No such file or directory")):
+        result = CliRunner().invoke(apdl_app, ["export-cdb", "--mesh", str(tmp_path / name),
+                                               "--out", str(tmp_path / "x.cdb")])
+        assert result.exit_code == 2, result.output
+        assert result.output.startswith(f"error: {tmp_path / name}, option '--mesh': {words}")
+    assert not (tmp_path / "x.cdb").exists()

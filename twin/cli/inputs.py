@@ -181,9 +181,10 @@ def checked_model(methods: list[str], model: Path | None) -> str | None:
         raise InputError(
             "the bpnn method needs a correction model: pass --model FILE", column="--model"
         )
-    if not Path(model).is_file():
-        raise InputError("model file not found", file=str(model), column="--model")
     from twin.correction.modelfile import load_model
+    from twin.paths import check_input_file
+
+    check_input_file(model, column="--model")  # nothing there, a folder, a fifo: say which
 
     load_model(model)
     return str(model)
