@@ -484,6 +484,19 @@ def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monk
         [] if message.endswith("no such folder") else ["missing"])
 
 
+def test_report_names_no_option_it_does_not_have(tmp_path):
+    # a folder where summary.json goes was "DIR/summary.json, option '--out': ...", an
+    # option twin report does not take
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "accuracy.json").write_text("{}")
+    (tmp_path / "summary.json").mkdir()
+    result = CliRunner().invoke(app, ["report", str(tmp_path)])
+    assert result.exit_code == 2, result.output
+    assert result.output == f"error: {tmp_path / 'summary.json'}: is a folder, not a file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run", "summary.json"]
+
+
 @pytest.mark.parametrize("command", [
     ["simulate", "--out", "OUT"],
     ["synth", "--minutes", "3", "--seed", "1", "--out", "OUT.csv"],

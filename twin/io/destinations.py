@@ -42,7 +42,7 @@ def _inside(path: Path, folder: Path) -> bool:
     return True
 
 
-def _check_ancestors(target: Path, option: str) -> None:
+def _check_ancestors(target: Path, option: str | None) -> None:
     """The nearest existing ancestor of `target` must be a folder (mkdir would fail) the
     command may write in."""
     for parent in target.absolute().parents:
@@ -53,7 +53,7 @@ def _check_ancestors(target: Path, option: str) -> None:
             return
 
 
-def _check_writable(folder: Path, target: Path, option: str) -> None:
+def _check_writable(folder: Path, target: Path, option: str | None) -> None:
     """InputError unless a file can be made in `folder`.  Tried, with an unnamed temporary
     file where the system has them (nothing to see or leave behind): `os.access` says yes
     to root on a mount that refuses it (/sys), and the write failed after all the work as
@@ -66,14 +66,14 @@ def _check_writable(folder: Path, target: Path, option: str) -> None:
                          file=str(target), column=option) from None
 
 
-def refuse_special(target: Path, option: str = "--out") -> None:
+def refuse_special(target: Path, option: str | None = "--out") -> None:
     """InputError if `target` exists (through any symlink) and is not a regular file."""
     # nothing there (or a dangling symlink, which the rename replaces) is fine
     regular_file_info(target, use="use as output", column=option, missing_ok=True)
 
 
 def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                   option: str = "--out", also: Iterable[StrPath] = (),
+                   option: str | None = "--out", also: Iterable[StrPath] = (),
                    suffixes: Sequence[str] = ()) -> Path:
     """`out` as a Path if a command may write the file there (see the module doc).
 
@@ -98,7 +98,7 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
 
 
 def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                  option: str = "--out", owned: Iterable[str] = (),
+                  option: str | None = "--out", owned: Iterable[str] = (),
                   files: Iterable[str] = ()) -> Path:
     """`out` as a Path if a command may write its output folder there.
 
