@@ -66,8 +66,13 @@ def read_input_bytes(path: str | os.PathLike[str], *, column: str | None = None,
 
 def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
                     max_bytes: int = MAX_INPUT_BYTES) -> str:
-    """The UTF-8 text of a checked input file; a bad byte names its line."""
+    """The UTF-8 text of a checked input file; a bad byte names its line.  A file whose
+    lines all end in a bare CR (classic Mac OS, Excel's "CSV (Macintosh)") reads as if
+    they ended in LF, as editors show it: read as it was, it was one line, a comment, and
+    a run "an empty file", a profile "not a readable CSV line", a scenario not TOML."""
     data = read_input_bytes(path, column=column, max_bytes=max_bytes)
+    if b"\r" in data and b"\n" not in data:
+        data = data.replace(b"\r", b"\n")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
