@@ -259,3 +259,18 @@ def test_files_with_bare_cr_line_ends_read_as_with_lf(tmp_path):
     with pytest.raises(InputError) as info:
         read_run(bad)
     assert info.value.row == 8 and info.value.column == "time_s"
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
+    # Excel's "Unicode text" is UTF-16: "row 1: not UTF-8 text" left the user guessing
+    path = tmp_path / "run.csv"
+    text = csv_text(warmup(), "# name: Prüfstand\n")
+    path.write_bytes(("\ufeff" if encoding.endswith("be") else "").encode(encoding)
+                     + text.encode(encoding))
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    assert str(info.value) == f"{path}: UTF-16 text; save it as UTF-8"
+    path.write_bytes(text.encode("latin-1"))  # not UTF-8, but no UTF-16 either
+    with pytest.raises(InputError, match="row 1: not UTF-8 text"):
+        read_run(path)

@@ -7,6 +7,7 @@ A fifo, a device or a folder given where a file is expected would block a reader
 
 from __future__ import annotations
 
+import codecs
 import os
 import re
 import stat
@@ -76,6 +77,9 @@ def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
+        if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):  # Excel's "Unicode"
+            raise InputError("UTF-16 text; save it as UTF-8", file=str(path),
+                             column=column) from None
         line = data[: exc.start].count(b"\n") + 1
         raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
 
