@@ -151,6 +151,17 @@ def test_toml_errors_name_the_line_and_key_not_a_row_and_column(tmp_path):
     with pytest.raises(InputError) as info:
         load_spec(spec)
     assert str(info.value).startswith(f"{spec}, line 2, key 'spindle.name': ")
+    from twin.spindle.spec import DEFAULT_SPEC_PATH
+
+    text = DEFAULT_SPEC_PATH.read_text()
+    line = text[:text.index("max_speed_rpm = ")].count("\n") + 1
+    spec.write_text(text.replace("max_speed_rpm = ", "max_sped = 1\nmax_speed_rpm = ", 1))
+    with pytest.raises(InputError, match=f"line {line}, key 'spindle.max_sped': unknown key"):
+        load_spec(spec)
+    # pydantic's words ("Field required", "unknown field") were left in the message
+    with pytest.raises(InputError) as info:
+        parse_scenario("[motor_heat]\nfactor = [1.2]\n", "bad.toml")
+    assert str(info.value) == "bad.toml, line 1, key 'motor_heat.time_s': missing required key"
     # a table clashing with the profile's column
     scenario, profile = tmp_path / "s.toml", tmp_path / "p.csv"
     scenario.write_text("[ambient]\ntime_s = [0]\nambient_C = [20]\n")

@@ -240,6 +240,8 @@ def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
         message = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             message = "unknown key (check the spelling)"
+        elif err["type"] == "missing":  # pydantic's "Field required"
+            message = "missing required key"
         raise TomlError(message, file=file, line=toml_line_of(text, loc),
                         key=".".join(str(k) for k in loc) or None) from None
 

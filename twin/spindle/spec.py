@@ -397,9 +397,9 @@ def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> S
         else:
             field_name, message = _field_path(first["loc"]), first["msg"]
             if first["type"] == "missing":
-                message = "missing required field"
+                message = "missing required key"
             elif first["type"] == "extra_forbidden":
-                message = "unknown field (check the spelling and the unit in the name)"
+                message = "unknown key (check the spelling and the unit in the name)"
             more = exc.error_count() - 1
         suffix = f" (and {more} more problem{'s' if more > 1 else ''})" if more > 0 else ""
         row = None if text is None else toml_line_of(text, tuple(re.findall(r"[^.\[\]]+",
