@@ -285,3 +285,20 @@ def test_ctrl_c_leaves_no_summary_or_report_listing_the_run_it_removed(replayed,
     assert [r["run"] for r in summary_of(out)["runs"]] == ["a"]
     assert "<td>b</td>" not in (out / "report.html").read_text()
     assert "<td>a</td>" in (out / "report.html").read_text()
+
+
+@pytest.mark.timeout(120)
+def test_a_run_file_name_that_is_not_utf8_is_bad_input(runs, tmp_path):
+    # a name of bytes that are not UTF-8 ended the replay in an internal error (the report
+    # could not hold it), or hung it: the forked plotter waited for a start never sent
+    name = os.fsdecode(b"run\xff.csv")
+    path = tmp_path / name
+    path.write_bytes((runs / "a.csv").read_bytes())
+    out = tmp_path / "out"
+    result = replay([path, runs / "b.csv"], out)
+    assert result.exit_code == 2
+    assert [f["run"] for f in result.failed] == ["run\udcff"]
+    assert "not UTF-8 text" in result.failed[0]["error"]
+    assert [r["run"] for r in summary_of(out)["runs"]] == ["b"]
+    build_report(out)  # the failure names the file: the page holds it as the terminal shows it
+    assert "run\\udcff.csv" in (out / "report.html").read_text()
