@@ -272,3 +272,20 @@ def test_an_unwritable_out_is_refused_before_any_work(tmp_path, run_file, comman
         assert "\n" not in result.output.rstrip("\n")
         if name:
             assert not (folder / name.split("/")[0]).exists()
+
+
+@pytest.mark.parametrize("command", [
+    ["synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1],
+    ["train", "RUN", "--epochs", 1],
+])
+@pytest.mark.parametrize("out", ["", "/"])
+def test_an_out_without_a_file_name_is_bad_input(tmp_path, run_file, monkeypatch, command,
+                                                 out):
+    # '--out ""' (an unset shell variable) is the folder '.': the name of the file written
+    # beside it (RUN.truth.csv, MODEL.report.json) was an internal error
+    monkeypatch.chdir(tmp_path)
+    args = [run_file if a == "RUN" else a for a in command]
+    result = run_cli(app, [*args, "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"error: {out or '.'}, option '--out': ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
