@@ -116,6 +116,10 @@ def train(
         if not quiet:
             typer.echo(f"networks kept: {', '.join(gate['kept']) or 'none (the anchor)'}",
                        err=True)
+    for stale in report_paths(out):
+        # they describe the model replaced now: a stop while the new ones are drawn (a
+        # second or so) left them beside it, as its report
+        stale.unlink(missing_ok=True)
     save_model(model, out)
     results[chosen.name] = dataclasses.replace(results[chosen.name], model=model)
     json_path, html_path = write_report(out, results, chosen.name)
