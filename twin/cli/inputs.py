@@ -66,6 +66,10 @@ def bundled_runs_dir() -> Path:
     return bundled_path("runs").resolve()
 
 
+RUN_SUFFIXES = (".csv", ".parquet", ".pq")
+"""What a recorded run's file ends in, in any case (the readers of `twin.runs.run`): a
+folder's RUN.CSV was passed over while the same file named alone was replayed."""
+
 COMPANION_SUFFIXES = (".truth.csv", ".profile.csv")
 """Files `twin synth` writes beside a run (its truth and speed profile): not runs."""
 
@@ -75,7 +79,7 @@ def runs_in(folder: Path) -> list[Path]:
     truth and profile files `twin synth` writes beside each run, so a synth suite's
     folder replays as it is."""
     runs = sorted(p for p in folder.iterdir()
-                  if p.suffix in (".csv", ".parquet") and p.is_file())
+                  if p.suffix.lower() in RUN_SUFFIXES and p.is_file())
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
 
 
@@ -100,7 +104,7 @@ def run_files_in(folder: Path) -> list[Path]:
     """Every file of recorded runs in `folder`, sorted by name: the runs `runs_in` finds
     and the truth, profile and scenario files `twin synth` writes beside them."""
     return sorted(p for p in folder.iterdir() if p.is_file() and (
-        p.suffix in (".csv", ".parquet") or p.name.endswith(".scenario.toml")))
+        p.suffix.lower() in RUN_SUFFIXES or p.name.endswith(".scenario.toml")))
 
 
 def expand_run_folders(paths: list[Path]) -> list[Path]:
