@@ -183,14 +183,16 @@ def test_cli_choices_match_the_modules_that_act_on_them():
     assert tuple(Field) == tuple(FIELDS)
 
 
-def test_a_folder_lists_the_runs_its_files_name_in_any_case(tmp_path):
+def test_a_folder_lists_its_runs_in_any_case_and_no_hidden_file(tmp_path):
     # a folder's RUN1.CSV (or run.pq) was passed over without a word, while the same file
     # named alone was replayed: the readers take the suffix in any case
     from twin.cli.inputs import RUN_SUFFIXES, runs_in
     from twin.runs.run import _READERS
 
     assert set(RUN_SUFFIXES) == set(_READERS)
-    for name in ("RUN1.CSV", "run2.pq", "Run3.Parquet", "run3.truth.csv", "notes.txt"):
+    # and hidden files are no runs: a Mac's ._RUN1.CSV, a killed writer's temporary file
+    for name in ("RUN1.CSV", "run2.pq", "Run3.Parquet", "run3.truth.csv", "notes.txt",
+                 "._RUN1.CSV", ".run4.123.abcd1234.csv"):
         (tmp_path / name).write_text("")
     (tmp_path / "folder.csv").mkdir()
     assert [p.name for p in runs_in(tmp_path)] == ["RUN1.CSV", "Run3.Parquet", "run2.pq"]

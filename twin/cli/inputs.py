@@ -77,9 +77,11 @@ COMPANION_SUFFIXES = (".truth.csv", ".profile.csv")
 def runs_in(folder: Path) -> list[Path]:
     """The recorded runs in `folder` (CSV or Parquet, sorted by name), leaving out the
     truth and profile files `twin synth` writes beside each run, so a synth suite's
-    folder replays as it is."""
-    runs = sorted(p for p in folder.iterdir()
-                  if p.suffix.lower() in RUN_SUFFIXES and p.is_file())
+    folder replays as it is, and hidden files: a Mac's `._RUN.csv` beside each run
+    copied to a stick, a killed writer's temporary file (each failed the batch as a run
+    that a leading dot cannot name)."""
+    runs = sorted(p for p in folder.iterdir() if p.suffix.lower() in RUN_SUFFIXES
+                  and not p.name.startswith(".") and p.is_file())
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
 
 
@@ -103,8 +105,8 @@ def check_operating_options(spec: SpindleSpec, speed: float, ambient: float,
 def run_files_in(folder: Path) -> list[Path]:
     """Every file of recorded runs in `folder`, sorted by name: the runs `runs_in` finds
     and the truth, profile and scenario files `twin synth` writes beside them."""
-    return sorted(p for p in folder.iterdir() if p.is_file() and (
-        p.suffix.lower() in RUN_SUFFIXES or p.name.endswith(".scenario.toml")))
+    return sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
+                  and (p.suffix.lower() in RUN_SUFFIXES or p.name.endswith(".scenario.toml")))
 
 
 def expand_run_folders(paths: list[Path]) -> list[Path]:
