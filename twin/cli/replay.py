@@ -73,25 +73,24 @@ def replay(
     # the run names keep their width: a failed run's long status is what gets cut (it is
     # printed whole after the bar)
     names = Column(no_wrap=True, min_width=min(60, max(len(Path(p).stem) for p in paths)))
-    try:
-        with run_plotter(fork=in_this_process) as plotter, Progress(
-            TextColumn("{task.description}", table_column=names),
-            BarColumn(),
-            TextColumn("{task.fields[status]}",
-                       table_column=Column(no_wrap=True, overflow="ellipsis")),
-            TimeElapsedColumn(),
-            console=console,
-            disable=quiet,
-            auto_refresh=False,
-        ) as progress:
-            from twin.loop.batch import replay_batch
+    with run_plotter(fork=in_this_process) as plotter, Progress(
+        TextColumn("{task.description}", table_column=names),
+        BarColumn(),
+        TextColumn("{task.fields[status]}",
+                   table_column=Column(no_wrap=True, overflow="ellipsis")),
+        TimeElapsedColumn(),
+        console=console,
+        disable=quiet,
+        auto_refresh=False,
+    ) as progress:
+        from twin.loop.batch import replay_batch
 
-            tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="")
-                     for p in paths}
+        tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="") for p in paths}
 
-            def tell(name: str, status: str) -> None:
-                progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
+        def tell(name: str, status: str) -> None:
+            progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
 
+        try:
             result = replay_batch(
                 paths,
                 out,
@@ -105,11 +104,11 @@ def replay(
                 assimilate_drift=drift_assimilation,
                 plotter=plotter if in_this_process else None,
             )
-    except KeyboardInterrupt:
-        # the run under way went with its folder (a failed rerun leaves no earlier result
-        # standing): summary.json and report.html must not list that result either
-        build_report(out)
-        raise
+        except KeyboardInterrupt:
+            # the run under way went with its folder (a failed rerun leaves no earlier
+            # result standing): summary.json and report.html must not list that result
+            build_report(out)
+            raise
     build_report(out, rebuild_summary=False)
     for failure in result.failed:
         typer.echo(f"error: {failure['error']}", err=True)
