@@ -289,3 +289,16 @@ def test_an_out_without_a_file_name_is_bad_input(tmp_path, run_file, monkeypatch
     assert result.exit_code == 2, result.output
     assert result.output.startswith(f"error: {out or '.'}, option '--out': ")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+
+
+def test_a_symlink_loop_given_as_a_run_is_bad_input(tmp_path, run_file):
+    # pathlib's resolve() raised RuntimeError on the loop in the --out check: exit 1
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    out = tmp_path / "out"
+    result = run_cli(app, ["replay", tmp_path / "a.csv", run_file, "--methods", "open_loop",
+                           "--snapshots", "none", "--quiet", "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output == (f"error: {tmp_path / 'a.csv'}: cannot read file: Too many "
+                             "levels of symbolic links\n")
+    assert sorted(p.name for p in out.iterdir()) == ["report.html", "run", "summary.json"]

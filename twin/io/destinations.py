@@ -31,13 +31,16 @@ def _same(a: Path, b: Path) -> bool:
     try:
         return os.path.samefile(a, b)
     except OSError:
-        return a.resolve() == b.resolve()
+        try:
+            return a.resolve() == b.resolve()
+        except RuntimeError:  # a symlink loop names no file, so not this one (pathlib's
+            return False      # RuntimeError was an internal error before the input check)
 
 
 def _inside(path: Path, folder: Path) -> bool:
     try:
         path.resolve().relative_to(folder.resolve())
-    except ValueError:
+    except (ValueError, RuntimeError):  # RuntimeError: a symlink loop, inside nothing
         return False
     return True
 
