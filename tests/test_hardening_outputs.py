@@ -302,3 +302,14 @@ def test_a_symlink_loop_given_as_a_run_is_bad_input(tmp_path, run_file):
     assert result.output == (f"error: {tmp_path / 'a.csv'}: cannot read file: Too many "
                              "levels of symbolic links\n")
     assert sorted(p.name for p in out.iterdir()) == ["report.html", "run", "summary.json"]
+
+
+def test_a_symlink_loop_given_to_train_is_bad_input(tmp_path, run_file):
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    result = run_cli(app, ["train", tmp_path / "a.csv", run_file, "--epochs", 1, "--quiet",
+                           "--out", tmp_path / "m.safetensors"])
+    assert result.exit_code == 2, result.output
+    assert result.output == (f"error: {tmp_path / 'a.csv'}: cannot read file: Too many "
+                             "levels of symbolic links\n")
+    assert not (tmp_path / "m.safetensors").exists()

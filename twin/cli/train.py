@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 
 import typer
@@ -62,9 +63,10 @@ def train(
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
     check_out_file(out, inputs=runs + gate_runs, also=report_paths(out),
                    suffixes=(".safetensors",))  # what replay --model and model-info read
-    trained = {path.resolve() for path in runs}
+    # realpath: resolve() raised RuntimeError on a symlink loop, an internal error
+    trained = {os.path.realpath(path) for path in runs}
     for path in gate_runs:  # the gate measures the networks on runs they never saw
-        if path.resolve() in trained:
+        if os.path.realpath(path) in trained:
             raise InputError("is also a training run; the gate replays runs never trained "
                              "on: leave it out of the RUN list or of --gate-runs",
                              file=str(path), column="--gate-runs")
