@@ -205,6 +205,9 @@ def test_missing_time(tmp_path):
 def test_unknown_suffix_and_bad_parquet(tmp_path):
     with pytest.raises(InputError, match="unknown run format"):
         read_run(write(tmp_path, "x", "run.txt"))
+    # a mistyped folder name was "unknown run format ''", as if the file were there
+    with pytest.raises(InputError, match="cannot read file: No such file or directory"):
+        read_run(tmp_path / "my_runs")
     with pytest.raises(InputError, match="Parquet"):
         read_run(write(tmp_path, "not parquet", "run.parquet"))
 
