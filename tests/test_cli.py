@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -182,6 +183,21 @@ def test_cli_choices_match_the_modules_that_act_on_them():
     assert tuple(Field) == tuple(FIELDS)
 
 
+def test_a_folder_lists_its_runs_in_any_case_and_no_hidden_file(tmp_path):
+    # a folder's RUN1.CSV (or run.pq) was passed over without a word, while the same file
+    # named alone was replayed: the readers take the suffix in any case
+    from twin.cli.inputs import RUN_SUFFIXES, runs_in
+    from twin.runs.run import _READERS
+
+    assert set(RUN_SUFFIXES) == set(_READERS)
+    # and hidden files are no runs: a Mac's ._RUN1.CSV, a killed writer's temporary file
+    for name in ("RUN1.CSV", "run2.pq", "Run3.Parquet", "run3.truth.csv", "notes.txt",
+                 "._RUN1.CSV", ".run4.123.abcd1234.csv"):
+        (tmp_path / name).write_text("")
+    (tmp_path / "folder.csv").mkdir()
+    assert [p.name for p in runs_in(tmp_path)] == ["RUN1.CSV", "Run3.Parquet", "run2.pq"]
+
+
 @pytest.mark.parametrize(
     ("argv", "option"),
     [
@@ -210,6 +226,14 @@ def test_cli_choices_match_the_modules_that_act_on_them():
           "--out", "OUT.csv"], "--minutes"),
         (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "-2",
           "--out", "OUT.csv"], "--seed"),
+        # numpy takes any seed >= 0; a suite's runs are seeded below 2**32, and a longer
+        # suite seed made file names the file system refused after the draw
+        (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed",
+          str(2**32), "--out", "OUT.csv"], "--seed"),
+        (["synth", "--suite", "2", "--minutes", "3", "--seed", "9" * 300, "--out", "OUT"],
+         "--seed"),
+        (["synth", "--suite", "2", "--minutes", "3", "--seed", "-1", "--out", "OUT"],
+         "--seed"),
         (["synth", "--speed", "-5", "--minutes", "3", "--ambient", "25", "--seed", "1",
           "--out", "OUT.csv"], "--speed"),
         (["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1",
@@ -475,6 +499,19 @@ def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monk
         [] if message.endswith("no such folder") else ["missing"])
 
 
+def test_report_names_no_option_it_does_not_have(tmp_path):
+    # a folder where summary.json goes was "DIR/summary.json, option '--out': ...", an
+    # option twin report does not take
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "accuracy.json").write_text("{}")
+    (tmp_path / "summary.json").mkdir()
+    result = CliRunner().invoke(app, ["report", str(tmp_path)])
+    assert result.exit_code == 2, result.output
+    assert result.output == f"error: {tmp_path / 'summary.json'}: is a folder, not a file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run", "summary.json"]
+
+
 @pytest.mark.parametrize("command", [
     ["simulate", "--out", "OUT"],
     ["synth", "--minutes", "3", "--seed", "1", "--out", "OUT.csv"],
@@ -527,9 +564,31 @@ def test_a_model_given_is_checked_whatever_the_methods(argv, tmp_path, monkeypat
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(app, [*argv, "--model", "modle.safetensors"])
     assert result.exit_code == 2, result.output
-    assert "modle.safetensors, option '--model': model file not found" in result.output
+    assert ("modle.safetensors, option '--model': cannot read file: No such file or "
+            "directory") in result.output
+    (tmp_path / "models").mkdir()  # 'model file not found' of a folder that is there
+    result = CliRunner().invoke(app, [*argv, "--model", "models"])
+    assert result.exit_code == 2, result.output
+    assert "models, option '--model': is a folder, not a file" in result.output
+    (tmp_path / "models").rmdir()
     (tmp_path / "notes.safetensors").write_text("not a model")
     result = CliRunner().invoke(app, [*argv, "--model", "notes.safetensors"])
     assert result.exit_code == 2, result.output
     assert "notes.safetensors: not a readable safetensors model file" in result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.safetensors"]
+
+
+def test_export_cdb_names_what_is_wrong_with_its_mesh(tmp_path):
+    # a folder or a fifo given as --mesh was 'mesh file not found', naming no option
+    from apdl_like.cli import app as apdl_app
+
+    (tmp_path / "meshes").mkdir()
+    os.mkfifo(tmp_path / "pipe.msh")
+    for name, words in (("meshes", "is a folder, not a file"),
+                        ("pipe.msh", "is not a regular file"),
+                        ("none.msh", "cannot read mesh: No such file or directory")):
+        result = CliRunner().invoke(apdl_app, ["export-cdb", "--mesh", str(tmp_path / name),
+                                               "--out", str(tmp_path / "x.cdb")])
+        assert result.exit_code == 2, result.output
+        assert result.output.startswith(f"error: {tmp_path / name}, option '--mesh': {words}")
+    assert not (tmp_path / "x.cdb").exists()

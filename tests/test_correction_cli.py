@@ -216,3 +216,26 @@ def test_a_copy_of_a_run_is_refused(runs, tmp_path, monkeypatch, as_gate):
     assert result.exit_code == 2, result.output
     assert f"{copy}: holds the same data as {runs[1]}" in " ".join(result.output.split())
     assert len(result.output.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_a_stop_while_the_report_is_drawn_leaves_no_earlier_report_beside_the_model(
+        runs, tmp_path, monkeypatch):
+    # the model was replaced, then Ctrl-C while the report was drawn (about 1 s) left the
+    # earlier model's report beside the new model, as its report
+    import twin.correction.report
+
+    out = tmp_path / "m.safetensors"
+    args = ["train", *map(str, runs), "--out", str(out), "--epochs", "5", "--quiet",
+            "--paper-config", "--targets", "ratio"]
+    assert _invoke(args).exit_code == 0
+    assert (tmp_path / "m.safetensors.report.json").exists()
+
+    def interrupted(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(twin.correction.report, "write_report", interrupted)
+    result = _invoke([*args, "--seed", "1"])
+    assert result.exit_code == 130, result.output
+    assert load_model(out).metadata["seed"] == 1
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("m.")) == [
+        "m.safetensors"]

@@ -212,3 +212,26 @@ def test_a_probe_that_never_moves_is_bad_input_and_reports_still_work(machine, t
     result = run("report", str(model), str(dead), "--out", str(tmp_path / "report"))
     assert result.exit_code == 0, result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dead.csv", "report"]
+
+
+def test_a_stop_while_the_report_is_drawn_leaves_the_earlier_pair(machine, tmp_path,
+                                                                  monkeypatch):
+    # metrics.json was written before the figures were drawn: Ctrl-C while drawing left
+    # the new metrics beside the earlier report.html
+    import twin.drift.report
+
+    folder, data, model = machine
+    out = tmp_path / "report"
+    assert run("report", str(model), str(data), "--out", str(out)).exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    (out / "metrics.json").write_text("{}")  # the earlier pair, told apart from the new
+    (out / "report.html").write_text("<p>earlier</p>")
+
+    def interrupted(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(twin.drift.report, "_figures", interrupted)
+    assert run("report", str(model), str(data), "--out", str(out)).exit_code == 130
+    assert (out / "metrics.json").read_text() == "{}"
+    assert (out / "report.html").read_text() == "<p>earlier</p>"
+    assert sorted(before) == sorted(p.name for p in out.iterdir())

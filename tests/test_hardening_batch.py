@@ -256,3 +256,49 @@ def test_summary_keeps_earlier_failures_until_the_run_is_retried(replayed, tmp_p
     (out / "summary.json").write_text(json.dumps({"runs": [], "failed": failed}))
     assert collect_summary(out)["failed"] == failed
     assert collect_summary(out, attempted=["c"])["failed"] == []  # DESIGN: always listed
+
+
+def test_ctrl_c_leaves_no_summary_or_report_listing_the_run_it_removed(replayed, runs,
+                                                                        tmp_path, monkeypatch):
+    # Ctrl-C in a rerun removes that run's folder (a failed rerun leaves no earlier result
+    # standing), yet summary.json and report.html went on showing the earlier result
+    from typer.testing import CliRunner
+
+    import twin.loop.batch
+    from twin.cli import app
+
+    out = copy_of(replayed, tmp_path)
+    real = twin.loop.batch.replay_run_to_dir
+
+    def interrupted_in_b(run_path, out_root, *args, **kwargs):  # noqa: ANN001, ANN202
+        if Path(run_path).stem == "b":
+            with replaced_folder(Path(out_root) / "b"):
+                raise KeyboardInterrupt
+        return real(run_path, out_root, *args, **kwargs)
+
+    monkeypatch.setattr(twin.loop.batch, "replay_run_to_dir", interrupted_in_b)
+    result = CliRunner().invoke(app, ["replay", str(runs / "a.csv"), str(runs / "b.csv"),
+                                      "--methods", "open_loop", "--snapshots", "none",
+                                      "--quiet", "--out", str(out)])
+    assert result.exit_code == 130, result.output
+    assert not (out / "b").exists()
+    assert [r["run"] for r in summary_of(out)["runs"]] == ["a"]
+    assert "<td>b</td>" not in (out / "report.html").read_text()
+    assert "<td>a</td>" in (out / "report.html").read_text()
+
+
+@pytest.mark.timeout(120)
+def test_a_run_file_name_that_is_not_utf8_is_bad_input(runs, tmp_path):
+    # a name of bytes that are not UTF-8 ended the replay in an internal error (the report
+    # could not hold it), or hung it: the forked plotter waited for a start never sent
+    name = os.fsdecode(b"run\xff.csv")
+    path = tmp_path / name
+    path.write_bytes((runs / "a.csv").read_bytes())
+    out = tmp_path / "out"
+    result = replay([path, runs / "b.csv"], out)
+    assert result.exit_code == 2
+    assert [f["run"] for f in result.failed] == ["run\udcff"]
+    assert "not UTF-8 text" in result.failed[0]["error"]
+    assert [r["run"] for r in summary_of(out)["runs"]] == ["b"]
+    build_report(out)  # the failure names the file: the page holds it as the terminal shows it
+    assert "run\\udcff.csv" in (out / "report.html").read_text()

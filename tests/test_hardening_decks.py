@@ -86,3 +86,20 @@ def test_a_quad_bent_by_a_moved_node_is_refused_at_solve(tmp_path, moved):
     with pytest.raises(ApdlError, match="not convex") as info:
         Session(base_dir=tmp_path).run_text(deck, "deck.inp")
     assert info.value.line == 10
+
+
+def test_quiet_keeps_the_unknown_command_warnings(tmp_path):
+    # --quiet silenced the warnings too: a deck whose command was skipped ran in CI as if
+    # it had run in full
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app
+
+    deck = tmp_path / "deck.inp"
+    deck.write_text("A = 1\nFROBNICATE,1\n")
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"),
+                                      "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout == ""
+    assert result.stderr == (f"warning: {deck}:2: FROBNICATE: unknown or unsupported command "
+                             "FROBNICATE; ignored\n")

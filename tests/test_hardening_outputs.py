@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import stat
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -194,3 +195,121 @@ def test_apdl_run_leaves_no_result_of_an_earlier_run_beyond_its_own_steps(tmp_pa
     assert run_cli(apdl_app, ["run", one, "--out", out, "--quiet"]).exit_code == 0
     assert sorted(p.name for p in out.iterdir()) == [
         "log.txt", "notes", "params.json", "result_001.vtu", "result_notes.txt"]
+
+
+@pytest.mark.parametrize(("command", "suffixes"), [
+    (["twin", "synth", "--speed", 9000, "--minutes", 3, "--ambient", 25, "--seed", 1],
+     ".csv or .parquet"),
+    (["twin", "mesh"], ".msh"),
+    (["twin", "train", "RUN", "--epochs", 1], ".safetensors"),
+    (["twin", "snapshot", "RUN", "--time", 100, "--method", "open_loop"], ".png"),
+    (["twin", "drift", "fit", "RUN", "--target", "disp_z_um"], ".safetensors"),
+    (["twin", "drift", "predict", "RUN", "RUN"], ".csv"),
+    (["twin", "drift", "select", "RUN", "--target", "disp_z_um"], ".json"),
+    (["apdl-like", "export-cdb"], ".cdb"),
+])
+@pytest.mark.parametrize("name", ["out.txt", "out", "out.msh.bak"])
+def test_an_output_file_of_another_suffix_is_refused_before_any_work(tmp_path, run_file,
+                                                                    command, suffixes, name):
+    # each command checked the suffix in its own words, after other work (train, snapshot),
+    # without naming the option (mesh), not at all (export-cdb wrote any name as CDB) or
+    # case-sensitively (mesh refused OUT.MSH, which the others take)
+    before = run_file.read_bytes()
+    out = tmp_path / name
+    cli = {"twin": app, "apdl-like": apdl_app}[command[0]]
+    args = [run_file if a == "RUN" else a for a in command[1:]]
+    result = run_cli(cli, [*args, "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output == f"error: {out}, option '--out': must end in {suffixes}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+    assert run_file.read_bytes() == before
+
+
+def test_an_output_suffix_is_checked_in_any_case(tmp_path):
+    out = tmp_path / "MESH.MSH"
+    with pytest.raises(InputError, match="must end in .png"):
+        check_out_file(out, suffixes=(".png",))
+    assert check_out_file(out, suffixes=(".msh",)) == out
+
+
+def _unwritable_folders(tmp_path):
+    """Folders the test's user may not write in: a read-only folder (root writes there
+    anyway) and /proc, which refuses root too."""
+    folders = []
+    if os.geteuid() != 0:
+        locked = tmp_path / "locked"
+        locked.mkdir()
+        locked.chmod(0o555)
+        folders.append(locked)
+    if os.path.isdir("/proc/self"):
+        folders.append(Path("/proc"))
+    if not folders:
+        pytest.skip("no folder here that the test's user may not write in")
+    return folders
+
+
+@pytest.mark.parametrize(("command", "name"), [
+    (["twin", "synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
+      "--quiet"], "new/run.csv"),
+    (["twin", "mesh", "--quiet"], "m.msh"),
+    (["twin", "replay", "RUN", "--methods", "open_loop", "--quiet"], "new"),
+    (["twin", "simulate", "--speed", 9000, "--minutes", 0.2, "--ambient", 25, "--quiet"], ""),
+    (["twin", "drift", "select", "RUN", "--target", "disp_z_um"], "ranking.json"),
+    (["apdl-like", "run", "DECK", "--quiet"], "out"),
+])
+def test_an_unwritable_out_is_refused_before_any_work(tmp_path, run_file, command, name):
+    # the write failed after all the work: 'internal error: PermissionError', exit 1
+    deck = tmp_path / "d.inp"
+    deck.write_text("A = 1\n")
+    cli = {"twin": app, "apdl-like": apdl_app}[command[0]]
+    args = [{"RUN": run_file, "DECK": deck}.get(a, a) for a in command[1:]]
+    for folder in _unwritable_folders(tmp_path):
+        out = folder / name if name else folder
+        result = run_cli(cli, [*args, "--out", out])
+        assert result.exit_code == 2, result.output
+        assert result.output.startswith(f"error: {out}, option '--out': cannot write in "
+                                        f"{folder}: "), result.output
+        assert "\n" not in result.output.rstrip("\n")
+        if name:
+            assert not (folder / name.split("/")[0]).exists()
+
+
+@pytest.mark.parametrize("command", [
+    ["synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1],
+    ["train", "RUN", "--epochs", 1],
+])
+@pytest.mark.parametrize("out", ["", "/"])
+def test_an_out_without_a_file_name_is_bad_input(tmp_path, run_file, monkeypatch, command,
+                                                 out):
+    # '--out ""' (an unset shell variable) is the folder '.': the name of the file written
+    # beside it (RUN.truth.csv, MODEL.report.json) was an internal error
+    monkeypatch.chdir(tmp_path)
+    args = [run_file if a == "RUN" else a for a in command]
+    result = run_cli(app, [*args, "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"error: {out or '.'}, option '--out': ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
+
+
+def test_a_symlink_loop_given_as_a_run_is_bad_input(tmp_path, run_file):
+    # pathlib's resolve() raised RuntimeError on the loop in the --out check: exit 1
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    out = tmp_path / "out"
+    result = run_cli(app, ["replay", tmp_path / "a.csv", run_file, "--methods", "open_loop",
+                           "--snapshots", "none", "--quiet", "--out", out])
+    assert result.exit_code == 2, result.output
+    assert result.output == (f"error: {tmp_path / 'a.csv'}: cannot read file: Too many "
+                             "levels of symbolic links\n")
+    assert sorted(p.name for p in out.iterdir()) == ["report.html", "run", "summary.json"]
+
+
+def test_a_symlink_loop_given_to_train_is_bad_input(tmp_path, run_file):
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    result = run_cli(app, ["train", tmp_path / "a.csv", run_file, "--epochs", 1, "--quiet",
+                           "--out", tmp_path / "m.safetensors"])
+    assert result.exit_code == 2, result.output
+    assert result.output == (f"error: {tmp_path / 'a.csv'}: cannot read file: Too many "
+                             "levels of symbolic links\n")
+    assert not (tmp_path / "m.safetensors").exists()

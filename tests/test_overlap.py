@@ -88,6 +88,18 @@ def test_a_task_never_started_never_runs_and_the_parents_error_passes(tmp_path):
         os.waitpid(pid, os.WNOHANG)
 
 
+@pytest.mark.timeout(60)
+@pytest.mark.usefixtures("needs_fork")
+def test_a_start_that_fails_leaves_no_child_waiting(tmp_path):
+    # start("bad\udcffname") failed encoding the name after the task counted as started:
+    # the parent's join then waited for a reply from a child waiting for its start
+    done = tmp_path / "done"
+    with pytest.raises(UnicodeEncodeError):
+        with ForkedTask(lambda _: done.write_text("x")) as side:
+            side.start("bad\udcffname")
+    assert side.join() is None and not done.exists()
+
+
 def test_without_fork_start_runs_prepare_and_task_here_in_order(tmp_path):
     calls = []
     side = ForkedTask(lambda arg: calls.append(("task", arg, os.getpid())) or "done",

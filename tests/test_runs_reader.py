@@ -205,6 +205,9 @@ def test_missing_time(tmp_path):
 def test_unknown_suffix_and_bad_parquet(tmp_path):
     with pytest.raises(InputError, match="unknown run format"):
         read_run(write(tmp_path, "x", "run.txt"))
+    # a mistyped folder name was "unknown run format ''", as if the file were there
+    with pytest.raises(InputError, match="cannot read file: No such file or directory"):
+        read_run(tmp_path / "my_runs")
     with pytest.raises(InputError, match="Parquet"):
         read_run(write(tmp_path, "not parquet", "run.parquet"))
 
@@ -231,3 +234,46 @@ def test_a_folder_given_as_a_run_is_named_a_folder(tmp_path):
     with pytest.raises(InputError, match="is a folder, not a run file") as info:
         read_run(tmp_path)
     assert info.value.file == str(tmp_path)
+
+
+def test_files_with_bare_cr_line_ends_read_as_with_lf(tmp_path):
+    # Excel's "CSV (Macintosh)" ends lines in a bare CR: the whole file was one line, so a
+    # run was "an empty file", a speed profile "not a readable CSV line" and a scenario
+    # not TOML
+    from twin.drift.data import read_drift_table
+    from twin.plant.profile import read_speed_profile
+    from twin.plant.scenario import load_scenario
+
+    text = csv_text(warmup(), "# name: demo\n")
+    lf, cr = write(tmp_path, text), write(tmp_path, text.replace("\n", "\r"), "mac.csv")
+    before = cr.read_bytes()
+    a, b = read_run(lf), read_run(cr)
+    np.testing.assert_array_equal(a.T_C, b.T_C)
+    assert (a.name, a.metadata) == (b.name, b.metadata)
+    assert read_drift_table(cr).columns.keys() == read_drift_table(lf).columns.keys()
+    profile = write(tmp_path, "time_s,speed_rpm\r0,6000\r60,9000\r", "p.csv")
+    assert read_speed_profile(profile).speed_rpm(np.array([30.0, 90.0])).tolist() == [
+        6000.0, 9000.0]
+    scenario = write(tmp_path, "[motor_heat]\rtime_s = [0]\rfactor = [1.2]\r", "s.toml")
+    assert load_scenario(scenario).motor_heat.factor == [1.2]
+    assert cr.read_bytes() == before
+    # an error names the line an editor shows
+    bad = write(tmp_path, text.replace("\n", "\r").replace("\r5.0000,", "\rx,", 1), "bad.csv")
+    with pytest.raises(InputError) as info:
+        read_run(bad)
+    assert info.value.row == 8 and info.value.column == "time_s"
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
+    # Excel's "Unicode text" is UTF-16: "row 1: not UTF-8 text" left the user guessing
+    path = tmp_path / "run.csv"
+    text = csv_text(warmup(), "# name: Prüfstand\n")
+    path.write_bytes(("\ufeff" if encoding.endswith("be") else "").encode(encoding)
+                     + text.encode(encoding))
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    assert str(info.value) == f"{path}: UTF-16 text; save it as UTF-8"
+    path.write_bytes(text.encode("latin-1"))  # not UTF-8, but no UTF-16 either
+    with pytest.raises(InputError, match="row 1: not UTF-8 text"):
+        read_run(path)

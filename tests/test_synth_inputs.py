@@ -131,6 +131,49 @@ def test_a_list_items_error_names_the_items_line(text, row, column):
     assert (info.value.row, info.value.column) == (row, column), str(info.value)
 
 
+def test_toml_errors_name_the_line_and_key_not_a_row_and_column(tmp_path):
+    # the scenario's errors were told in the CSV reader's words: "bad.toml, row 2, column
+    # 'material.conductivty'", and a user looked for a column in a TOML file
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+    from twin.spindle.spec import load_spec
+
+    with pytest.raises(InputError) as info:
+        parse_scenario("[material]\nconductivty = 0.9\n", "bad.toml")
+    assert str(info.value) == ("bad.toml, line 2, key 'material.conductivty': unknown key "
+                               "(check the spelling)")
+    with pytest.raises(InputError) as info:
+        parse_scenario("x = [\n", "bad.toml")
+    assert str(info.value).startswith("bad.toml, line 1: not valid TOML")
+    spec = tmp_path / "spec.toml"
+    spec.write_text("[spindle]\nname = 1\n")
+    with pytest.raises(InputError) as info:
+        load_spec(spec)
+    assert str(info.value).startswith(f"{spec}, line 2, key 'spindle.name': ")
+    from twin.spindle.spec import DEFAULT_SPEC_PATH
+
+    text = DEFAULT_SPEC_PATH.read_text()
+    line = text[:text.index("max_speed_rpm = ")].count("\n") + 1
+    spec.write_text(text.replace("max_speed_rpm = ", "max_sped = 1\nmax_speed_rpm = ", 1))
+    with pytest.raises(InputError, match=f"line {line}, key 'spindle.max_sped': unknown key"):
+        load_spec(spec)
+    # pydantic's words ("Field required", "unknown field") were left in the message
+    with pytest.raises(InputError) as info:
+        parse_scenario("[motor_heat]\nfactor = [1.2]\n", "bad.toml")
+    assert str(info.value) == "bad.toml, line 1, key 'motor_heat.time_s': missing required key"
+    # a table clashing with the profile's column
+    scenario, profile = tmp_path / "s.toml", tmp_path / "p.csv"
+    scenario.write_text("[ambient]\ntime_s = [0]\nambient_C = [20]\n")
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,20\n")
+    result = CliRunner().invoke(app, ["synth", "--profile", str(profile), "--minutes", "2",
+                                      "--ambient", "20", "--seed", "1", "--scenario",
+                                      str(scenario), "--out", str(tmp_path / "run.csv")])
+    assert result.exit_code == 2
+    assert result.output.startswith(f"error: {scenario}, key 'ambient': [ambient] and ")
+    assert "column 'ambient'" not in result.output and not (tmp_path / "run.csv").exists()
+
+
 def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     # a spike at 99999 s in a 5-min run landed on its last sample; a late dropout vanished
     from typer.testing import CliRunner

@@ -152,6 +152,26 @@ def test_whatever_synth_writes_replay_accepts(tmp_path_factory, suite_seed, inde
     assert all(np.isfinite(m["temperature_accuracy_pct"]) for m in accuracy.values())
 
 
+def test_a_case_stopped_while_emulated_leaves_its_earlier_files_as_they_were(tmp_path,
+                                                                           monkeypatch):
+    # the profile and scenario were written before the run was emulated: Ctrl-C there
+    # left them beside the run of an earlier suite of the same seed and another length
+    import twin.plant.suite
+    from twin.plant.suite import case_files, write_case
+
+    write_case(draw_case(6, 0, minutes=2.0), tmp_path)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert sorted(before) == sorted(case_files("suite6_001").values())
+
+    def interrupted(case, model=None):  # noqa: ANN001, ANN202
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(twin.plant.suite, "synthesize_case", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_case(draw_case(6, 0, minutes=3.0), tmp_path)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
 def test_a_suite_folder_replays_as_it_is(tmp_path):
     """`twin replay FOLDER` takes the runs in it and leaves out the truth and profile files
     synth writes beside them (each of those would otherwise fail as a run)."""

@@ -178,7 +178,7 @@ case("negative speed", R, "bad", outs=["out"], names="run.csv")(
     run_case(edit_cell(20, "speed_rpm", "-5")))
 case("Kelvin temperatures", R, "bad", outs=["out"], names="run.csv")(
     run_case(edit_column("T1_C", lambda i, v: f"{float(v) + 273.15:.3f}")))
-case("all T1 empty", R, "bad", outs=["out"], names="run.csv")(
+case("all T1 empty (a dead channel, excluded and reported)", R, "ok", outs=["out"])(
     run_case(edit_column("T1_C", lambda i, v: "")))
 def _shifted(delta: float) -> str:
     text = base_run()
@@ -430,7 +430,9 @@ for label, args, expect in [
     ("--coolant 150", ("--coolant", "150"), "bad"),
     ("--coolant 50", ("--coolant", "50"), "bad"),
     ("--seed=-1", ("--seed", "-1"), "bad"),
-    ("--seed 2**70 (numpy seeds are unbounded)", ("--seed", str(2**70)), "ok"),
+    ("--seed 2**32 - 1 (the largest: a suite's runs are seeded below 2**32)",
+     ("--seed", str(2**32 - 1)), "ok"),
+    ("--seed 2**32", ("--seed", str(2**32)), "bad"),
     ("--ambient 50", ("--ambient", "50"), "bad"),
     ("--ambient nan", ("--ambient", "nan"), "bad"),
     ("--ambient -25", ("--ambient", "-25"), "ok"),
@@ -479,8 +481,8 @@ for label, toml, expect in [
      "bad"),
     ("spike size 1e300", "[faults]\nspikes = [{sensor = \"T1\", time_s = 60, size = 1e300}]\n",
      "bad"),
-    ("dropout over the whole run (synth refuses: replay would)",
-     "[faults]\ndropouts = [{sensor = \"T4\", start_s = 0, end_s = 100000}]\n", "bad"),
+    ("dropout over the whole run (a dead channel, which replay excludes)",
+     "[faults]\ndropouts = [{sensor = \"T4\", start_s = 0, end_s = 100000}]\n", "ok"),
     ("ambient table 50 °C", "[ambient]\ntime_s = [0]\nambient_C = [50]\n", "bad"),
     ("stuck every sensor", "[faults]\nstuck = [\"T1\",\"T2\",\"T3\",\"T4\",\"T5\"]\n", "ok"),
     ("valid faults", "[faults]\nstuck = [\"T2\"]\n", "ok"),

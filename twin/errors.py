@@ -24,6 +24,10 @@ EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports `cmd | head`
 class InputError(ValueError):
     """Bad user input: a file, a row/line, a column/field and what is wrong with it."""
 
+    ROW = "row"
+    COLUMN = "column"
+    """How `where` calls the row and the column (a table's words; `TomlError` has its own)."""
+
     def __init__(
         self,
         message: str,
@@ -46,9 +50,9 @@ class InputError(ValueError):
         if self.file is not None:
             where.append(str(self.file))
         if self.row is not None:
-            where.append(f"row {self.row}")
+            where.append(f"{self.ROW} {self.row}")
         if self.column is not None:
-            kind = "option" if self.column.startswith("--") else "column"
+            kind = "option" if self.column.startswith("--") else self.COLUMN
             where.append(f"{kind} {self.column!r}")
         return ", ".join(where)
 
@@ -65,6 +69,19 @@ class InputError(ValueError):
     def __str__(self) -> str:
         where = self.where()
         return f"{where}: {self.reason}" if where else self.reason
+
+
+class TomlError(InputError):
+    """Bad TOML input (a scenario, a spindle spec): `file, line 3, key 'faults.stuck'`.
+    Its row is the line and its column the dotted key (of a value or a table): told as
+    the CSV reader's "row" and "column", a user looked for a column in a TOML file."""
+
+    ROW = "line"
+    COLUMN = "key"
+
+    def __init__(self, message: str, *, file: str | None = None, line: int | None = None,
+                 key: str | None = None) -> None:
+        super().__init__(message, file=file, row=line, column=key)
 
 
 def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:

@@ -26,11 +26,27 @@ def log_path() -> Path:
     return platformdirs.user_log_path("spindle-twin") / "twin.log"
 
 
+class _LogFile(logging.FileHandler):
+    """The log file, opened at the first record (most runs write none); a file that then
+    cannot be opened or written drops its records, as the module doc says: a log folder
+    that exists but may not be written in (a read-only home in CI) ended the command in
+    an internal error at its first warning."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            super().emit(record)
+        except OSError:
+            pass
+
+    def handleError(self, record: logging.LogRecord) -> None:  # noqa: N802 - logging's name
+        pass  # a failed write: dropped, not logging's "--- Logging error ---" on stderr
+
+
 def _handler() -> logging.Handler:
     try:
         path = log_path()
         path.parent.mkdir(parents=True, exist_ok=True)
-        handler: logging.Handler = logging.FileHandler(path, encoding="utf-8", delay=True)
+        handler: logging.Handler = _LogFile(path, encoding="utf-8", delay=True)
     except OSError:
         return logging.NullHandler()
     handler.setFormatter(logging.Formatter("%(asctime)s %(process)d %(name)s: %(message)s"))

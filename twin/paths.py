@@ -7,13 +7,14 @@ A fifo, a device or a folder given where a file is expected would block a reader
 
 from __future__ import annotations
 
+import codecs
 import os
 import re
 import stat
 import tomllib
 from pathlib import Path
 
-from twin.errors import InputError
+from twin.errors import InputError, TomlError
 
 MAX_INPUT_BYTES = 512 * 2**20
 """Largest input file read (512 MiB): a day of 10 Hz samples as CSV is under 100 MiB."""
@@ -66,11 +67,19 @@ def read_input_bytes(path: str | os.PathLike[str], *, column: str | None = None,
 
 def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
                     max_bytes: int = MAX_INPUT_BYTES) -> str:
-    """The UTF-8 text of a checked input file; a bad byte names its line."""
+    """The UTF-8 text of a checked input file; a bad byte names its line.  A file whose
+    lines all end in a bare CR (classic Mac OS, Excel's "CSV (Macintosh)") reads as if
+    they ended in LF, as editors show it: read as it was, it was one line, a comment, and
+    a run "an empty file", a profile "not a readable CSV line", a scenario not TOML."""
     data = read_input_bytes(path, column=column, max_bytes=max_bytes)
+    if b"\r" in data and b"\n" not in data:
+        data = data.replace(b"\r", b"\n")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
+        if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):  # Excel's "Unicode"
+            raise InputError("UTF-16 text; save it as UTF-8", file=str(path),
+                             column=column) from None
         line = data[: exc.start].count(b"\n") + 1
         raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
 
@@ -85,9 +94,9 @@ def parse_toml(text: str, file: str, column: str | None = None) -> dict:
         row = int(match.group(1)) if match else None
         if row is None and "end of document" in str(exc):
             row = text.rstrip("\n").count("\n") + 1
-        raise InputError(f"not valid TOML: {exc}", file=file, row=row, column=column) from None
+        raise TomlError(f"not valid TOML: {exc}", file=file, line=row, key=column) from None
     except RecursionError:
-        raise InputError("not valid TOML: nested too deeply", file=file, column=column) from None
+        raise TomlError("not valid TOML: nested too deeply", file=file, key=column) from None
 
 
 def toml_line_of(text: str, loc: tuple) -> int | None:

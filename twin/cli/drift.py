@@ -14,6 +14,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED
 from twin.errors import InputError, report_errors
+from twin.io.destinations import check_out_dir, check_out_file
 
 drift_app = typer.Typer(
     name="drift",
@@ -38,16 +39,6 @@ def _targets(text: str) -> list[str]:
             raise InputError(f"{name!r} is not a displacement column (a name ending in "
                              f"{DISPLACEMENT_SUFFIX})", column="--target")
     return names
-
-
-def _check_out_file(out: Path, inputs: Sequence[Path], suffixes: Sequence[str]) -> None:
-    """Refuse an --out that is a folder, a special file or one of the inputs (exit 2)."""
-    from twin.io.destinations import check_out_file
-
-    check_out_file(out, inputs=inputs)
-    if suffixes and out.suffix.lower() not in suffixes:
-        raise InputError(f"--out must end in {' or '.join(suffixes)}", file=str(out),
-                         column="--out")
 
 
 def _check_inputs(paths: Sequence[Path]) -> None:
@@ -100,7 +91,7 @@ def fit(
     from twin.drift.model import fit_drift_model
     from twin.drift.modelfile import save_drift_model
 
-    _check_out_file(out, data, (".safetensors",))
+    check_out_file(out, inputs=data, suffixes=(".safetensors",))
     _check_inputs(data)
     if method is not None:
         method_named(method)
@@ -141,7 +132,7 @@ def predict(
     from twin.drift.modelfile import load_drift_model
     from twin.drift.output import write_predictions
 
-    _check_out_file(out, [model_file, data], (".csv",))
+    check_out_file(out, inputs=[model_file, data], suffixes=(".csv",))
     _check_inputs([model_file, data])
     model = load_drift_model(model_file)
     drift_data = read_drift_data([data], sensors=model.spec.sensors, targets=model.targets,
@@ -165,7 +156,6 @@ def report(
     from twin.drift.data import read_drift_data
     from twin.drift.modelfile import load_drift_model
     from twin.drift.report import write_drift_report
-    from twin.io.destinations import check_out_dir
 
     check_out_dir(out, inputs=[model_file, *data], files=["metrics.json", "report.html"])
     _check_inputs([model_file, *data])
@@ -196,7 +186,7 @@ def select(
     from twin.io.atomic import write_json
 
     if out is not None:
-        _check_out_file(out, data, (".json",))
+        check_out_file(out, inputs=data, suffixes=(".json",))
     _check_inputs(data)
     drift_data = read_drift_data(data, targets=_targets(target))
     ranking = sensor_ranking(drift_data)

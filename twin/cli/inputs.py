@@ -53,15 +53,22 @@ MAX_SIZE_FACTOR = 100.0
 """Mesh element size multiplier: above this the spindle is no longer resolved at all."""
 
 MAX_SEED = 2**32 - 1
-"""Largest --seed of the commands that seed torch or scikit-learn (k-means takes seeds
-below 2**32, torch below 2**64): beyond it a run ended in an internal error after its
-work, where typer can refuse the option before any."""
+"""Largest --seed of every command.  k-means takes seeds below 2**32 and torch below
+2**64: beyond, `train` and `drift fit` ended in an internal error after their work, where
+typer can refuse the option before any.  numpy's generators behind `synth` take any seed
+≥ 0, but a suite's runs get seeds below 2**32 (`twin.plant.suite`, the seeds their
+scenarios reproduce them with), and a longer suite seed, in every file name, made names
+the file system refused once the suite was drawn."""
 
 
 def bundled_runs_dir() -> Path:
     """Where the example recorded runs shipped with the twin are (package data)."""
     return bundled_path("runs").resolve()
 
+
+RUN_SUFFIXES = (".csv", ".parquet", ".pq")
+"""What a recorded run's file ends in, in any case (the readers of `twin.runs.run`): a
+folder's RUN.CSV was passed over while the same file named alone was replayed."""
 
 COMPANION_SUFFIXES = (".truth.csv", ".profile.csv")
 """Files `twin synth` writes beside a run (its truth and speed profile): not runs."""
@@ -70,9 +77,11 @@ COMPANION_SUFFIXES = (".truth.csv", ".profile.csv")
 def runs_in(folder: Path) -> list[Path]:
     """The recorded runs in `folder` (CSV or Parquet, sorted by name), leaving out the
     truth and profile files `twin synth` writes beside each run, so a synth suite's
-    folder replays as it is."""
-    runs = sorted(p for p in folder.iterdir()
-                  if p.suffix in (".csv", ".parquet") and p.is_file())
+    folder replays as it is, and hidden files: a Mac's `._RUN.csv` beside each run
+    copied to a stick, a killed writer's temporary file (each failed the batch as a run
+    that a leading dot cannot name)."""
+    runs = sorted(p for p in folder.iterdir() if p.suffix.lower() in RUN_SUFFIXES
+                  and not p.name.startswith(".") and p.is_file())
     return [r for r in runs if not r.name.endswith(COMPANION_SUFFIXES)]
 
 
@@ -96,8 +105,8 @@ def check_operating_options(spec: SpindleSpec, speed: float, ambient: float,
 def run_files_in(folder: Path) -> list[Path]:
     """Every file of recorded runs in `folder`, sorted by name: the runs `runs_in` finds
     and the truth, profile and scenario files `twin synth` writes beside them."""
-    return sorted(p for p in folder.iterdir() if p.is_file() and (
-        p.suffix in (".csv", ".parquet") or p.name.endswith(".scenario.toml")))
+    return sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith(".")
+                  and (p.suffix.lower() in RUN_SUFFIXES or p.name.endswith(".scenario.toml")))
 
 
 def expand_run_folders(paths: list[Path]) -> list[Path]:
@@ -178,9 +187,10 @@ def checked_model(methods: list[str], model: Path | None) -> str | None:
         raise InputError(
             "the bpnn method needs a correction model: pass --model FILE", column="--model"
         )
-    if not Path(model).is_file():
-        raise InputError("model file not found", file=str(model), column="--model")
     from twin.correction.modelfile import load_model
+    from twin.paths import check_input_file
+
+    check_input_file(model, column="--model")  # nothing there, a folder, a fifo: say which
 
     load_model(model)
     return str(model)

@@ -21,14 +21,11 @@ def mesh(
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),
 ) -> None:
     """Mesh the axisymmetric spindle (regions, boundaries, contact interfaces)."""
-    from twin.errors import InputError
     from twin.io.destinations import check_out_file
     from twin.spindle.mesher import build_mesh, mesh_quality, write_msh
     from twin.spindle.spec import load_spec
 
-    if out.suffix != ".msh":
-        raise InputError("the mesh file must end in .msh", file=str(out))
-    check_out_file(out, inputs=[spec])
+    check_out_file(out, inputs=[spec], suffixes=(".msh",))
     the_spec = load_spec(spec)
     result = build_mesh(the_spec, size_factor)
     write_msh(result, out)

@@ -90,19 +90,25 @@ def replay(
         def tell(name: str, status: str) -> None:
             progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
 
-        result = replay_batch(
-            paths,
-            out,
-            chosen,
-            model_path,
-            jobs=jobs,
-            dask_address=dask,
-            snapshots=snapshots.value,
-            resume=resume,
-            progress=tell,
-            assimilate_drift=drift_assimilation,
-            plotter=plotter if in_this_process else None,
-        )
+        try:
+            result = replay_batch(
+                paths,
+                out,
+                chosen,
+                model_path,
+                jobs=jobs,
+                dask_address=dask,
+                snapshots=snapshots.value,
+                resume=resume,
+                progress=tell,
+                assimilate_drift=drift_assimilation,
+                plotter=plotter if in_this_process else None,
+            )
+        except KeyboardInterrupt:
+            # the run under way went with its folder (a failed rerun leaves no earlier
+            # result standing): summary.json and report.html must not list that result
+            build_report(out)
+            raise
     build_report(out, rebuild_summary=False)
     for failure in result.failed:
         typer.echo(f"error: {failure['error']}", err=True)

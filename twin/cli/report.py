@@ -12,6 +12,7 @@ from twin.errors import EXIT_INPUT_ERROR, InputError
 
 def report(out: Path = typer.Argument(..., help="a replay output folder")) -> None:
     """Rebuild DIR/report.html and DIR/summary.json from a replay folder."""
+    from twin.io.destinations import check_out_dir
     from twin.loop.report import build_report
 
     if not out.exists():
@@ -21,6 +22,8 @@ def report(out: Path = typer.Argument(..., help="a replay output folder")) -> No
                          file=str(out))
     if not any(out.glob("*/accuracy.json")):
         raise InputError("not a replay folder (no <run>/accuracy.json inside)", file=str(out))
+    # the folder is the command's argument, no option: the writer's checks named '--out'
+    check_out_dir(out, option=None, files=["summary.json", "report.html"])
     path = build_report(out)
     typer.echo(f"wrote {path}")
     # runs the report leaves out (an unreadable accuracy.json, a run that failed in the

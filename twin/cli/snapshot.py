@@ -28,10 +28,8 @@ def snapshot(
     from twin.spindle.model import SpindleModel
 
     method_name = method.value
+    check_out_file(out, inputs=[run, model], suffixes=(".png",))
     model_path = checked_model([method_name], model)
-    if out.suffix.lower() != ".png":
-        raise InputError("the picture must be a .png file", file=str(out), column="--out")
-    check_out_file(out, inputs=[run, model])
     spindle = SpindleModel.load()
     recorded = read_run(run, max_speed_rpm=spindle.spec.spindle.max_speed_rpm)
     try:

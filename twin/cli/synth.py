@@ -6,8 +6,8 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import RANGE_C
-from twin.errors import InputError
+from twin.cli.inputs import MAX_SEED, RANGE_C
+from twin.errors import InputError, TomlError
 
 SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
 
@@ -39,7 +39,7 @@ def synth(
     out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
                              "RUN.parquet; the truth goes to RUN.truth.csv beside it), or "
                              "with --suite the folder of the suite's files."),
-    seed: int = typer.Option(..., "--seed", min=0,
+    seed: int = typer.Option(..., "--seed", min=0, max=MAX_SEED,
                              help="Seed of every random choice (deterministic)."),
     minutes: float | None = typer.Option(None, "--minutes", min=2.0, max=24 * 60.0,
                                          help="Run length, minutes (two 60 s windows at "
@@ -88,14 +88,12 @@ def synth(
     # the range replay reads (twin.contract.OPERATING_TEMPERATURE_C; NaN too): synth must
     # not write what replay refuses
     check_operating_options(load_spec(None), speed or 0.0, ambient, coolant)
-    if out.suffix.lower() not in (".csv", ".parquet"):
-        raise InputError("the run must be written as .csv or .parquet", file=str(out),
-                         column="--out")
     if out.name.endswith(COMPANION_SUFFIXES):
         raise InputError(f"a run may not be named *{'/*'.join(COMPANION_SUFFIXES)}: those are "
                          "the files synth writes beside a run, which 'twin replay FOLDER' "
                          "leaves out", file=str(out), column="--out")
-    check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)])
+    check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)],
+                   suffixes=(".csv", ".parquet"))
     speed_profile = None if profile is None else read_speed_profile(profile)
     if speed_profile is not None and speed_profile.ignored and not quiet:
         typer.echo(f"note: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
@@ -105,8 +103,8 @@ def synth(
     profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
     if profile_ambient and truth.ambient is not None:
         # the scenario's table won and the profile's column was read for nothing
-        raise InputError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
-                         "the ambient: keep one of them", file=str(scenario), column="ambient")
+        raise TomlError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
+                        "the ambient: keep one of them", file=str(scenario), key="ambient")
     run = synthesize(
         speed_rpm=speed, profile=speed_profile,
         minutes=minutes, ambient_C=ambient, seed=seed, scenario=truth, rate_hz=rate,

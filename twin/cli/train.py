@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 
 import typer
@@ -60,16 +61,15 @@ def train(
     from twin.spindle.model import SpindleModel
 
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
-    check_out_file(out, inputs=runs + gate_runs, also=report_paths(out))
-    trained = {path.resolve() for path in runs}
+    check_out_file(out, inputs=runs + gate_runs, also=report_paths(out),
+                   suffixes=(".safetensors",))  # what replay --model and model-info read
+    # realpath: resolve() raised RuntimeError on a symlink loop, an internal error
+    trained = {os.path.realpath(path) for path in runs}
     for path in gate_runs:  # the gate measures the networks on runs they never saw
-        if path.resolve() in trained:
+        if os.path.realpath(path) in trained:
             raise InputError("is also a training run; the gate replays runs never trained "
                              "on: leave it out of the RUN list or of --gate-runs",
                              file=str(path), column="--gate-runs")
-    if out.suffix.lower() != ".safetensors":  # what replay --model and model-info read
-        raise InputError("the model file must end in .safetensors", file=str(out),
-                         column="--out")
     named = [(str(path), run_name(path)) for path in runs]
     check_distinct_names(named)
     tables = [read_table(path) for path in [*runs, *gate_runs]]
@@ -118,6 +118,10 @@ def train(
         if not quiet:
             typer.echo(f"networks kept: {', '.join(gate['kept']) or 'none (the anchor)'}",
                        err=True)
+    for stale in report_paths(out):
+        # they describe the model replaced now: a stop while the new ones are drawn (a
+        # second or so) left them beside it, as its report
+        stale.unlink(missing_ok=True)
     save_model(model, out)
     results[chosen.name] = dataclasses.replace(results[chosen.name], model=model)
     json_path, html_path = write_report(out, results, chosen.name)

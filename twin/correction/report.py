@@ -17,8 +17,8 @@ from twin.io.html_pages import png_data_uri, render_page
 
 def report_paths(model_path: str | Path) -> tuple[Path, Path]:
     """(JSON, HTML) report paths beside the model: MODEL.report.json, MODEL.report.html."""
-    p = Path(model_path)
-    return p.with_name(p.name + ".report.json"), p.with_name(p.name + ".report.html")
+    p = Path(model_path)  # `parent /`: with_name refused '.' (--out '') with a ValueError
+    return p.parent / (p.name + ".report.json"), p.parent / (p.name + ".report.html")
 
 
 def _figure_png(fig: Any) -> bytes:

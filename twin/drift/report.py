@@ -106,7 +106,6 @@ def write_drift_report(out_dir: str | os.PathLike[str], model: DriftModel, data:
     mean, lo, hi = model.predict(data)
     metrics = drift_metrics(model, data, mean, lo, hi)
     out = Path(out_dir)
-    metrics_path = write_metrics(out / "metrics.json", metrics)
     validation = model.metadata.get("validation", {}).get("methods", {})
     html = render_page(
         "drift_report.html.j2", model_name=model_name, metrics=metrics,
@@ -115,5 +114,8 @@ def write_drift_report(out_dir: str | os.PathLike[str], model: DriftModel, data:
         chosen=model.metadata.get("validation", {}).get("chosen", model.method),
         ranking=model.metadata.get("ranking", {}).get("sensors", []),
         images=_figures(model, data, mean, lo, hi))
+    # both written once the page is drawn (the slow part): a stop while drawing left the
+    # new metrics.json beside the earlier report.html
+    metrics_path = write_metrics(out / "metrics.json", metrics)
     html_path = write_text(out / "report.html", html)
     return metrics, metrics_path, html_path

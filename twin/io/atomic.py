@@ -93,8 +93,10 @@ def write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> Path:
-    """Write `text` (UTF-8) to `path` atomically."""
-    return write_bytes(path, text.encode("utf-8"))
+    """Write `text` (UTF-8) to `path` atomically.  A file name's bytes that are not UTF-8
+    (Python's surrogate escapes, in an error naming the file) are written as the terminal
+    shows them (`bad\\udcffname.csv`): the report of a batch holding such a file failed."""
+    return write_bytes(path, text.encode("utf-8", errors="backslashreplace"))
 
 
 def _json_default(value: object) -> object:

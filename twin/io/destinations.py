@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import os
 import stat
-from collections.abc import Iterable
+import tempfile
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from twin.errors import InputError
@@ -30,38 +31,59 @@ def _same(a: Path, b: Path) -> bool:
     try:
         return os.path.samefile(a, b)
     except OSError:
-        return a.resolve() == b.resolve()
+        try:
+            return a.resolve() == b.resolve()
+        except RuntimeError:  # a symlink loop names no file, so not this one (pathlib's
+            return False      # RuntimeError was an internal error before the input check)
 
 
 def _inside(path: Path, folder: Path) -> bool:
     try:
         path.resolve().relative_to(folder.resolve())
-    except ValueError:
+    except (ValueError, RuntimeError):  # RuntimeError: a symlink loop, inside nothing
         return False
     return True
 
 
-def _check_ancestors(target: Path, option: str) -> None:
-    """The nearest existing ancestor of `target` must be a folder (mkdir would fail)."""
+def _check_ancestors(target: Path, option: str | None) -> None:
+    """The nearest existing ancestor of `target` must be a folder (mkdir would fail) the
+    command may write in."""
     for parent in target.absolute().parents:
         if parent.exists():
             if not parent.is_dir():
                 raise InputError(f"{parent} is not a folder", file=str(target), column=option)
+            _check_writable(parent, target, option)
             return
 
 
-def refuse_special(target: Path, option: str = "--out") -> None:
+def _check_writable(folder: Path, target: Path, option: str | None) -> None:
+    """InputError unless a file can be made in `folder`.  Tried, with an unnamed temporary
+    file where the system has them (nothing to see or leave behind): `os.access` says yes
+    to root on a mount that refuses it (/sys), and the write failed after all the work as
+    an internal error."""
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise InputError(f"cannot write in {folder}: {exc.strerror or exc}",
+                         file=str(target), column=option) from None
+
+
+def refuse_special(target: Path, option: str | None = "--out") -> None:
     """InputError if `target` exists (through any symlink) and is not a regular file."""
     # nothing there (or a dangling symlink, which the rename replaces) is fine
     regular_file_info(target, use="use as output", column=option, missing_ok=True)
 
 
 def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                   option: str = "--out", also: Iterable[StrPath] = ()) -> Path:
+                   option: str | None = "--out", also: Iterable[StrPath] = (),
+                   suffixes: Sequence[str] = ()) -> Path:
     """`out` as a Path if a command may write the file there (see the module doc).
 
     `inputs` are the files the command reads; `also` are further files it writes beside
-    `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.
+    `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.  `suffixes`, if
+    given, are the ones `out` may end in, in any case (`S.PNG` too): another name was
+    written in a format it does not name, or refused by the writer after the work.
     """
     target = Path(out)
     _check_ancestors(target, option)
@@ -72,11 +94,14 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
             if _same(written, source):
                 raise InputError(f"is also an input of this command ({source}); refusing to "
                                  "overwrite it", file=str(written), column=option)
+    if suffixes and target.suffix.lower() not in suffixes:
+        raise InputError(f"must end in {' or '.join(suffixes)}", file=str(target),
+                         column=option)
     return target
 
 
 def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
-                  option: str = "--out", owned: Iterable[str] = (),
+                  option: str | None = "--out", owned: Iterable[str] = (),
                   files: Iterable[str] = ()) -> Path:
     """`out` as a Path if a command may write its output folder there.
 
@@ -86,10 +111,11 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
     fifo) there is refused now, not once the work is done.
     """
     target = Path(out)
-    _check_ancestors(target, option)
     files = list(files)
     owned = [*owned, *files]
-    if target.exists() or target.is_symlink():
+    if not (target.exists() or target.is_symlink()):
+        _check_ancestors(target, option)
+    else:
         try:
             info = target.stat()
         except OSError as exc:
@@ -99,6 +125,7 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
             kind = "a file" if stat.S_ISREG(info.st_mode) else "not a folder"
             raise InputError(f"is {kind}; a folder is expected", file=str(target),
                              column=option)
+        _check_writable(target, target, option)  # not its parent: the files go inside
         for name in files:
             refuse_special(target / name, option)
     for source in (Path(p) for p in inputs if p is not None):

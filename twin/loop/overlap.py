@@ -99,13 +99,17 @@ class ForkedTask:
         child)."""
         if not self.fresh:
             raise RuntimeError("the task was started or ended already")
+        # encoded before the task counts as started: an argument that cannot be sent (a
+        # file name of bytes that are not UTF-8) left the parent's join waiting for the
+        # child's reply and the child for its start, for ever
+        message = _GO + argument.encode()
         self._started = True
         if self._pid is None:
             if self._prepare is not None:
                 self._prepare()
             self._value = _checked(self._task(argument))
             return
-        _write_all(self._go, _GO + argument.encode())
+        _write_all(self._go, message)
         os.close(self._go)
         self._go = -1
 

@@ -62,6 +62,11 @@ def run_name(path: str | Path) -> str:
     if not name or name.startswith(".") or name != Path(name).name:
         raise InputError(f"{name!r} cannot name a run folder (a leading dot or a path)",
                          file=str(path))
+    try:
+        name.encode()
+    except UnicodeEncodeError:  # bytes that are not UTF-8: no report could hold the name
+        raise InputError("the file name is not UTF-8 text, and it names the run's folder "
+                         "and reports: rename the file", file=str(path)) from None
     return name
 
 

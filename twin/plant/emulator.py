@@ -320,7 +320,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
 
 def truth_path_for(run_path: Path) -> Path:
     """RUN.csv → RUN.truth.csv (also for .parquet runs: the truth is always CSV)."""
-    return run_path.with_name(run_path.stem + ".truth.csv")
+    # `parent /`: with_name refused '.' (--out '') with a ValueError, not bad input
+    return run_path.parent / (run_path.stem + ".truth.csv")
 
 
 def write_synth(run: SynthRun, out: Path) -> tuple[Path, Path]:

@@ -58,7 +58,7 @@ from pydantic import (
 )
 
 from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
-from twin.errors import InputError
+from twin.errors import TomlError
 from twin.paths import parse_toml, read_input_text, toml_line_of
 from twin.plant.timetable import TimeTable
 
@@ -240,8 +240,10 @@ def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
         message = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             message = "unknown key (check the spelling)"
-        raise InputError(message, file=file, row=toml_line_of(text, loc),
-                         column=".".join(str(k) for k in loc) or None) from None
+        elif err["type"] == "missing":  # pydantic's "Field required"
+            message = "missing required key"
+        raise TomlError(message, file=file, line=toml_line_of(text, loc),
+                        key=".".join(str(k) for k in loc) or None) from None
 
 
 def dump_scenario(scenario: Scenario, header: str = "") -> str:
@@ -271,12 +273,12 @@ def load_scenario(path: str | os.PathLike[str] | None,
 
 
 def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) -> None:
-    """InputError naming the first spike or dropout that starts after the run's end."""
+    """TomlError naming the first spike or dropout that starts after the run's end."""
     late = [(("faults", "spikes", k, "time_s"), f"spike at {spike.time_s:g} s")
             for k, spike in enumerate(faults.spikes) if spike.time_s > duration_s]
     late += [(("faults", "dropouts", k, "start_s"), f"dropout from {drop.start_s:g} s")
              for k, drop in enumerate(faults.dropouts) if drop.start_s > duration_s]
     if late:
         loc, what = late[0]
-        raise InputError(f"{what} is after the run's end ({duration_s:g} s)", file=file,
-                         row=toml_line_of(text, loc), column=".".join(map(str, loc)))
+        raise TomlError(f"{what} is after the run's end ({duration_s:g} s)", file=file,
+                        line=toml_line_of(text, loc), key=".".join(map(str, loc)))

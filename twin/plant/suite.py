@@ -251,14 +251,17 @@ def synthesize_case(case: SuiteCase, model=None):  # noqa: ANN001, ANN201 - Synt
 
 def write_case(case: SuiteCase, out_dir: Path, model=None) -> dict[str, Path]:  # noqa: ANN001
     """Write the case's profile and scenario, then its run and truth; paths by kind
-    (`model` as in `synthesize_case`)."""
+    (`model` as in `synthesize_case`).  The run is emulated first: written before it, a
+    profile and scenario stopped there (Ctrl-C, a failure) stood beside the run of an
+    earlier suite of the same seed and another length, as if they described it."""
     from twin.io.atomic import write_text
     from twin.plant.emulator import write_synth
 
     files = {kind: Path(out_dir) / name for kind, name in case_files(case.name).items()}
+    synthesized = synthesize_case(case, model)
     profile = write_text(files["profile"], profile_text(case))
     scenario = write_text(files["scenario"], scenario_text(case))
-    run, truth = write_synth(synthesize_case(case, model), files["run"])
+    run, truth = write_synth(synthesized, files["run"])
     return {"run": run, "truth": truth, "scenario": scenario, "profile": profile}
 
 

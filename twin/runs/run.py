@@ -12,6 +12,7 @@ import numpy as np
 
 from twin.errors import InputError
 from twin.io.atomic import write_json
+from twin.paths import regular_file_info
 from twin.runs.csv_format import read_csv_table, write_csv_table
 from twin.runs.parquet_format import read_parquet_table, write_parquet_table
 from twin.runs.quality import QualityConfig, drop_repeated_rows, finding, repair
@@ -151,6 +152,8 @@ def read_table(path: str | os.PathLike[str],
     if reader is None and file.is_dir():  # said as it is, not as a format named ''
         raise InputError("is a folder, not a run file (CSV or Parquet)", file=str(path))
     if reader is None:
+        # nothing there (a mistyped folder), a fifo, a symlink loop: said as it is
+        regular_file_info(path, use="read file")
         raise InputError(f"unknown run format {file.suffix!r}; expected .csv or .parquet",
                          file=str(path))
     return reader(path, keep)

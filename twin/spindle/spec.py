@@ -12,8 +12,8 @@ contact interfaces are named in the spec; boundary names are the keys of `[conve
 
 `load_spec(path)` validates everything it can without meshing: positive sizes, parts that
 do not overlap, regions/materials that exist, sensors inside the body, bearing regions
-that fit together.  Any problem raises `twin.errors.InputError` naming the file and the
-field (e.g. `parts[3].r_outer_mm`).
+that fit together.  Any problem raises a `twin.errors.TomlError` naming the file, the line
+and the key (e.g. `parts[3].r_outer_mm`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from twin.contract import SENSOR_NAMES
 from twin.data import bundled_path
-from twin.errors import InputError
+from twin.errors import TomlError
 from twin.paths import parse_toml, read_input_text, toml_line_of
 
 DEFAULT_SPEC_PATH = bundled_path("meshes", "reference_spindle.toml").resolve()
@@ -397,15 +397,14 @@ def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> S
         else:
             field_name, message = _field_path(first["loc"]), first["msg"]
             if first["type"] == "missing":
-                message = "missing required field"
+                message = "missing required key"
             elif first["type"] == "extra_forbidden":
-                message = "unknown field (check the spelling and the unit in the name)"
+                message = "unknown key (check the spelling and the unit in the name)"
             more = exc.error_count() - 1
         suffix = f" (and {more} more problem{'s' if more > 1 else ''})" if more > 0 else ""
         row = None if text is None else toml_line_of(text, tuple(re.findall(r"[^.\[\]]+",
                                                                              field_name)))
-        raise InputError(f"field {field_name}: {message}{suffix}", file=source,
-                         row=row) from None
+        raise TomlError(f"{message}{suffix}", file=source, line=row, key=field_name) from None
 
 
 def load_spec(path: str | Path | None = None) -> SpindleSpec:
