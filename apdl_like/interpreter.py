@@ -6,6 +6,7 @@ Limits keep any deck finite: loop iterations per run, statements per run, /INPUT
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -253,7 +254,8 @@ def _input(session: SessionState, st: Statement, depth: int) -> None:
         raise st.error("/INPUT needs a deck folder (run the deck from a file)")
     name = f"{fname}.{ext}" if ext else fname
     base = session.base_dir.resolve()
-    target = (base / name).resolve()
+    # realpath, not Path.resolve: a symlink loop is a file not found, not a RuntimeError
+    target = Path(os.path.realpath(base / name))
     if not target.is_relative_to(base):
         raise st.error(f"/INPUT file {name!r} lies outside the deck's folder {str(base)!r}")
     if not target.is_file():

@@ -212,6 +212,12 @@ def test_input_stays_in_the_deck_folder(tmp_path):
     (tmp_path / "self.inp").write_text("/INPUT,self,inp\n")
     with pytest.raises(ApdlError, match="nested deeper"):
         Session().run_file(tmp_path / "self.inp")
+    (tmp_path / "loop_a.inp").symlink_to(tmp_path / "loop_b.inp")
+    (tmp_path / "loop_b.inp").symlink_to(tmp_path / "loop_a.inp")
+    (tmp_path / "loops.inp").write_text("/INPUT,loop_a,inp\n")
+    with pytest.raises(ApdlError, match="not found") as info:  # was a RuntimeError
+        Session().run_file(tmp_path / "loops.inp")
+    assert info.value.line == 1
 
 
 def test_file_size_limit(tmp_path, monkeypatch):
