@@ -189,3 +189,22 @@ def test_synth_profile_with_an_ambient_column(tmp_path):
     assert result.exit_code == 2 and "p.csv" in result.output, result.output
     assert "3" in result.output and "ambient_C" in result.output and "-40..45" in result.output
     assert not (tmp_path / "r2.csv").exists()
+
+
+def test_twin_mesh_never_replaces_the_bundled_mesh_with_another(tmp_path):
+    """`twin mesh --out meshes/reference_spindle.msh --size-factor 2` overwrote the mesh
+    every replay of the reference spindle reads, without a word."""
+    from twin.spindle.model import DEFAULT_MESH_PATH
+    from twin.spindle.spec import DEFAULT_SPEC_PATH
+
+    before = DEFAULT_MESH_PATH.read_bytes()
+    link = tmp_path / "link.msh"
+    link.symlink_to(DEFAULT_MESH_PATH)
+    spec = tmp_path / "spec.toml"  # another spec file, even with the same text
+    spec.write_bytes(DEFAULT_SPEC_PATH.read_bytes())
+    for extra in (("--size-factor", 2), ("--spec", spec)):
+        for out in (DEFAULT_MESH_PATH, link):
+            result = cli("mesh", "--out", out, *extra, "--quiet")
+            assert result.exit_code == 2, result.output
+            assert "bundled mesh" in result.output and "--out" in result.output
+    assert DEFAULT_MESH_PATH.read_bytes() == before

@@ -26,6 +26,7 @@ def mesh(
     from twin.spindle.spec import load_spec
 
     check_out_file(out, inputs=[spec], suffixes=(".msh",))
+    _keep_the_bundled_mesh(out, spec, size_factor)
     the_spec = load_spec(spec)
     result = build_mesh(the_spec, size_factor)
     write_msh(result, out)
@@ -33,3 +34,22 @@ def mesh(
         q = mesh_quality(result.points, result.triangles)
         typer.echo(f"wrote {out}: {q['n_nodes']} nodes, {q['n_cells']} triangles, "
                    f"min angle {q['min_angle_deg']:.1f}°, max aspect {q['max_aspect']:.2f}")
+
+
+def _keep_the_bundled_mesh(out: Path, spec: Path | None, size_factor: float) -> None:
+    """The committed mesh is what every replay of the reference spindle reads: it may be
+    regenerated (the bundled spec at size factor 1), never replaced by another mesh."""
+    import os
+
+    from twin.errors import InputError
+    from twin.spindle.model import DEFAULT_MESH_PATH
+    from twin.spindle.spec import DEFAULT_SPEC_PATH
+
+    if os.path.realpath(out) != os.path.realpath(DEFAULT_MESH_PATH):
+        return
+    other_spec = spec is not None and os.path.realpath(spec) != os.path.realpath(
+        DEFAULT_SPEC_PATH)
+    if other_spec or size_factor != 1.0:
+        raise InputError("is the bundled mesh of the reference spindle at size factor 1, "
+                         "which every replay of it reads; write this mesh elsewhere",
+                         file=str(out), column="--out")
