@@ -208,3 +208,10 @@ def test_twin_mesh_never_replaces_the_bundled_mesh_with_another(tmp_path):
             assert result.exit_code == 2, result.output
             assert "bundled mesh" in result.output and "--out" in result.output
     assert DEFAULT_MESH_PATH.read_bytes() == before
+
+
+def test_train_epochs_are_bounded(tmp_path):
+    result = cli("train", "examples/runs/spindle_9000rpm_30min.csv", "--out",
+                 tmp_path / "m.safetensors", "--epochs", 10**20)
+    assert result.exit_code == 2 and "--epochs" in result.output
+    assert list(tmp_path.iterdir()) == []

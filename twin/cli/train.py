@@ -11,12 +11,17 @@ import typer
 from twin.cli.inputs import MAX_SEED
 from twin.loop.target_rules import TargetRule
 
+MAX_EPOCHS = 100_000
+"""Most Rprop epochs `--epochs` takes, 20× the default."""
+
 
 def train(
     runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on; "
                                       "a folder stands for the runs in it, as in replay."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
-    epochs: int = typer.Option(5000, "--epochs", min=1, help="Maximum Rprop epochs."),
+    # bounded: a run alone has no validation split to stop early, so 1e20 ran for ever
+    epochs: int = typer.Option(5000, "--epochs", min=1, max=MAX_EPOCHS,
+                               help="Maximum Rprop epochs."),
     seed: int = typer.Option(0, "--seed", min=0, max=MAX_SEED,
                              help="Seed of the 80/20 split and the weights."),
     paper_config: bool = typer.Option(
