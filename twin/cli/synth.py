@@ -95,8 +95,10 @@ def synth(
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)],
                    suffixes=(".csv", ".parquet"))
     speed_profile = None if profile is None else read_speed_profile(profile)
-    if speed_profile is not None and speed_profile.ignored and not quiet:
-        typer.echo(f"note: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
+    if speed_profile is not None and speed_profile.ignored:
+        # a warning, shown under --quiet too (which silences progress): a misspelt
+        # ambient column means a run emulated at another ambient than the file gave
+        typer.echo(f"warning: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
                    "speed profile sets time_s, speed_rpm and ambient_C only (the coolant: a "
                    "scenario's [coolant])", err=True)
     truth = load_scenario(scenario, duration_s=60.0 * minutes)
