@@ -277,3 +277,21 @@ def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
     path.write_bytes(text.encode("latin-1"))  # not UTF-8, but no UTF-16 either
     with pytest.raises(InputError, match="row 1: not UTF-8 text"):
         read_run(path)
+
+
+def test_a_spreadsheets_trailing_separators_are_read_past(tmp_path):
+    """Excel pads every line of its used range with separators ("T5_C,,," and "25.1,,,");
+    the run was refused ("header field 9 is empty").  A value under no name still is."""
+    clean = csv_text(warmup())
+    lines = clean.splitlines()
+    padded = "\n".join([lines[0] + ",,,"] + [ln + ",," for ln in lines[1:]]) + "\n"
+    a = read_run(write(tmp_path, clean, "clean.csv"))
+    b = read_run(write(tmp_path, padded, "padded.csv"))
+    assert np.array_equal(a.T_C, b.T_C) and np.array_equal(a.time_s, b.time_s)
+    assert b.quality == []
+    lines[5] += ",,7"
+    expect_error(write(tmp_path, "\n".join([lines[0] + ",,,"] + lines[1:]) + "\n"), 6, None,
+                 "expected 8 fields")
+    inner = lines[0].replace("speed_rpm,", "speed_rpm,,")
+    expect_error(write(tmp_path, "\n".join([inner] + lines[1:]) + "\n"), 1, None,
+                 "header field 3 is empty")

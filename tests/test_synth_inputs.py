@@ -340,3 +340,10 @@ def test_xy_drift_is_the_lagged_linear_response_to_the_temperature_rises():
     assert np.abs(xy[0, 5:] - exact_x[5:]).max() < 0.02 * xy[0, -1]
     assert xy[0, -1] == pytest.approx(1.1 * 0.22 * 10.0, rel=1e-3)
     assert np.allclose(xy[1], 0.0)
+
+
+def test_a_profile_with_a_spreadsheets_trailing_separators_reads(tmp_path):
+    path = tmp_path / "p.csv"
+    path.write_text("time_s,speed_rpm,,\n0,6000,,\n600,9000,\n")
+    profile = read_speed_profile(path)
+    assert list(profile.speed_rpm.values) == [6000.0, 9000.0] and profile.ignored == ()

@@ -21,7 +21,7 @@ from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
 from twin.paths import read_input_text
 from twin.plant.timetable import StepTable
-from twin.runs.csv_format import check_header, csv_records
+from twin.runs.csv_format import check_header, csv_records, without_trailing_blanks
 from twin.runs.table import parse_cell
 
 
@@ -53,10 +53,11 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
             continue
         fields = [f.strip() for f in next(csv_records([line], file, [number]))]
         if header is None:
+            fields = without_trailing_blanks(fields)
             check_header(fields, file, number)
             header, header_line = fields, number
         else:
-            rows.append((number, fields))
+            rows.append((number, without_trailing_blanks(fields, len(header))))
     if header is None:
         raise InputError("empty speed profile", file=file)
     for name in ("time_s", "speed_rpm"):

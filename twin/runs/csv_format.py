@@ -50,7 +50,8 @@ def read_csv_table(path: str | os.PathLike[str],
                     metadata[key.strip()] = value.strip()
             continue
         if header is None:
-            header = [name.strip() for name in next(csv_records([line], file, [number]))]
+            header = without_trailing_blanks(
+                [name.strip() for name in next(csv_records([line], file, [number]))])
             header_line = number
             continue
         data_lines.append(line)
@@ -70,6 +71,7 @@ def read_csv_table(path: str | os.PathLike[str],
     values = np.full((len(data_lines), len(known)), np.nan)
     for k, fields in enumerate(csv_records(data_lines, file, data_numbers)):
         line = data_numbers[k]
+        fields = without_trailing_blanks(fields, len(header))
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields as in the header, found "
                              f"{len(fields)}", file=file, row=line)
@@ -80,6 +82,19 @@ def read_csv_table(path: str | os.PathLike[str],
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored)
+
+
+def without_trailing_blanks(fields: list[str], width: int | None = None) -> list[str]:
+    """`fields` without the blank fields after the first `width` (default: after the last
+    non-blank one): the trailing separators a spreadsheet writes to fill its used range
+    ("T5_C,coolant_C,,," and "24.1,23.0,,,").  Blanks inside the row stay."""
+    if width is None:
+        width = len(fields)
+        while width and not fields[width - 1].strip():
+            width -= 1
+    if len(fields) > width and not any(f.strip() for f in fields[width:]):
+        return fields[:width]
+    return fields
 
 
 def check_header(header: list[str], file: str, line: int) -> None:
