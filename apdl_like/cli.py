@@ -24,6 +24,7 @@ from twin.errors import InputError, report_errors, run_console_script
 from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
 from twin.paths import regular_file_info
+from twin.version import version_option
 
 app = typer.Typer(
     name="apdl-like",
@@ -32,6 +33,15 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(False, "--version", callback=version_option("apdl-like"),
+                                 is_eager=True, help="Print the installed version and exit."),
+) -> None:
+    # the app's own options (typer's callback); the help text is the app's
+    pass
 
 
 @app.command("run")

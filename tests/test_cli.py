@@ -553,6 +553,17 @@ def test_version_prints_the_installed_package_version():
     assert result.exit_code == 0 and "Open-loop transient" in result.output
 
 
+def test_apdl_like_tells_its_version_and_still_runs_its_commands():
+    from importlib.metadata import version
+
+    from apdl_like.cli import app as apdl_app
+
+    result = CliRunner().invoke(apdl_app, ["--version"])
+    assert result.exit_code == 0 and result.output == f"apdl-like {version('spindle-twin')}\n"
+    result = CliRunner().invoke(apdl_app, ["run", "--help"])
+    assert result.exit_code == 0 and "--strict" in result.output
+
+
 @pytest.mark.parametrize("argv", [
     ["replay", "RUN", "--methods", "open_loop,estimator", "--snapshots", "none", "--out", "OUT"],
     ["snapshot", "RUN", "--time", "60", "--method", "ratio", "--out", "S.png"],

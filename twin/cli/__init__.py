@@ -25,6 +25,7 @@ from twin.cli.synth import synth
 from twin.cli.train import train
 from twin.errors import report_errors, run_console_script
 from twin.log import send_warnings_to_log
+from twin.version import version_option
 
 COMMANDS = (
     ("replay", replay),
@@ -39,27 +40,9 @@ COMMANDS = (
 """(name, function) of every `twin` command, in the order `twin --help` lists them."""
 
 
-PACKAGE = "spindle-twin"
-"""The distribution whose metadata `twin --version` reads (pyproject.toml's name)."""
-
-
-def _print_version(value: bool) -> None:
-    if not value:
-        return
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        typer.echo(f"twin {version(PACKAGE)}")
-    except PackageNotFoundError:  # run from a checkout that was never installed
-        typer.echo(f"twin: the {PACKAGE} package is not installed; no version to tell",
-                   err=True)
-        raise typer.Exit(1) from None
-    raise typer.Exit(0)
-
-
 def _options(
-    version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
-                                 help="Print the installed version and exit."),
+    version: bool = typer.Option(False, "--version", callback=version_option("twin"),
+                                 is_eager=True, help="Print the installed version and exit."),
 ) -> None:
     # the app's own options (typer's callback); the help text is the app's
     pass
