@@ -465,6 +465,11 @@ def test_a_dead_thermocouple_is_left_out_as_a_stuck_one_is(tmp_path, spindle_mod
     acc = {n: json.loads((d / "accuracy.json").read_text())["methods"] for n, d in out.items()}
     assert acc["dead"] == acc["stuck"]
     assert all(m["rmse_C"]["T2"] is None for m in acc["dead"].values())
+    # the report tells both findings as table rows, not JSON text
+    page = (tmp_path / "out" / "report.html").read_text()
+    for kind in ("dead", "stuck"):
+        assert f"<td>T2_C</td><td>{kind}</td><td>76</td><td>0–300</td>" in page, kind
+    assert "&#34;" not in page
 
 
 def test_a_snapshots_marker_names_the_shown_fields_largest_value():

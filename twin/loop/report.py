@@ -238,15 +238,31 @@ def _accuracy_cells(metrics: dict) -> list[str]:
              "deformation_accuracy_pct")]
 
 
-def _findings(run_dir: Path) -> list[str] | None:
-    """The run's data-quality findings as JSON lines; None without a quality.json."""
+MAX_SPANS_SHOWN = 4
+"""Time spans a finding's row lists in the report before '…' (quality.json has them all)."""
+
+
+def _findings(run_dir: Path) -> list[dict[str, str]] | None:
+    """The run's data-quality findings as table rows (column, kind, samples, time spans,
+    action, detail: quality.json's fields, spans in s); None without a quality.json."""
     try:
         findings = json.loads((run_dir / "quality.json").read_text())
     except (OSError, ValueError):
         return None
     items = findings if isinstance(findings, list) else findings.get("findings", findings)
-    return [json.dumps(f, ensure_ascii=False) for f in
-            (items if isinstance(items, list) else [items] if items else [])]
+    items = items if isinstance(items, list) else [items] if items else []
+    return [_finding_row(f) for f in items]
+
+
+def _finding_row(finding: object) -> dict[str, str]:
+    if not isinstance(finding, dict):  # a hand-edited file: shown as it is
+        return {"column": "", "kind": "", "count": "", "spans": "", "action": "",
+                "detail": json.dumps(finding, ensure_ascii=False)}
+    spans = [f"{a:g}–{b:g}" for a, b in finding.get("spans_s") or []]
+    shown = ", ".join(spans[:MAX_SPANS_SHOWN]) + (" …" if len(spans) > MAX_SPANS_SHOWN else "")
+    return {"column": str(finding.get("column", "")), "kind": str(finding.get("kind", "")),
+            "count": str(finding.get("count", "")), "spans": shown,
+            "action": str(finding.get("action", "")), "detail": str(finding.get("detail", ""))}
 
 
 def _summary_of_batch(out_root: Path) -> dict | None:
