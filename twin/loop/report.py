@@ -258,7 +258,7 @@ def _finding_row(finding: object) -> dict[str, str]:
     if not isinstance(finding, dict):  # a hand-edited file: shown as it is
         return {"column": "", "kind": "", "count": "", "spans": "", "action": "",
                 "detail": json.dumps(finding, ensure_ascii=False)}
-    spans = [f"{a:g}–{b:g}" for a, b in finding.get("spans_s") or []]
+    spans = [f"{a:g}" if a == b else f"{a:g}–{b:g}" for a, b in finding.get("spans_s") or []]
     shown = ", ".join(spans[:MAX_SPANS_SHOWN]) + (" …" if len(spans) > MAX_SPANS_SHOWN else "")
     return {"column": str(finding.get("column", "")), "kind": str(finding.get("kind", "")),
             "count": str(finding.get("count", "")), "spans": shown,
