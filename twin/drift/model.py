@@ -96,13 +96,27 @@ def sensor_ranking(data: DriftData) -> SensorRanking:
     return rank_sensors(data.sensors, data.T_C[rows], targets)
 
 
-def measured_rows(data: DriftData) -> np.ndarray:
+MIN_MEASURED_ROWS = 20
+
+
+def measured_rows(data: DriftData, every_file: bool = False) -> np.ndarray:
+    """The rows with every target measured: at least `MIN_MEASURED_ROWS` of them, and with
+    `every_file` in each file (time-blocked validation holds each file out in turn and
+    fits on the others: a one-row file left one row to fit on)."""
     if data.targets_um is None:
         raise InputError("no target column given", column="--target")
     rows = np.flatnonzero(np.all(np.isfinite(data.targets_um), axis=1))
-    if rows.size < 20:
-        raise InputError(f"only {rows.size} rows hold every target; need at least 20",
-                         file=data.files[0], column=",".join(data.targets))
+    counts = [(data.files[0], rows.size, "")]
+    if every_file and len(data.files) > 1:
+        per_file = np.bincount(data.segment_ids()[rows], minlength=len(data.files))
+        counts = [(f, int(n), " in every file") for f, n in zip(data.files, per_file,
+                                                                  strict=True)]
+    for file, count, where in counts:
+        if count < MIN_MEASURED_ROWS:
+            rows_hold = "1 row holds" if count == 1 else f"{count} rows hold"
+            raise InputError(f"only {rows_hold} every target; need at least "
+                             f"{MIN_MEASURED_ROWS}{where}", file=file,
+                             column=",".join(data.targets))
     return rows
 
 
@@ -135,7 +149,7 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
     columns = [data.sensors.index(s) for s in chosen_sensors]
     T = data.T_C[:, columns]
     reference = tuple(float(v) for v in reference_temperatures(T))
-    rows = measured_rows(data)
+    rows = measured_rows(data, every_file=True)
     Y = data.targets_um[rows]
     blocks = block_labels(data.n_samples, data.segment_ids())[rows]
     names = [method] if method else list(candidates or METHODS)
