@@ -120,6 +120,27 @@ def measured_rows(data: DriftData, every_file: bool = False) -> np.ndarray:
     return rows
 
 
+def _methods_without_speed(names: list[str], method: str | None, data: DriftData,
+                           progress: Progress) -> list[str]:
+    """The methods of `names` that need no speed, for data without `speed_rpm` in every
+    file (it is optional); a forced method that needs it is bad input."""
+    def needs_speed(name: str) -> bool:
+        return FeatureSpec((), (), groups=METHODS[name].groups).uses_speed
+
+    usable = [n for n in names if not needs_speed(n)]
+    if method is not None and not usable:
+        without = [n for n in METHODS if not needs_speed(n)]
+        raise InputError(f"method {method!r} needs speed_rpm, which not every file holds: "
+                         f"give it in every file, or use {' or '.join(without)}",
+                         file=", ".join(data.files), column="--method")
+    if not usable:
+        raise InputError("every candidate method needs speed_rpm, which not every file "
+                         "holds", file=", ".join(data.files))
+    if progress and usable != names:
+        progress(f"no speed_rpm in every file: validating {', '.join(usable)} only")
+    return usable
+
+
 def one_blas_thread():
     """Run numpy/scipy/scikit-learn linear algebra on one thread.
 
@@ -153,6 +174,8 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
     Y = data.targets_um[rows]
     blocks = block_labels(data.n_samples, data.segment_ids())[rows]
     names = [method] if method else list(candidates or METHODS)
+    if data.speed_rpm is None:
+        names = _methods_without_speed(names, method, data, progress)
     features: dict[tuple[str, ...], np.ndarray] = {}
     results: list[MethodValidation] = []
     for name in names:
