@@ -120,7 +120,10 @@ def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--method", "magic")
     assert result.exit_code == 2 and "unknown method" in result.output
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", "Z_C")
-    assert result.exit_code == 2 and "--sensors" in result.output
+    assert result.exit_code == 2 and f"{data}, row 1, column 'Z_C'" in result.output
+    for listed in ("A_C,drift_um", ",", "speed_rpm"):
+        result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", listed)
+        assert result.exit_code == 2 and "option '--sensors'" in result.output, result.output
 
 
 def test_more_sensors_than_the_data_hold_is_bad_input(machine, tmp_path):

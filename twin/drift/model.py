@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.drift.data import DriftData
+from twin.drift.data import TEMPERATURE_SUFFIX, DriftData
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
 from twin.drift.folds import block_labels
 from twin.drift.intervals import apply_interval
@@ -56,6 +56,23 @@ class DriftModel:
                                    data.segment_starts)
 
 
+def listed_sensors(option: str) -> list[str] | None:
+    """The temperature columns a `--sensors` list names (each once), or None for `auto`,
+    `all` or a count: only listed columns need be in every data file."""
+    text = option.strip()
+    if text in ("auto", "all") or text.isdigit():
+        return None
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
+    if not names:
+        raise InputError("name at least one temperature column", column="--sensors")
+    not_temperatures = [n for n in names if not n.endswith(TEMPERATURE_SUFFIX)]
+    if not_temperatures:
+        # a probe or the speed listed here would be read as a temperature
+        raise InputError(f"not temperature columns (names ending in {TEMPERATURE_SUFFIX}): "
+                         f"{', '.join(not_temperatures)}", column="--sensors")
+    return names
+
+
 def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str]) -> list[str]:
     """`auto` (cluster representatives), `all`, a count K (best K representatives) or a list."""
     text = option.strip()
@@ -76,7 +93,7 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
                 f"form {len(best)} correlation clusters: give at most {len(best)}, or 'all' "
                 "for every column", column="--sensors")
         return best[:k]
-    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))  # once each
+    names = listed_sensors(text) or []
     unknown = [n for n in names if n not in available]
     if unknown or not names:
         raise InputError(f"unknown temperature columns {unknown}; the data hold "
