@@ -120,7 +120,10 @@ def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--method", "magic")
     assert result.exit_code == 2 and "unknown method" in result.output
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", "Z_C")
-    assert result.exit_code == 2 and "--sensors" in result.output
+    assert result.exit_code == 2 and f"{data}, row 1, column 'Z_C'" in result.output
+    for listed in ("A_C,drift_um", ",", "speed_rpm"):
+        result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", listed)
+        assert result.exit_code == 2 and "option '--sensors'" in result.output, result.output
 
 
 def test_more_sensors_than_the_data_hold_is_bad_input(machine, tmp_path):
@@ -235,3 +238,64 @@ def test_a_stop_while_the_report_is_drawn_leaves_the_earlier_pair(machine, tmp_p
     assert (out / "metrics.json").read_text() == "{}"
     assert (out / "report.html").read_text() == "<p>earlier</p>"
     assert sorted(before) == sorted(p.name for p in out.iterdir())
+
+
+def _two_files(tmp_path, change_second):
+    """Two hours of the synthetic machine, as two files of one hour each (the second
+    changed by `change_second`)."""
+    columns = synthetic_columns(hours=2.0)
+    half = columns["time_s"].size // 2
+    first = tmp_path / "first.csv"
+    second = tmp_path / "second.csv"
+    write_csv(first, {k: v[:half] for k, v in columns.items()})
+    later = {k: v[half:].copy() for k, v in columns.items()}
+    change_second(later)
+    write_csv(second, later)
+    return first, second
+
+
+def test_a_file_too_short_for_a_validation_block_is_bad_input(tmp_path):
+    # a one-row second file is a validation block of its own: holding the first file out
+    # left one row to fit on ('internal error: ValueError: Found array with 0 sample(s)')
+    first, second = _two_files(tmp_path, lambda c: [c.__setitem__(k, v[:1])
+                                                    for k, v in list(c.items())])
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
+                 "--method", "ridge_dynamic")
+    assert result.exit_code == 2, result.output
+    assert (f"{second}, column 'drift_um': only 1 row holds every target; need at least 20 "
+            "in every file") in " ".join(result.output.split())
+    assert "Traceback" not in result.output and not out.exists()
+
+
+def test_data_without_speed_fit_with_the_methods_that_need_none(tmp_path):
+    # speed_rpm is optional (DESIGN): without it in every file, fit validated the speed
+    # methods too and ended in 'internal error: ValueError: the features need speed_rpm'
+    first, second = _two_files(tmp_path, lambda c: c.pop("speed_rpm"))
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert "ridge_lagged" in result.output and "ridge_dynamic" not in result.output
+    assert "no speed_rpm in every file" in result.output
+    pred = tmp_path / "p.csv"
+    assert run("predict", str(out), str(second), "--out", str(pred)).exit_code == 0
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
+                 "--method", "bp")
+    assert result.exit_code == 2, result.output
+    message = " ".join(result.output.split())
+    assert f"{first}, {second}, option '--method': method 'bp' needs speed_rpm" in message
+    assert "Traceback" not in result.output
+
+
+def test_listed_sensors_need_not_be_the_first_files_every_column(tmp_path):
+    # --sensors A_C,B_C was refused because the second file lacks C_C, a column not asked
+    # for (the first file's temperature columns were required in every file)
+    first, second = _two_files(tmp_path, lambda c: c.pop("C_C"))
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
+                 "--method", "ridge_dynamic", "--sensors", "A_C,B_C", "--quiet")
+    assert result.exit_code == 0, result.output
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
+                 "--method", "ridge_dynamic", "--sensors", "A_C,C_C", "--quiet")
+    assert result.exit_code == 2, result.output
+    assert f"{second}, row 1, column 'C_C': required column is missing" in result.output

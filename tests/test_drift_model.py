@@ -178,3 +178,27 @@ def test_the_two_kinds_of_model_file_are_named_where_the_other_is_expected(ridge
         load_drift_model(bundled_path("correction_model.safetensors"))
     result = CliRunner().invoke(app, ["model-info", str(drift)])
     assert result.exit_code == 2 and "twin drift predict" in result.output
+
+
+def test_damaged_model_metadata_is_refused(ridge_model, data_file, tmp_path):
+    # the checksum covered the tensors only: a damaged digit of a reference temperature
+    # moved every prediction without a word, a damaged interval rule ended in
+    # 'internal error: KeyError'
+    import json
+
+    path = save_drift_model(ridge_model, tmp_path / "model.safetensors")
+    raw = path.read_bytes()
+    size = int.from_bytes(raw[:8], "little")
+    header = json.loads(raw[8 : 8 + size])
+    doc = json.loads(header["__metadata__"]["spindle_twin_drift"])
+    for damage in (lambda d: d["features"]["reference_C"].__setitem__(0, 99.0),
+                   lambda d: d.__setitem__("interval", {})):
+        damaged = json.loads(json.dumps(doc))
+        damage(damaged)
+        header["__metadata__"]["spindle_twin_drift"] = json.dumps(damaged, sort_keys=True)
+        text = json.dumps(header).encode()
+        text += b" " * (-len(text) % 8)
+        bad = tmp_path / "bad.safetensors"
+        bad.write_bytes(len(text).to_bytes(8, "little") + text + raw[8 + size:])
+        with pytest.raises(InputError, match="bad.safetensors: checksum mismatch: the metadata"):
+            load_drift_model(bad)

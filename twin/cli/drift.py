@@ -88,7 +88,7 @@ def fit(
     """Fit a drift model; validation leaves one time block out at a time (never shuffled)."""
     from twin.drift.data import read_drift_data
     from twin.drift.methods import method_named
-    from twin.drift.model import fit_drift_model
+    from twin.drift.model import fit_drift_model, listed_sensors
     from twin.drift.modelfile import save_drift_model
 
     check_out_file(out, inputs=data, suffixes=(".safetensors",))
@@ -96,9 +96,11 @@ def fit(
     if method is not None:
         method_named(method)
     targets = _targets(target)
+    # a listed sensor is required in every file, another temperature column in none
+    listed = listed_sensors(sensors)
     tell = _progress(quiet)
     tell(f"reading {len(data)} file(s)")
-    drift_data = read_drift_data(data, targets=targets)
+    drift_data = read_drift_data(data, sensors=listed, targets=targets)
     _report_findings(drift_data.findings, quiet)
     model = fit_drift_model(drift_data, method=method, sensors=sensors, seed=seed,
                             progress=tell)

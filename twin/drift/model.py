@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.drift.data import DriftData
+from twin.drift.data import TEMPERATURE_SUFFIX, DriftData
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
 from twin.drift.folds import block_labels
 from twin.drift.intervals import apply_interval
@@ -56,6 +56,23 @@ class DriftModel:
                                    data.segment_starts)
 
 
+def listed_sensors(option: str) -> list[str] | None:
+    """The temperature columns a `--sensors` list names (each once), or None for `auto`,
+    `all` or a count: only listed columns need be in every data file."""
+    text = option.strip()
+    if text in ("auto", "all") or text.isdigit():
+        return None
+    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))
+    if not names:
+        raise InputError("name at least one temperature column", column="--sensors")
+    not_temperatures = [n for n in names if not n.endswith(TEMPERATURE_SUFFIX)]
+    if not_temperatures:
+        # a probe or the speed listed here would be read as a temperature
+        raise InputError(f"not temperature columns (names ending in {TEMPERATURE_SUFFIX}): "
+                         f"{', '.join(not_temperatures)}", column="--sensors")
+    return names
+
+
 def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str]) -> list[str]:
     """`auto` (cluster representatives), `all`, a count K (best K representatives) or a list."""
     text = option.strip()
@@ -76,7 +93,7 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
                 f"form {len(best)} correlation clusters: give at most {len(best)}, or 'all' "
                 "for every column", column="--sensors")
         return best[:k]
-    names = list(dict.fromkeys(n.strip() for n in text.split(",") if n.strip()))  # once each
+    names = listed_sensors(text) or []
     unknown = [n for n in names if n not in available]
     if unknown or not names:
         raise InputError(f"unknown temperature columns {unknown}; the data hold "
@@ -96,14 +113,49 @@ def sensor_ranking(data: DriftData) -> SensorRanking:
     return rank_sensors(data.sensors, data.T_C[rows], targets)
 
 
-def measured_rows(data: DriftData) -> np.ndarray:
+MIN_MEASURED_ROWS = 20
+
+
+def measured_rows(data: DriftData, every_file: bool = False) -> np.ndarray:
+    """The rows with every target measured: at least `MIN_MEASURED_ROWS` of them, and with
+    `every_file` in each file (time-blocked validation holds each file out in turn and
+    fits on the others: a one-row file left one row to fit on)."""
     if data.targets_um is None:
         raise InputError("no target column given", column="--target")
     rows = np.flatnonzero(np.all(np.isfinite(data.targets_um), axis=1))
-    if rows.size < 20:
-        raise InputError(f"only {rows.size} rows hold every target; need at least 20",
-                         file=data.files[0], column=",".join(data.targets))
+    counts = [(data.files[0], rows.size, "")]
+    if every_file and len(data.files) > 1:
+        per_file = np.bincount(data.segment_ids()[rows], minlength=len(data.files))
+        counts = [(f, int(n), " in every file") for f, n in zip(data.files, per_file,
+                                                                  strict=True)]
+    for file, count, where in counts:
+        if count < MIN_MEASURED_ROWS:
+            rows_hold = "1 row holds" if count == 1 else f"{count} rows hold"
+            raise InputError(f"only {rows_hold} every target; need at least "
+                             f"{MIN_MEASURED_ROWS}{where}", file=file,
+                             column=",".join(data.targets))
     return rows
+
+
+def _methods_without_speed(names: list[str], method: str | None, data: DriftData,
+                           progress: Progress) -> list[str]:
+    """The methods of `names` that need no speed, for data without `speed_rpm` in every
+    file (it is optional); a forced method that needs it is bad input."""
+    def needs_speed(name: str) -> bool:
+        return FeatureSpec((), (), groups=METHODS[name].groups).uses_speed
+
+    usable = [n for n in names if not needs_speed(n)]
+    if method is not None and not usable:
+        without = [n for n in METHODS if not needs_speed(n)]
+        raise InputError(f"method {method!r} needs speed_rpm, which not every file holds: "
+                         f"give it in every file, or use {' or '.join(without)}",
+                         file=", ".join(data.files), column="--method")
+    if not usable:
+        raise InputError("every candidate method needs speed_rpm, which not every file "
+                         "holds", file=", ".join(data.files))
+    if progress and usable != names:
+        progress(f"no speed_rpm in every file: validating {', '.join(usable)} only")
+    return usable
 
 
 def one_blas_thread():
@@ -135,10 +187,12 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
     columns = [data.sensors.index(s) for s in chosen_sensors]
     T = data.T_C[:, columns]
     reference = tuple(float(v) for v in reference_temperatures(T))
-    rows = measured_rows(data)
+    rows = measured_rows(data, every_file=True)
     Y = data.targets_um[rows]
     blocks = block_labels(data.n_samples, data.segment_ids())[rows]
     names = [method] if method else list(candidates or METHODS)
+    if data.speed_rpm is None:
+        names = _methods_without_speed(names, method, data, progress)
     features: dict[tuple[str, ...], np.ndarray] = {}
     results: list[MethodValidation] = []
     for name in names:

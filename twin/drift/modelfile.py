@@ -3,8 +3,12 @@
 Tensors are float64 arrays named as the method stores them, plus the chosen method's
 out-of-fold validation under `validation.*` (for the report); the safetensors header
 holds one metadata entry `spindle_twin_drift` with JSON: format, version, method,
-targets, feature spec, interval rule, metadata (ranking, validation) and a SHA-256 of
-the tensors.  Loading reads tensors and JSON only (no unpickling) and checks them.
+targets, feature spec, interval rule, metadata (ranking, validation), a SHA-256 of the
+tensors and one of the rest of that JSON (the reference temperatures and interval
+widths are numbers there too: a damaged digit moved every prediction or band silently;
+files written before it load without that check).  Loading reads tensors and JSON only
+(no unpickling) and checks them.  As for the correction model, the checksums detect
+corruption, not forgery.
 """
 
 from __future__ import annotations
@@ -38,6 +42,12 @@ def _digest(tensors: dict[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
+def _metadata_digest(doc: dict) -> str:
+    """SHA-256 of the model's JSON without its checksums (keys sorted, as written)."""
+    rest = {k: v for k, v in doc.items() if k not in ("sha256", "metadata_sha256")}
+    return hashlib.sha256(json.dumps(rest, sort_keys=True, allow_nan=True).encode()).hexdigest()
+
+
 def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
     """Write the model atomically."""
     from safetensors.numpy import save
@@ -48,6 +58,7 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
     doc = {"format": FORMAT, "version": VERSION, "method": model.method,
            "targets": model.targets, "features": model.spec.to_json(),
            "interval": model.interval, "metadata": model.metadata, "sha256": _digest(tensors)}
+    doc["metadata_sha256"] = _metadata_digest(doc)
     data = save(tensors, metadata={METADATA_KEY: json.dumps(doc, sort_keys=True,
                                                              allow_nan=True)})
     return write_bytes(path, data)
@@ -97,6 +108,9 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
             raise InputError(f"tensor {name!r} is not finite float64", file=file)
     if doc.get("sha256") != _digest(tensors):
         raise InputError("checksum mismatch: the weights were modified or damaged", file=file)
+    if "metadata_sha256" in doc and doc["metadata_sha256"] != _metadata_digest(doc):
+        raise InputError("checksum mismatch: the metadata (sensors, reference temperatures, "
+                         "interval) were modified or damaged", file=file)
     try:
         spec = FeatureSpec.from_json(doc["features"])
         params = {k: v for k, v in tensors.items() if not k.startswith(VALIDATION)}
