@@ -39,16 +39,14 @@ def mesh(
 def _keep_the_bundled_mesh(out: Path, spec: Path | None, size_factor: float) -> None:
     """The committed mesh is what every replay of the reference spindle reads: it may be
     regenerated (the bundled spec at size factor 1), never replaced by another mesh."""
-    import os
-
     from twin.errors import InputError
+    from twin.io.destinations import same_file
     from twin.spindle.model import DEFAULT_MESH_PATH
     from twin.spindle.spec import DEFAULT_SPEC_PATH
 
-    if os.path.realpath(out) != os.path.realpath(DEFAULT_MESH_PATH):
+    if not same_file(out, DEFAULT_MESH_PATH):
         return
-    other_spec = spec is not None and os.path.realpath(spec) != os.path.realpath(
-        DEFAULT_SPEC_PATH)
+    other_spec = spec is not None and not same_file(spec, DEFAULT_SPEC_PATH)
     if other_spec or size_factor != 1.0:
         raise InputError("is the bundled mesh of the reference spindle at size factor 1, "
                          "which every replay of it reads; write this mesh elsewhere",

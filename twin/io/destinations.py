@@ -27,7 +27,10 @@ from twin.paths import regular_file_info
 StrPath = str | os.PathLike[str]
 
 
-def _same(a: Path, b: Path) -> bool:
+def same_file(a: StrPath, b: StrPath) -> bool:
+    """Whether `a` and `b` name one file (through links too); a path that names nothing,
+    or a symlink loop, is no file."""
+    a, b = Path(a), Path(b)
     try:
         return os.path.samefile(a, b)
     except OSError:
@@ -91,7 +94,7 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
     for written in (target, *(Path(p) for p in also)):
         refuse_special(written, option)
         for source in read:
-            if _same(written, source):
+            if same_file(written, source):
                 raise InputError(f"is also an input of this command ({source}); refusing to "
                                  "overwrite it", file=str(written), column=option)
     if suffixes and target.suffix.lower() not in suffixes:
@@ -131,7 +134,7 @@ def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
     for source in (Path(p) for p in inputs if p is not None):
         for name in owned:
             place = target / name
-            if _same(place, source) or (place.is_dir() and _inside(source, place)):
+            if same_file(place, source) or (place.is_dir() and _inside(source, place)):
                 raise InputError(f"the input {source} lies where this command writes "
                                  f"{place}; refusing to replace it", file=str(target),
                                  column=option)

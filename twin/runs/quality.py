@@ -346,8 +346,9 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
                                 detail=f"first sample at {time[0]:g} s"))
         time = time - time[0]
 
-    dead = [n for n in TEMPERATURES if np.isnan(columns[n]).all()]
-    for name in [n for n in columns if np.isnan(columns[n]).all()]:
+    empty = [n for n in columns if np.isnan(columns[n]).all()]
+    dead = [n for n in empty if n in TEMPERATURES]
+    for name in empty:
         # Only optional columns and thermocouples can be empty here (validation rejects
         # the other required ones and a run without any temperature).
         if name in dead:
