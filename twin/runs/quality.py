@@ -76,12 +76,20 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
-def noise_sigma(values: np.ndarray) -> float:
-    """Robust white-noise estimate from second differences (blind to slow trends)."""
-    x = values[~np.isnan(values)]
-    if x.size < 5:
+def noise_sigma(values: np.ndarray, keep: np.ndarray | None = None) -> float:
+    """Robust white-noise estimate from second differences (blind to slow trends).
+
+    With `keep` (bool per sample), only second differences of three consecutive kept
+    samples count: the noise of the running or the stopped stretches of a run, say.
+    """
+    ok = ~np.isnan(values) if keep is None else ~np.isnan(values) & keep
+    if keep is None:
+        x = values[ok]
+        d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
+    else:
+        d2 = (values[2:] - 2.0 * values[1:-1] + values[:-2])[ok[2:] & ok[1:-1] & ok[:-2]]
+    if d2.size < 3:
         return 0.0
-    d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
     # Var(d2) = 6 σ² for white noise; 1.4826·MAD estimates a standard deviation.
     return float(1.4826 * np.median(np.abs(d2 - np.median(d2))) / np.sqrt(6.0))
 
