@@ -1,4 +1,4 @@
-"""Run outputs: params.json, result_NNN.vtu per solved load step (meshio), log.txt.
+"""Run outputs: params.json, result_NNN.vtu per solved load step (twin.io.vtk), log.txt.
 
 VTU points are every APDL node at (X, Y, 0) = (r, z, 0) in metres; nodal arrays TEMP (°C),
 U (m, 3 components, U_z = 0) and S (Pa, 6 components XX YY ZZ XY YZ XZ with ZZ the hoop

@@ -173,13 +173,13 @@ def _bundled_model():
 
 
 def test_cli_choices_match_the_modules_that_act_on_them():
-    from twin.cli.inputs import Field, Method, Snapshots
+    from twin.cli.inputs import Field, Method, WindowEnds
     from twin.correction.methods import METHODS
-    from twin.loop.runfiles import SNAPSHOT_CHOICES
+    from twin.loop.runfiles import WINDOW_END_CHOICES
     from twin.loop.snapshot import FIELDS
 
     assert tuple(Method) == METHODS
-    assert tuple(Snapshots) == SNAPSHOT_CHOICES
+    assert tuple(WindowEnds) == WINDOW_END_CHOICES
     assert tuple(Field) == tuple(FIELDS)
 
 

@@ -31,8 +31,9 @@ class Method(StrEnum):
     ESTIMATOR = "estimator"
 
 
-class Snapshots(StrEnum):
-    """Which field pictures a replay draws (`twin.loop.runfiles.SNAPSHOT_CHOICES`)."""
+class WindowEnds(StrEnum):
+    """Which window ends a replay pictures (--snapshots) or writes field files of
+    (--fields): `twin.loop.runfiles.WINDOW_END_CHOICES`."""
 
     NONE = "none"
     END = "end"

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from twin.cli.inputs import (
-    Snapshots,
+    WindowEnds,
     bundled_runs,
     bundled_runs_dir,
     checked_model,
@@ -34,8 +34,13 @@ def replay(
     dask: str | None = typer.Option(
         None, "--dask", callback=dask_address, help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     ),
-    snapshots: Snapshots = typer.Option(
-        Snapshots.END, "--snapshots", help="field pictures: none, at the end, every window"
+    snapshots: WindowEnds = typer.Option(
+        WindowEnds.END, "--snapshots", help="field pictures: none, at the end, every window"
+    ),
+    fields: WindowEnds = typer.Option(
+        WindowEnds.EVERY, "--fields",
+        help="field files (fields/*.vtu + fields.pvd): every window end, the last one only "
+        "(end), or none; about 220 kB a window of the default spindle",
     ),
     resume: bool = typer.Option(False, "--resume", help="skip runs already finished"),
     quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
@@ -99,6 +104,7 @@ def replay(
                 jobs=jobs,
                 dask_address=dask,
                 snapshots=snapshots.value,
+                fields=fields.value,
                 resume=resume,
                 progress=tell,
                 assimilate_drift=drift_assimilation,

@@ -34,6 +34,7 @@ class ReplayJob:
     model_path: str | None
     snapshots: str
     assimilate_drift: bool = True  # the estimator's (twin.estimation.method.EstimatorConfig)
+    fields: str = "every"  # the window ends written as field files
 
 
 @dataclass
@@ -58,7 +59,7 @@ def run_job(job: ReplayJob, spindle=None, overlap: bool = False,  # noqa: ANN001
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
             spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
-            plotter=plotter,
+            plotter=plotter, fields=job.fields,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -89,6 +90,7 @@ def replay_batch(
     progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
+    fields: str = "every",
 ) -> BatchResult:
     """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
 
@@ -116,7 +118,8 @@ def replay_batch(
     todo: list[ReplayJob] = []
     for path, name in named:
         if resume:
-            finished = _finished(out_root / name, path, methods, model_path, assimilate_drift)
+            finished = _finished(out_root / name, path, methods, model_path, assimilate_drift,
+                                 fields)
             if finished is not None:
                 result.accuracies.append(finished)
                 result.skipped.append(name)
@@ -124,7 +127,7 @@ def replay_batch(
                     progress(name, "skipped")
                 continue
         todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
-                              assimilate_drift))
+                              assimilate_drift, fields))
 
     for outcome in _execute(todo, jobs, dask_address, progress, plotter):
         if "ok" in outcome:
@@ -151,11 +154,13 @@ def _refused_folder(folder: Path, path: str, result: BatchResult) -> bool:
 
 
 def _finished(out_dir: Path, path: str, methods: Sequence[str],
-              model_path: str | None, assimilate_drift: bool = True) -> dict | None:
+              model_path: str | None, assimilate_drift: bool = True,
+              fields: str = "every") -> dict | None:
     """The accuracy of a run folder --resume may keep, or None: replay it (again) when its
     token does not match or its accuracy.json is missing or unreadable."""
     try:
-        if not is_done(out_dir, resume_token(path, methods, model_path, assimilate_drift)):
+        if not is_done(out_dir, resume_token(path, methods, model_path, assimilate_drift,
+                                             fields)):
             return None
     except OSError:
         return None

@@ -10,8 +10,10 @@ Layout under DIR/<run-name>/ (shared DESIGN.md):
     decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/),
                                 window_kkk_rerun.inp (a re-run) and window_kkk_start.vtu
                                 (the start field where the decks do not give it)
-    fields/*.vtu + fields.pvd   the primary method's field at every window end
-    snapshots/*.png             field pictures (--snapshots end|every)
+    fields/*.vtu + fields.pvd   the primary method's field at every window end (--fields
+                                every; end: the last one; none: neither)
+    snapshots/*.png             field pictures (--snapshots end|every), drawn from the
+                                replay's own fields, not from the field files
     plots/*.png                 the report's figures of this run
     .done.json                  written last: what --resume checks
 The primary method is bpnn when it runs, else the last method listed.
@@ -43,7 +45,8 @@ from twin.loop.replay import (
 )
 
 DONE_FILE = ".done.json"
-SNAPSHOT_CHOICES = ("none", "end", "every")
+WINDOW_END_CHOICES = ("none", "end", "every")
+"""Which window ends a replay pictures (snapshots) or writes field files of (fields)."""
 
 
 def file_digest(path: str | Path) -> str:
@@ -82,9 +85,13 @@ def check_distinct_names(named: Sequence[tuple[str, str]]) -> None:
 
 
 def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None,
-                 assimilate_drift: bool = True) -> dict:
-    """What must match for a finished run folder to be reused by --resume."""
+                 assimilate_drift: bool = True, fields: str = "every") -> dict:
+    """What must match for a finished run folder to be reused by --resume.  `fields` is
+    part of it unless it is the default: a folder replayed with `--fields none` lacks the
+    files `--fields every` asks for (and a folder of earlier releases had every field)."""
     token = {"input_sha256": file_digest(path), "methods": list(methods)}
+    if fields != "every":
+        token["fields"] = fields
     if "estimator" in methods:
         token["estimator_assimilate_drift"] = bool(assimilate_drift)
     if "bpnn" in methods and model_path is not None:
@@ -114,9 +121,12 @@ def replay_run_to_dir(
     overlap: bool = True,
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
+    fields: str = "every",
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
     `assimilate_drift`: the estimator's option (twin.estimation.method.EstimatorConfig).
+    `snapshots`, `fields`: the window ends pictured and written as field files
+    (`WINDOW_END_CHOICES`).
 
     The folder DIR/<run-name>/ is replaced as a whole (`replaced_folder`): a shorter rerun
     leaves none of the longer run's files, and a failed one leaves no earlier result.
@@ -127,16 +137,17 @@ def replay_run_to_dir(
     imports, so that matplotlib loads on the idle core); used if still fresh, else this
     run forks its own.
     """
-    if snapshots not in SNAPSHOT_CHOICES:
-        raise ValueError(f"snapshots must be one of {SNAPSHOT_CHOICES}, got {snapshots!r}")
+    for option, value in (("snapshots", snapshots), ("fields", fields)):
+        if value not in WINDOW_END_CHOICES:
+            raise ValueError(f"{option} must be one of {WINDOW_END_CHOICES}, got {value!r}")
     with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
         return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
-                            on_window, overlap, assimilate_drift, plotter)
+                            on_window, overlap, assimilate_drift, plotter, fields)
 
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
                  on_window, overlap: bool, assimilate_drift: bool,
-                 plotter: ForkedTask | None) -> dict:  # noqa: ANN001
+                 plotter: ForkedTask | None, fields: str) -> dict:  # noqa: ANN001
     from twin.io.figures import load_matplotlib
     from twin.loop.report import run_plotter
 
@@ -147,7 +158,7 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
         load_matplotlib()  # here, once per process: the plotters of later runs inherit it
     with plotter if fresh else run_plotter(fork=overlap) as plots:
         accuracy, token = _replay_outputs(run_path, out_dir, methods, model_path, snapshots,
-                                          spindle, on_window, plots, assimilate_drift)
+                                          spindle, on_window, plots, assimilate_drift, fields)
         plots.join()
     write_json(out_dir / "accuracy.json", accuracy)
     write_json(out_dir / DONE_FILE, token)
@@ -156,7 +167,8 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
 
 def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
                     on_window, plots: ForkedTask,
-                    assimilate_drift: bool = True) -> tuple[dict, dict]:  # noqa: ANN001
+                    assimilate_drift: bool = True,
+                    fields: str = "every") -> tuple[dict, dict]:  # noqa: ANN001
     """Replay and write every file but accuracy.json and the .done token; `plots` is
     started once keypoints.csv and corrections.csv (what the figures show) are written."""
     from twin.correction.methods import make_corrector
@@ -166,7 +178,7 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     model = spindle if spindle is not None else SpindleModel.load()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
     run = replace(run, name=run_name(run_path))  # as its folder and accuracy.json know it
-    token = resume_token(run_path, methods, model_path, assimilate_drift)
+    token = resume_token(run_path, methods, model_path, assimilate_drift, fields)
     config = None
     if "estimator" in methods:  # its modules load only for the method that uses them
         from twin.estimation.method import EstimatorConfig
@@ -181,8 +193,9 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     primary = primary_method(methods)
 
     results = _replay_methods(run, model, correctors, primary, solver, on_window,
-                              partial(_write_fields, out_dir, model), snapshots,
-                              fork=plots.forked)
+                              partial(_write_fields, out_dir, model, fields), snapshots,
+                              fork=plots.forked,
+                              keep_fields=fields != "none" or snapshots != "none")
 
     first = next(iter(results.values()))
     meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
@@ -228,26 +241,28 @@ def _write_start_state(path: Path, model, w) -> None:  # noqa: ANN001
                     w.start_s, extra)
 
 
-def _snapshot_times(fields: dict[float, np.ndarray], snapshots: str) -> list[float]:
-    """The window ends pictured: none, the last one (end) or all (every)."""
+def _window_ends(fields: dict[float, np.ndarray], choice: str) -> list[float]:
+    """The window ends pictured or written (`WINDOW_END_CHOICES`): none, the last one
+    (end) or all (every)."""
     times = sorted(fields)
-    return {"none": [], "end": times[-1:], "every": times}[snapshots]
+    return {"none": [], "end": times[-1:], "every": times}[choice]
 
 
 def _write_snapshots(out_dir: Path, model, r: MethodReplay, snapshots: str,  # noqa: ANN001
                      title: str) -> None:
     from twin.loop.snapshot import render_snapshot
 
-    for t in _snapshot_times(r.fields, snapshots):
+    for t in _window_ends(r.fields, snapshots):
         render_snapshot(model, r.fields[t], out_dir / "snapshots" / f"{r.method}_t{t:05.0f}s.png",
                         title=f"{title} · {r.method} · t = {t:.0f} s", T_initial_C=r.T_initial_C)
 
 
 def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
                     write_primary_fields: Callable[[MethodReplay], None], snapshots: str,
-                    fork: bool) -> dict[str, MethodReplay]:
+                    fork: bool, keep_fields: bool = True) -> dict[str, MethodReplay]:
     """Every method's replay, by name in the order given; the primary's field files are
-    written by `write_primary_fields` as soon as it is replayed.
+    written by `write_primary_fields` as soon as it is replayed.  `keep_fields`: the
+    primary keeps its window-end fields (for the field files or the snapshots).
 
     With `fork` (and no per-window callback, which could not cross processes) a forked
     child on the second core replays the primary and writes its fields (their structural
@@ -264,14 +279,15 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
         callback = None
         if on_window is not None:
             callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
-        r = replay_method(run, model, corrector, keep_fields=corrector.name == primary,
+        r = replay_method(run, model, corrector,
+                          keep_fields=keep_fields and corrector.name == primary,
                           on_window=callback, solver=solver)
         if r.method == primary:
             write_primary_fields(r)
         return r
 
     def pictured(r: MethodReplay) -> MethodReplay:
-        return replace(r, fields={t: r.fields[t] for t in _snapshot_times(r.fields, snapshots)})
+        return replace(r, fields={t: r.fields[t] for t in _window_ends(r.fields, snapshots)})
 
     def replay_away(_: str) -> str:
         return json.dumps([method_replay_to_json(pictured(replay(c))) for c in away])
@@ -413,10 +429,14 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
     write_csv(path, header, rows)
 
 
-def _write_fields(out_dir: Path, model, r: MethodReplay) -> None:  # noqa: ANN001
+def _write_fields(out_dir: Path, model, fields: str, r: MethodReplay) -> None:  # noqa: ANN001
+    """fields/*.vtu and fields.pvd of the window ends `fields` chooses; none: neither."""
     from twin.io.vtk import write_field_series
     from twin.spindle.fields import field_mesh
 
+    times = _window_ends(r.fields, fields)
+    if not times:
+        return
     write_field_series(out_dir, ((t, f"fields/{r.method}_t{t:05.0f}s.vtu",
                                   field_mesh(model, r.fields[t], r.T_initial_C))
-                                 for t in sorted(r.fields)))
+                                 for t in times))
