@@ -180,25 +180,120 @@ def test_the_two_kinds_of_model_file_are_named_where_the_other_is_expected(ridge
     assert result.exit_code == 2 and "twin drift predict" in result.output
 
 
+def _with_document(raw: bytes, change, path, checksum: bool = True):
+    """A copy of the model file bytes `raw` at `path`, its JSON changed by `change`, and
+    without the JSON's checksum unless `checksum` (a file written before it existed)."""
+    import json
+
+    size = int.from_bytes(raw[:8], "little")
+    header = json.loads(raw[8 : 8 + size])
+    doc = json.loads(header["__metadata__"]["spindle_twin_drift"])
+    if not checksum:
+        del doc["metadata_sha256"]
+    change(doc)
+    header["__metadata__"]["spindle_twin_drift"] = json.dumps(doc, sort_keys=True)
+    text = json.dumps(header).encode()
+    text += b" " * (-len(text) % 8)
+    path.write_bytes(len(text).to_bytes(8, "little") + text + raw[8 + size:])
+    return path
+
+
 def test_damaged_model_metadata_is_refused(ridge_model, data_file, tmp_path):
     # the checksum covered the tensors only: a damaged digit of a reference temperature
     # moved every prediction without a word, a damaged interval rule ended in
     # 'internal error: KeyError'
-    import json
-
-    path = save_drift_model(ridge_model, tmp_path / "model.safetensors")
-    raw = path.read_bytes()
-    size = int.from_bytes(raw[:8], "little")
-    header = json.loads(raw[8 : 8 + size])
-    doc = json.loads(header["__metadata__"]["spindle_twin_drift"])
+    raw = save_drift_model(ridge_model, tmp_path / "model.safetensors").read_bytes()
     for damage in (lambda d: d["features"]["reference_C"].__setitem__(0, 99.0),
                    lambda d: d.__setitem__("interval", {})):
-        damaged = json.loads(json.dumps(doc))
-        damage(damaged)
-        header["__metadata__"]["spindle_twin_drift"] = json.dumps(damaged, sort_keys=True)
-        text = json.dumps(header).encode()
-        text += b" " * (-len(text) % 8)
-        bad = tmp_path / "bad.safetensors"
-        bad.write_bytes(len(text).to_bytes(8, "little") + text + raw[8 + size:])
+        bad = _with_document(raw, damage, tmp_path / "bad.safetensors")
         with pytest.raises(InputError, match="bad.safetensors: checksum mismatch: the metadata"):
             load_drift_model(bad)
+
+
+def _set(*keys_value):
+    *keys, last, value = keys_value
+
+    def change(doc):
+        for key in keys:
+            doc = doc[key]
+        doc[last] = value
+    return change
+
+
+@pytest.mark.parametrize(("change", "field", "message"), [
+    (_set("features", "taus_min", "10,30,90"), "features.taus_min", "valid list"),
+    (_set("features", "taus_min", []), "features.taus_min", "at least 1 item"),
+    (_set("features", "taus_min", [10.0, -30.0, 90.0]), "features.taus_min.1", "greater than 0"),
+    (_set("features", "taus_min", [10.0, 30.0]), "features",
+     "3 sensors and 2 lags make 15 feature columns; the weights take 20"),
+    (_set("features", "reference_C", [20.0]), "features", "1 reference temperatures"),
+    (_set("features", "reference_C", 2, "20.5"), "features.reference_C.2", "valid number"),
+    (_set("features", "reference_C", 0, float("nan")), "features.reference_C.0", "finite"),
+    (_set("features", "sensors", []), "features.sensors", "at least 1 item"),
+    (_set("features", "sensors", "A_C"), "features.sensors", "valid list"),
+    (_set("features", "sensors", 1, "A_C"), "features.sensors", "'A_C' is listed twice"),
+    (_set("features", "sensors", 0, "drift_um"), "features.sensors", "does not end in _C"),
+    (_set("features", "groups", ["rise"]), "features.groups", "takes the feature groups rise, "
+     "lag, speed"),
+    (_set("features", "groups", ["rise", "lags"]), "features.groups.1", "'rise', 'lag'"),
+    (_set("features", "cache", 1), "features.cache", "unknown field"),
+    (_set("interval", {}), "interval.kind", "missing"),
+    (_set("interval", "kind", "gauss"), "interval.kind", "'conformal' or 'scaled_posterior'"),
+    (_set("interval", "kind", "scaled_posterior"), "interval", "kind 'scaled_posterior' needs "
+     "factor"),
+    (_set("interval", "half_width_um", [0.4, 0.4]), "interval.half_width_um", "2 values for 1"),
+    (_set("interval", "half_width_um", "0.4"), "interval.half_width_um", "valid list"),
+    (_set("interval", "half_width_um", [-0.4]), "interval.half_width_um.0",
+     "greater than or equal to 0"),
+    (_set("targets", "drift_um"), "targets", "valid list"),
+    (_set("targets", ["drift_um", "tilt_um"]), "interval.half_width_um", "1 value for 2"),
+    (_set("method", "bayes"), "method", "not those of method 'bayes'"),
+    (_set("method", "mlr"), "features.groups", "'mlr' takes the feature groups rise"),
+    (_set("metadata", []), "metadata", "valid dictionary"),
+    (_set("metadata", "validation", "blocks", "4"), "metadata.validation.blocks", "integer"),
+    (_set("metadata", "validation", "methods", "ridge_dynamic", "rmse_um", {}),
+     "metadata.validation.methods.ridge_dynamic.rmse_um", "no value for target 'drift_um'"),
+    (_set("metadata", "ranking", "sensors", 0, "mean_grade", None),
+     "metadata.ranking.sensors.0.mean_grade", "valid number"),
+])
+def test_damaged_metadata_of_a_file_without_its_checksum_names_the_field(
+        ridge_model, data_file, tmp_path, change, field, message):
+    # a file written before the JSON had a checksum loads unchecked by it: a damaged lag
+    # list or interval rule ended in 'internal error: ...', a damaged width moved the band
+    from twin.errors import MetadataError
+
+    raw = save_drift_model(ridge_model, tmp_path / "model.safetensors").read_bytes()
+    older = _with_document(raw, lambda d: None, tmp_path / "older.safetensors", checksum=False)
+    assert load_drift_model(older).interval == ridge_model.interval     # still loads
+    bad = _with_document(raw, change, tmp_path / "bad.safetensors", checksum=False)
+    with pytest.raises(MetadataError) as err:
+        load_drift_model(bad)
+    assert (err.value.file, err.value.column) == (str(bad), field)
+    assert message in err.value.reason
+    assert f"bad.safetensors, metadata field '{field}': " in str(err.value)
+    result = CliRunner().invoke(app_of_twin(), ["drift", "predict", str(bad), str(data_file),
+                                                "--out", str(tmp_path / "p.csv")])
+    assert result.exit_code == 2, result.output
+    assert field in result.output and "Traceback" not in result.output
+
+
+def app_of_twin():
+    from twin.cli import app
+
+    return app
+
+
+def test_metadata_nested_too_deeply_is_bad_input(ridge_model, tmp_path):
+    # json.loads of 10^5 nested lists raised RecursionError: 'internal error'
+    raw = save_drift_model(ridge_model, tmp_path / "model.safetensors").read_bytes()
+    bad = tmp_path / "deep.safetensors"
+    bad.write_bytes(raw)
+    deep = _with_document(raw, _set("metadata", "x", []), bad, checksum=False).read_bytes()
+    size = int.from_bytes(deep[:8], "little")
+    text = deep[8 : 8 + size].replace(b'\\"x\\": []', b'\\"x\\": ' + b"[" * 100_000
+                                      + b"]" * 100_000)
+    assert len(text) > size
+    text += b" " * (-len(text) % 8)
+    bad.write_bytes(len(text).to_bytes(8, "little") + text + deep[8 + size:])
+    with pytest.raises(InputError, match="deep.safetensors"):
+        load_drift_model(bad)

@@ -37,7 +37,7 @@ def with_metadata(tmp_path, change):
                                             ("training_runs", 7), ("config", [])])
 def test_defect6_model_metadata_of_wrong_type(tmp_path, key, value):
     path = with_metadata(tmp_path, lambda m: m.__setitem__(key, value))
-    with pytest.raises(InputError, match=f"metadata field {key}") as info:
+    with pytest.raises(InputError, match=f"m.safetensors, metadata field '{key}") as info:
         load_model(path)
     assert info.value.file == str(path)
     result = cli("model-info", path)

@@ -84,6 +84,33 @@ class TomlError(InputError):
         super().__init__(message, file=file, row=line, column=key)
 
 
+class MetadataError(InputError):
+    """A model file's metadata field that is missing, of the wrong type or inconsistent:
+    `model.safetensors, metadata field 'features.taus_min': ...`; told as a table's
+    "column", a user looked for a column in a model file."""
+
+    COLUMN = "metadata field"
+
+    def __init__(self, message: str, *, file: str | None = None,
+                 field: str | None = None) -> None:
+        super().__init__(message, file=file, column=field)
+
+    @classmethod
+    def from_validation(cls, exc: Any, file: str) -> MetadataError:
+        """The first problem of a pydantic `ValidationError` (duck-typed: this module
+        loads no library), at its dotted field."""
+        first = exc.errors()[0]
+        field = ".".join(str(k) for k in first["loc"]) or None
+        # pydantic's words for a nested model ("a valid dictionary or instance of
+        # Metadata") name a class of ours, not anything in the file
+        message = first["msg"].removeprefix("Value error, ").split(" or instance of ")[0]
+        if first["type"] == "missing":
+            message = "missing"
+        elif first["type"] == "extra_forbidden":
+            message = "unknown field"
+        return cls(message, file=file, field=field)
+
+
 def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     """Wrap a CLI command: `InputError` → one line and exit 2, anything unexpected → one
     line and exit 1 (no traceback either way), Ctrl-C → 130, a closed pipe → 141."""

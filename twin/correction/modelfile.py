@@ -35,7 +35,7 @@ from twin.correction.features import (
     kind_of,
 )
 from twin.correction.network import CONFIGS, NetConfig, TrainedNet
-from twin.errors import InputError
+from twin.errors import InputError, MetadataError
 from twin.io.atomic import write_bytes
 from twin.paths import read_input_bytes
 
@@ -167,10 +167,7 @@ def load_model(path: str | Path, option: str | None = "--model") -> CorrectionMo
     try:
         _Metadata.model_validate(meta)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        field = ".".join(str(k) for k in err["loc"])
-        raise InputError(f"metadata field {field}: {err['msg']}", file=str(path),
-                         column=field) from None
+        raise MetadataError.from_validation(exc, str(path)) from None
     if meta.get("version") != VERSION:
         raise InputError(
             f"model version {meta.get('version')!r} is not supported (expected {VERSION})",

@@ -7,7 +7,9 @@ targets, feature spec, interval rule, metadata (ranking, validation), a SHA-256 
 tensors and one of the rest of that JSON (the reference temperatures and interval
 widths are numbers there too: a damaged digit moved every prediction or band silently;
 files written before it load without that check).  Loading reads tensors and JSON only
-(no unpickling) and checks them.  As for the correction model, the checksums detect
+(no unpickling) and checks them: the JSON's fields by their types (`twin.drift.modeldoc`,
+what guards a file written before the JSON's checksum), the tensors against the method,
+features and targets they must fit.  As for the correction model, the checksums detect
 corruption, not forgery.
 """
 
@@ -19,12 +21,15 @@ import os
 from pathlib import Path
 
 import numpy as np
+from pydantic import ValidationError
 
 from twin.drift.features import FeatureSpec
 from twin.drift.methods import METHODS
 from twin.drift.model import DriftModel
-from twin.errors import InputError
+from twin.drift.modeldoc import ModelDocument
+from twin.errors import InputError, MetadataError
 from twin.io.atomic import write_bytes
+from twin.paths import read_input_bytes
 
 FORMAT = "spindle-twin-drift"
 VERSION = 1
@@ -81,15 +86,13 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
     from safetensors.numpy import load
 
     file = str(path)
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read the model file: {exc.strerror}", file=file) from None
+    raw = read_input_bytes(path)
     try:
         tensors = load(raw)
         header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
         doc = json.loads(header["__metadata__"][METADATA_KEY])
-    except (SafetensorError, ValueError, KeyError, TypeError, UnicodeDecodeError):
+    except (SafetensorError, ValueError, KeyError, TypeError, UnicodeDecodeError,
+            RecursionError):
         if _is_correction_model(raw):
             raise InputError("is a correction model (twin train), not a drift model: use it "
                              "with 'twin replay --model' or 'twin model-info'",
@@ -112,11 +115,43 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
         raise InputError("checksum mismatch: the metadata (sensors, reference temperatures, "
                          "interval) were modified or damaged", file=file)
     try:
-        spec = FeatureSpec.from_json(doc["features"])
-        params = {k: v for k, v in tensors.items() if not k.startswith(VALIDATION)}
-        validation = {k[len(VALIDATION):]: v for k, v in tensors.items()
-                      if k.startswith(VALIDATION)}
-        return DriftModel(doc["method"], list(doc["targets"]), spec, params,
-                          dict(doc["interval"]), dict(doc.get("metadata", {})), validation)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(f"malformed model metadata: {exc}", file=file) from None
+        checked = ModelDocument.model_validate(doc)
+    except ValidationError as exc:
+        raise MetadataError.from_validation(exc, file) from None
+    except RecursionError:
+        raise MetadataError("nested too deeply", file=file) from None
+    problem = checked.per_target_problem()
+    if problem is not None:
+        raise MetadataError(problem[1], file=file, field=problem[0])
+    spec = FeatureSpec.from_json(doc["features"])
+    params = {k: v for k, v in tensors.items() if not k.startswith(VALIDATION)}
+    _check_weights_fit(checked, spec, params, file)
+    validation = {k[len(VALIDATION):]: v for k, v in tensors.items() if k.startswith(VALIDATION)}
+    return DriftModel(checked.method, list(checked.targets), spec, params,
+                      dict(doc["interval"]), dict(doc.get("metadata", {})), validation)
+
+
+def _check_weights_fit(doc: ModelDocument, spec: FeatureSpec, params: dict[str, np.ndarray],
+                       file: str) -> None:
+    """MetadataError unless the weights are the method's and take the features' columns
+    and give the targets (the tensors have their own checksum: the JSON is what is off)."""
+    method = METHODS[doc.method]
+    if spec.groups != method.groups:
+        raise MetadataError(f"method {doc.method!r} takes the feature groups "
+                            f"{', '.join(method.groups)}", file=file, field="features.groups")
+    columns = len(spec.names)
+    for name, array in params.items():
+        if name.endswith("x_offset") and array.shape != (columns,):
+            raise MetadataError(
+                f"{len(spec.sensors)} sensors and {len(spec.taus_min)} lags make {columns} "
+                f"feature columns; the weights take {array.shape[0] if array.ndim else 0}",
+                file=file, field="features")
+    try:
+        mean, std = method.predict(params, np.zeros((2, columns)))
+    except (KeyError, ValueError, IndexError):
+        raise MetadataError(f"the weights are not those of method {doc.method!r}",
+                            file=file, field="method") from None
+    p = len(doc.targets)
+    if mean.shape != (2, p) or (std is not None and std.shape != (2, p)):
+        raise MetadataError(f"{p} targets; the weights predict {mean.shape[-1]}", file=file,
+                            field="targets")
