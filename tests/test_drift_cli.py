@@ -299,3 +299,27 @@ def test_listed_sensors_need_not_be_the_first_files_every_column(tmp_path):
                  "--method", "ridge_dynamic", "--sensors", "A_C,C_C", "--quiet")
     assert result.exit_code == 2, result.output
     assert f"{second}, row 1, column 'C_C': required column is missing" in result.output
+
+
+def test_an_empty_speed_column_is_no_speed_column(tmp_path):
+    # a logger exporting every channel wrote speed_rpm without a value: fit refused it
+    # ('the column holds no value in any row') where a file without the column fitted
+    # with the methods that need no speed
+    first, second = _two_files(tmp_path, lambda c: c["speed_rpm"].__setitem__(slice(None),
+                                                                              np.nan))
+    out = tmp_path / "m.safetensors"
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert "ridge_lagged" in result.output and "ridge_dynamic" not in result.output
+    message = " ".join(result.output.split())
+    assert (f"note: {second}, column 'speed_rpm', rows 2–241: no value in any row: read as "
+            "no speed column") in message
+    pred = tmp_path / "p.csv"
+    assert run("predict", str(out), str(second), "--out", str(pred)).exit_code == 0
+    # a model that uses the speed still needs its values
+    speed_model = tmp_path / "speed.safetensors"
+    assert run("fit", str(first), "--target", "drift_um", "--out", str(speed_model),
+               "--method", "ridge_dynamic", "--quiet").exit_code == 0
+    result = run("predict", str(speed_model), str(second), "--out", str(pred))
+    assert result.exit_code == 2, result.output
+    assert f"{second}, row 2, column 'speed_rpm': the column holds no value" in result.output

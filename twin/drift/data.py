@@ -95,6 +95,10 @@ def _check_time(table: RawTable) -> np.ndarray:
     return t
 
 
+def _has_values(table: RawTable, name: str) -> bool:
+    return name in table.columns and not np.all(np.isnan(table.columns[name]))
+
+
 def _check_not_empty(table: RawTable, name: str) -> np.ndarray:
     values = table.columns[name]
     if np.all(np.isnan(values)):
@@ -122,11 +126,12 @@ def bridge_gaps(values: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
     return x, [(int(a), int(b)) for a, b in gaps]
 
 
-def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]]) -> list[dict]:
+def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
+                  repair: str | None = None) -> list[dict]:
     out = []
     for a, b in gaps:
-        how = ("leading gap: first reading used for the rows before it" if a == 0
-               else "gap bridged causally: last reading held")
+        how = repair or ("leading gap: first reading used for the rows before it" if a == 0
+                         else "gap bridged causally: last reading held")
         out.append({"file": table.file, "column": name, "first_row": int(table.rows[a]),
                     "last_row": int(table.rows[b]), "n_rows": b - a + 1, "repair": how})
     return out
@@ -155,7 +160,9 @@ def drift_data(
             raise InputError("no temperature columns (names ending in _C)", file=first.file,
                              row=first.header_row)
     sensors, targets = list(sensors), list(targets)
-    use_speed = require_speed or all(SPEED in t.columns for t in tables)
+    # speed is optional: a column without any value (a logger that exports every channel
+    # it has) is no speed, as a file without one
+    use_speed = require_speed or all(_has_values(t, SPEED) for t in tables)
     times, speeds, temps, drifts, rows, starts, findings = [], [], [], [], [], [], []
     n = 0
     for table in tables:
@@ -178,6 +185,9 @@ def drift_data(
             speed, gaps = bridge_gaps(_check_not_empty(table, SPEED))
             findings += _gap_findings(table, SPEED, gaps)
             speeds.append(speed)
+        elif SPEED in table.columns and not _has_values(table, SPEED):
+            findings += _gap_findings(table, SPEED, [(0, t.size - 1)],
+                                      "no value in any row: read as no speed column")
         if targets and all(name in table.columns for name in targets):
             drifts.append(np.stack([_check_not_empty(table, name) for name in targets], axis=1))
         else:
