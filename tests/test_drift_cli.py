@@ -323,3 +323,41 @@ def test_an_empty_speed_column_is_no_speed_column(tmp_path):
     result = run("predict", str(speed_model), str(second), "--out", str(pred))
     assert result.exit_code == 2, result.output
     assert f"{second}, row 2, column 'speed_rpm': the column holds no value" in result.output
+
+
+@pytest.mark.parametrize("sensors", ["auto", "all", "2"])
+def test_a_temperature_column_one_file_lacks_is_left_out_whichever_file_comes_first(
+        tmp_path, sensors):
+    # the first file's columns were required in every file: a second file without C_C
+    # was refused ('required column is missing'), a first one without it fitted in
+    # silence without C_C
+    first, second = _two_files(tmp_path, lambda c: c.pop("C_C"))
+    models = []
+    for k, files in enumerate(((first, second), (second, first))):
+        out = tmp_path / f"m{k}.safetensors"
+        result = run("fit", *map(str, files), "--target", "drift_um", "--out", str(out),
+                     "--method", "ridge_dynamic", "--sensors", sensors)
+        assert result.exit_code == 0, result.output
+        message = " ".join(result.output.split())
+        assert f"note: temperature column 'C_C' left out: not in {second}" in message
+        models.append(out)
+    from twin.drift.modelfile import load_drift_model
+
+    for out in models:
+        model = load_drift_model(out)
+        assert set(model.spec.sensors) <= {"A_C", "B_C"}
+        assert model.metadata["sensors_left_out"] == {"C_C": [str(second)]}
+    result = run("select", str(second), str(first), "--target", "drift_um")
+    assert result.exit_code == 0, result.output
+    assert "'C_C' left out" in result.output and "C_C " not in result.output
+
+
+def test_files_without_a_common_temperature_column_are_bad_input(tmp_path):
+    first, second = _two_files(tmp_path, lambda c: [c.__setitem__(f"{k[0]}2_C", c.pop(k))
+                                                    for k in ("A_C", "B_C", "C_C")])
+    result = run("fit", str(first), str(second), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"))
+    assert result.exit_code == 2, result.output
+    message = " ".join(result.output.split())
+    assert (f"{first}, {second}: no temperature column is in every file ({first}: A_C, B_C, "
+            f"C_C; {second}: A2_C, B2_C, C2_C)") in message

@@ -9,12 +9,16 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from twin.cli.inputs import MAX_SEED
 from twin.errors import InputError, report_errors
 from twin.io.destinations import check_out_dir, check_out_file
+
+if TYPE_CHECKING:
+    from twin.drift.data import DriftData
 
 drift_app = typer.Typer(
     name="drift",
@@ -58,12 +62,16 @@ def _progress(quiet: bool):
     return tell
 
 
-def _report_findings(findings: list[dict], quiet: bool) -> None:
+def _report_findings(data: DriftData, quiet: bool) -> None:
     if quiet:
         return
-    for f in findings:
+    for f in data.findings:
         typer.echo(f"note: {f['file']}, column {f['column']!r}, rows {f['first_row']}–"
                    f"{f['last_row']}: {f['repair']}", err=True)
+    for name, files in data.left_out.items():
+        typer.echo(f"note: temperature column {name!r} left out: not in {', '.join(files)} "
+                   "(only the columns every file holds are sensors; --sensors LIST names "
+                   "them)", err=True)
 
 
 @drift_app.command("fit")
@@ -101,7 +109,7 @@ def fit(
     tell = _progress(quiet)
     tell(f"reading {len(data)} file(s)")
     drift_data = read_drift_data(data, sensors=listed, targets=targets)
-    _report_findings(drift_data.findings, quiet)
+    _report_findings(drift_data, quiet)
     model = fit_drift_model(drift_data, method=method, sensors=sensors, seed=seed,
                             progress=tell)
     save_drift_model(model, out)
@@ -139,7 +147,7 @@ def predict(
     model = load_drift_model(model_file)
     drift_data = read_drift_data([data], sensors=model.spec.sensors, targets=model.targets,
                                  require_targets=False, require_speed=model.spec.uses_speed)
-    _report_findings(drift_data.findings, quiet)
+    _report_findings(drift_data, quiet)
     mean, lo, hi = model.predict(drift_data)
     write_predictions(out, model, drift_data, mean, lo, hi)
     if not quiet:
@@ -164,7 +172,7 @@ def report(
     model = load_drift_model(model_file)
     drift_data = read_drift_data(data, sensors=model.spec.sensors, targets=model.targets,
                                  require_targets=True, require_speed=model.spec.uses_speed)
-    _report_findings(drift_data.findings, quiet)
+    _report_findings(drift_data, quiet)
     metrics, metrics_path, html_path = write_drift_report(out, model, drift_data,
                                                           model_file.name)
     if not quiet:
@@ -191,6 +199,7 @@ def select(
         check_out_file(out, inputs=data, suffixes=(".json",))
     _check_inputs(data)
     drift_data = read_drift_data(data, targets=_targets(target))
+    _report_findings(drift_data, quiet=False)
     ranking = sensor_ranking(drift_data)
     rows = ranking.to_json()["sensors"][: top or None]
     typer.echo(f"{'sensor':12s} {'grade':>6s} {'cluster':>7s}  kept")

@@ -54,7 +54,8 @@ class DriftData:
     `T_C` (n, m) holds the temperature columns `sensors`; `targets_um` (n, p) the
     displacement columns `targets` (NaN where not measured, or None when the files hold
     none of them).  `segment_starts` are the first row of every file; `rows` the row of
-    every sample in its file (1-based line of a CSV file).
+    every sample in its file (1-based line of a CSV file).  `left_out` maps a temperature
+    column some files hold but not all (so not among the sensors) to the files lacking it.
     """
 
     files: list[str]
@@ -67,6 +68,7 @@ class DriftData:
     segment_starts: np.ndarray
     rows: np.ndarray
     findings: list[dict] = field(default_factory=list)
+    left_out: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
@@ -137,6 +139,30 @@ def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
     return out
 
 
+def _check_temperatures(table: RawTable) -> list[str]:
+    names = temperature_columns(table)
+    if not names:
+        raise InputError("no temperature columns (names ending in _C)", file=table.file,
+                         row=table.header_row)
+    return names
+
+
+def common_temperatures(tables: Sequence[RawTable]) -> tuple[list[str], dict[str, list[str]]]:
+    """The temperature columns every table holds (in the first's order), and the others
+    with the files lacking each: a sensor one file lacks cannot be a feature of a model
+    fitted on all of them, whichever file is given first."""
+    held = [_check_temperatures(table) for table in tables]
+    common = [n for n in held[0] if all(n in names for names in held)]
+    left_out = {n: [t.file for t, names in zip(tables, held, strict=True) if n not in names]
+                for names in held for n in names if n not in common}
+    if not common:
+        listing = "; ".join(f"{t.file}: {', '.join(names)}"
+                            for t, names in zip(tables, held, strict=True))
+        raise InputError(f"no temperature column is in every file ({listing})",
+                         file=", ".join(t.file for t in tables))
+    return common, left_out
+
+
 def drift_data(
     tables: Sequence[RawTable],
     sensors: Sequence[str] | None = None,
@@ -146,19 +172,17 @@ def drift_data(
 ) -> DriftData:
     """Check the tables and assemble a `DriftData`.
 
-    `sensors` None takes every temperature column (the first file's, which every further
-    file must also hold); `targets` must be present in every file when `require_targets`.
+    `sensors` None takes the temperature columns every file holds (in the first file's
+    order; the others are `left_out`, whichever file comes first); `targets` must be
+    present in every file when `require_targets`.
     """
     if not tables:
         raise InputError("no data file given")
     check_distinct_tables(tables, "validation holds one file out per block and would "
                           "score it against a model fitted on its copy")
-    first = tables[0]
+    left_out: dict[str, list[str]] = {}
     if sensors is None:
-        sensors = temperature_columns(first)
-        if not sensors:
-            raise InputError("no temperature columns (names ending in _C)", file=first.file,
-                             row=first.header_row)
+        sensors, left_out = common_temperatures(tables)
     sensors, targets = list(sensors), list(targets)
     # speed is optional: a column without any value (a logger that exports every channel
     # it has) is no speed, as a file without one
@@ -167,9 +191,7 @@ def drift_data(
     n = 0
     for table in tables:
         t = _check_time(table)
-        if not temperature_columns(table):
-            raise InputError("no temperature columns (names ending in _C)", file=table.file,
-                             row=table.header_row)
+        _check_temperatures(table)
         wanted = [*sensors, *([SPEED] if use_speed else [])]
         if require_targets:
             wanted += targets
@@ -203,7 +225,7 @@ def drift_data(
         speed_rpm=np.concatenate(speeds) if use_speed else None, sensors=sensors,
         T_C=np.concatenate(temps), targets=targets, targets_um=targets_um,
         segment_starts=np.asarray(starts, dtype=np.int64), rows=np.concatenate(rows),
-        findings=findings)
+        findings=findings, left_out=left_out)
 
 
 def read_drift_data(

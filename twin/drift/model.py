@@ -216,6 +216,8 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
                        "methods": {r.name: r.to_json(data.targets) for r in results}},
         "data_findings": data.findings,
     }
+    if data.left_out:
+        metadata["sensors_left_out"] = data.left_out
     validation = {"time_s": data.time_s[rows], "block": blocks.astype(float), "measured_um": Y,
                   "predicted_um": result.predicted, "lo_um": result.lo, "hi_um": result.hi}
     return DriftModel(best, list(data.targets), spec,
