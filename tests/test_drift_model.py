@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tests.drift_synthetic import synthetic_columns, write_csv
+from twin.data import bundled_path
 from twin.drift.data import read_drift_data
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
 from twin.drift.folds import block_labels
@@ -113,9 +114,49 @@ def test_no_temperature_columns(tmp_path):
 def test_time_going_back_names_the_line(tmp_path):
     columns = synthetic_columns(hours=0.5)
     columns["time_s"][10] = columns["time_s"][8]
-    with pytest.raises(InputError, match="does not increase") as err:
+    with pytest.raises(InputError, match="goes back from 135 s .line 11. to 120 s") as err:
         _read(tmp_path, columns)
     assert (err.value.row, err.value.column) == (12, "time_s")   # header is line 1
+
+
+def test_a_repeated_time_is_an_error(tmp_path):
+    columns = synthetic_columns(hours=0.5)
+    columns["time_s"][10] = columns["time_s"][9]
+    with pytest.raises(InputError, match="time 135 s repeats that of line 11") as err:
+        _read(tmp_path, columns)
+    assert (err.value.row, err.value.column) == (12, "time_s")
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+@pytest.mark.parametrize("change", [
+    lambda c: c.pop("time_s"),
+    lambda c: c.pop("T3_C"),
+    lambda c: c["speed_rpm"].__setitem__(slice(None), np.nan),
+    lambda c: c["time_s"].__setitem__(7, np.nan),
+    lambda c: c["time_s"].__setitem__(7, 1.0),
+], ids=["no_time", "no_T3", "empty_speed", "time_missing", "time_back"])
+def test_the_drift_and_run_readers_refuse_a_file_in_the_same_words(tmp_path, suffix, change):
+    # each reader had its own words for the same fault: 'no time column' / 'missing
+    # required column', 'the column holds no value in any row' / 'column has no values',
+    # 'time does not increase (1 s after 10 s)' / 'time goes back from 10 s (line 20) to 1 s'
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from twin.runs import read_run, read_table
+
+    columns = dict(read_table(bundled_path("runs", "spindle_9000rpm_30min.csv")).columns)
+    change(columns)
+    path = tmp_path / f"bad{suffix}"
+    if suffix == ".parquet":
+        pq.write_table(pa.table(columns), path)
+    else:
+        write_csv(path, columns)
+    with pytest.raises(InputError) as run_error:
+        read_run(path)
+    with pytest.raises(InputError) as drift_error:
+        read_drift_data([path], sensors=["T1_C", "T3_C"], targets=["disp_x_um"],
+                        require_speed=True)
+    assert str(drift_error.value) == str(run_error.value)
 
 
 def test_all_nan_column_is_an_error(tmp_path):

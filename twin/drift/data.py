@@ -2,8 +2,9 @@
 
 DESIGN.md, "Data-driven drift models": CSV or Parquet (`# key: value` lines allowed) with
 `time_s`, optional `speed_rpm`, any number of temperature columns `*_C` and displacement
-columns `*_um`.  The files are read with the recorded-run readers (`twin.runs`), so line
-numbers and error messages follow the same conventions.  Every file is its own continuous
+columns `*_um`.  The files are read and their columns and time checked with the
+recorded-run readers and checks (`twin.runs`), so a file both refuse is refused in the
+same words, at the same line and column.  Every file is its own continuous
 series (a *segment*): features restart at its first row.
 
 Gaps (NaN) in temperatures and speed are bridged causally — the last reading holds — and
@@ -24,6 +25,7 @@ from twin.errors import InputError
 from twin.runs import read_table
 from twin.runs.schema import SPEED, TIME
 from twin.runs.table import RawTable, check_distinct_tables
+from twin.runs.validate import checked_time, column_with_values, required_column
 
 TEMPERATURE_SUFFIX = "_C"
 DISPLACEMENT_SUFFIX = "_um"
@@ -81,32 +83,8 @@ class DriftData:
         return np.cumsum(ids)
 
 
-def _check_time(table: RawTable) -> np.ndarray:
-    if TIME not in table.columns:
-        raise InputError("no time column", file=table.file, row=table.header_row, column=TIME)
-    t = table.columns[TIME]
-    bad = np.flatnonzero(np.isnan(t))
-    if bad.size:
-        raise InputError("time is missing", file=table.file, row=int(table.rows[bad[0]]),
-                         column=TIME)
-    back = np.flatnonzero(np.diff(t) <= 0)
-    if back.size:
-        i = int(back[0]) + 1
-        raise InputError(f"time does not increase ({t[i]:g} s after {t[i - 1]:g} s)",
-                         file=table.file, row=int(table.rows[i]), column=TIME)
-    return t
-
-
 def _has_values(table: RawTable, name: str) -> bool:
     return name in table.columns and not np.all(np.isnan(table.columns[name]))
-
-
-def _check_not_empty(table: RawTable, name: str) -> np.ndarray:
-    values = table.columns[name]
-    if np.all(np.isnan(values)):
-        raise InputError("the column holds no value in any row", file=table.file,
-                         row=int(table.rows[0]), column=name)
-    return values
 
 
 def bridge_gaps(values: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
@@ -190,28 +168,26 @@ def drift_data(
     times, speeds, temps, drifts, rows, starts, findings = [], [], [], [], [], [], []
     n = 0
     for table in tables:
-        t = _check_time(table)
+        t = checked_time(table, repeats=False)
         _check_temperatures(table)
         wanted = [*sensors, *([SPEED] if use_speed else [])]
         if require_targets:
             wanted += targets
         for name in wanted:
-            if name not in table.columns:
-                raise InputError("required column is missing", file=table.file,
-                                 row=table.header_row, column=name)
+            required_column(table, name)
         T = np.empty((t.size, len(sensors)))
         for j, name in enumerate(sensors):
-            T[:, j], gaps = bridge_gaps(_check_not_empty(table, name))
+            T[:, j], gaps = bridge_gaps(column_with_values(table, name))
             findings += _gap_findings(table, name, gaps)
         if use_speed:
-            speed, gaps = bridge_gaps(_check_not_empty(table, SPEED))
+            speed, gaps = bridge_gaps(column_with_values(table, SPEED))
             findings += _gap_findings(table, SPEED, gaps)
             speeds.append(speed)
         elif SPEED in table.columns and not _has_values(table, SPEED):
             findings += _gap_findings(table, SPEED, [(0, t.size - 1)],
                                       "no value in any row: read as no speed column")
         if targets and all(name in table.columns for name in targets):
-            drifts.append(np.stack([_check_not_empty(table, name) for name in targets], axis=1))
+            drifts.append(np.stack([column_with_values(table, name) for name in targets], axis=1))
         else:
             drifts.append(np.full((t.size, len(targets)), np.nan))
         times.append(t)

@@ -2,7 +2,9 @@
 
 Each raises `InputError` naming the file, the row (1-based line in a CSV file) and the
 column.  Anything a repair can fix (duplicates, dropouts, spikes, stuck or noisy sensors)
-is left to `twin.runs.quality`.
+is left to `twin.runs.quality`.  The column and time checks (`required_column`,
+`column_with_values`, `checked_time`) serve the drift data too (`twin.drift.data`), so a
+file refused by both commands is refused in the same words.
 """
 
 from __future__ import annotations
@@ -31,35 +33,58 @@ FAHRENHEIT_AIR_RANGE_C = (OPERATING_TEMPERATURE_C[1], 130.0)
 to the second is Fahrenheit: 45–130 °F is 7–54 °C, any room or coolant logged in °F."""
 
 
-def check_structure(table: RawTable) -> None:
-    """Required columns present, each with values (but for dead thermocouples, while one
-    is left), time readable and non-decreasing."""
-    for name in REQUIRED:
-        if name not in table.columns:
-            raise InputError("missing required column", file=table.file, row=table.header_row,
-                             column=name)
-    for name in REQUIRED:
-        # a thermocouple with no value in the whole run is a dead channel, which the
-        # repair excludes; the run is refused only when no temperature sensor is left
-        if name not in TEMPERATURES and np.isnan(table.columns[name]).all():
-            raise InputError("column has no values", file=table.file,
-                             row=int(table.rows[0]), column=name)
-    if all(np.isnan(table.columns[name]).all() for name in TEMPERATURES):
-        raise InputError("no temperature sensor has a value (T1_C..T5_C all empty)",
-                         file=table.file, row=int(table.rows[0]), column=TEMPERATURES[0])
-    time = table.columns[TIME]
+def required_column(table: RawTable, name: str) -> np.ndarray:
+    """The column `name`, or InputError at the header if the file lacks it."""
+    if name not in table.columns:
+        raise InputError("missing required column", file=table.file, row=table.header_row,
+                         column=name)
+    return table.columns[name]
+
+
+def column_with_values(table: RawTable, name: str) -> np.ndarray:
+    """The column `name` (`required_column`), or InputError if no row holds a value."""
+    values = required_column(table, name)
+    if np.isnan(values).all():
+        raise InputError("column has no values", file=table.file, row=int(table.rows[0]),
+                         column=name)
+    return values
+
+
+def checked_time(table: RawTable, *, repeats: bool = True) -> np.ndarray:
+    """The time column, every row holding one, in time order; a time repeating the one
+    before is refused unless `repeats` (a run merges such samples, drift features do not)."""
+    time = required_column(table, TIME)
     missing = np.flatnonzero(np.isnan(time))
     if missing.size:
         raise InputError("time is missing", file=table.file, row=int(table.rows[missing[0]]),
                          column=TIME)
-    back = np.flatnonzero(np.diff(time) < 0)
-    if back.size:
-        i = int(back[0])
-        raise InputError(
-            f"time goes back from {time[i]:g} s ({table.row_unit} {table.rows[i]}) to "
-            f"{time[i + 1]:g} s; "
-            "samples must be in time order", file=table.file, row=int(table.rows[i + 1]),
-            column=TIME)
+    step = np.diff(time)
+    wrong = np.flatnonzero(step < 0 if repeats else step <= 0)
+    if wrong.size:
+        i = int(wrong[0])
+        where = f"{table.row_unit} {table.rows[i]}"
+        what = (f"time goes back from {time[i]:g} s ({where}) to {time[i + 1]:g} s; samples "
+                "must be in time order" if step[i] < 0 else
+                f"time {time[i]:g} s repeats that of {where}; each sample needs a later time "
+                "than the one before")
+        raise InputError(what, file=table.file, row=int(table.rows[i + 1]), column=TIME)
+    return time
+
+
+def check_structure(table: RawTable) -> None:
+    """Required columns present, each with values (but for dead thermocouples, while one
+    is left), time readable and non-decreasing."""
+    for name in REQUIRED:
+        required_column(table, name)
+    for name in REQUIRED:
+        # a thermocouple with no value in the whole run is a dead channel, which the
+        # repair excludes; the run is refused only when no temperature sensor is left
+        if name not in TEMPERATURES:
+            column_with_values(table, name)
+    if all(np.isnan(table.columns[name]).all() for name in TEMPERATURES):
+        raise InputError("no temperature sensor has a value (T1_C..T5_C all empty)",
+                         file=table.file, row=int(table.rows[0]), column=TEMPERATURES[0])
+    checked_time(table)
 
 
 def check_values(table: RawTable) -> None:
