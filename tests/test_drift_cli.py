@@ -361,3 +361,21 @@ def test_files_without_a_common_temperature_column_are_bad_input(tmp_path):
     message = " ".join(result.output.split())
     assert (f"{first}, {second}: no temperature column is in every file ({first}: A_C, B_C, "
             f"C_C; {second}: A2_C, B2_C, C2_C)") in message
+
+
+def test_predict_reads_no_target_so_an_empty_one_is_no_error(machine, tmp_path):
+    # a file with the probe's column left blank (the drift yet to come) was refused:
+    # 'column has no values'; predict needs time, speed and temperatures only
+    _, _, model = machine
+    columns = synthetic_columns(hours=0.5)
+    full, blank = tmp_path / "full.csv", tmp_path / "blank.csv"
+    write_csv(full, columns)
+    columns["drift_um"][:] = np.nan
+    write_csv(blank, columns)
+    pred, again = tmp_path / "p_blank.csv", tmp_path / "p_full.csv"
+    result = run("predict", str(model), str(blank), "--out", str(pred))
+    assert result.exit_code == 0, result.output
+    assert run("predict", str(model), str(full), "--out", str(again)).exit_code == 0
+    assert pred.read_bytes() == again.read_bytes()
+    result = run("report", str(model), str(blank), "--out", str(tmp_path / "report"))
+    assert result.exit_code == 2 and "column 'drift_um': column has no values" in result.output
