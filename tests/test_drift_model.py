@@ -159,6 +159,29 @@ def test_the_drift_and_run_readers_refuse_a_file_in_the_same_words(tmp_path, suf
     assert str(drift_error.value) == str(run_error.value)
 
 
+def test_rows_a_logger_sent_twice_are_dropped_as_a_runs_are(ridge_model, tmp_path):
+    # a logger re-sending its buffer wrote rows 50-59 again: the run reader drops such
+    # copies, the drift reader refused the file ('time ... does not increase')
+    columns = synthetic_columns(hours=0.5)
+    again = {k: np.concatenate([v[:60], v[50:60], v[60:]]) for k, v in columns.items()}
+    once, twice = tmp_path / "once.csv", tmp_path / "twice.csv"
+    write_csv(once, columns)
+    write_csv(twice, again)
+    names = list(ridge_model.spec.sensors)
+    a = read_drift_data([once], sensors=names, targets=["drift_um"])
+    b = read_drift_data([twice], sensors=names, targets=["drift_um"])
+    for x, y in zip(ridge_model.predict(a), ridge_model.predict(b), strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert [(f["column"], f["first_row"], f["last_row"], f["n_rows"]) for f in b.findings] == [
+        ("time_s", 62, 71, 10)]                   # header is line 1, the copies lines 62-71
+    assert "exact copies" in b.findings[0]["repair"]
+    columns["A_C"][9] += 0.5                      # the same time with other values
+    columns["time_s"][9] = columns["time_s"][8]
+    write_csv(once, columns)
+    with pytest.raises(InputError, match="time 120 s repeats that of line 10"):
+        read_drift_data([once], sensors=names, targets=["drift_um"])
+
+
 def test_all_nan_column_is_an_error(tmp_path):
     columns = synthetic_columns(hours=0.5)
     columns["B_C"][:] = np.nan

@@ -7,7 +7,8 @@ recorded-run readers and checks (`twin.runs`), so a file both refuse is refused 
 same words, at the same line and column.  Every file is its own continuous
 series (a *segment*): features restart at its first row.
 
-Gaps (NaN) in temperatures and speed are bridged causally — the last reading holds — and
+Rows repeating an earlier row exactly are dropped, as a run's are (`twin.runs.quality`);
+gaps (NaN) in temperatures and speed are bridged causally — the last reading holds — and
 reported; a sensor that starts with a gap takes its first reading for the rows before it
 (the one place a value is taken from later rows, reported as such).  Targets keep their
 NaN: those rows are left out of fitting and metrics.
@@ -23,6 +24,7 @@ import numpy as np
 
 from twin.errors import InputError
 from twin.runs import read_table
+from twin.runs.quality import drop_repeated_rows, true_runs
 from twin.runs.schema import SPEED, TIME
 from twin.runs.table import RawTable, check_distinct_tables
 from twin.runs.validate import checked_time, column_with_values, required_column
@@ -96,14 +98,13 @@ def bridge_gaps(values: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
     missing = np.isnan(x)
     if not missing.any():
         return x, []
-    edges = np.diff(np.concatenate([[0], missing.view(np.int8), [0]]))
-    gaps = list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True))
+    gaps = true_runs(missing)
     idx = np.where(missing, 0, np.arange(x.size))
     np.maximum.accumulate(idx, out=idx)
     first_valid = int(np.flatnonzero(~missing)[0])
     x = x[idx]
     x[:first_valid] = values[first_valid]
-    return x, [(int(a), int(b)) for a, b in gaps]
+    return x, gaps
 
 
 def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
@@ -115,6 +116,17 @@ def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
         out.append({"file": table.file, "column": name, "first_row": int(table.rows[a]),
                     "last_row": int(table.rows[b]), "n_rows": b - a + 1, "repair": how})
     return out
+
+
+def _without_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
+    """The table without the rows that repeat an earlier one exactly (a logger re-sending
+    its buffer), as the recorded-run reader drops them, and a finding per block dropped."""
+    kept, _ = drop_repeated_rows(table)
+    if kept is table:
+        return table, []
+    dropped = ~np.isin(table.rows, kept.rows)
+    return kept, _gap_findings(table, TIME, true_runs(dropped),
+                               "exact copies of earlier rows: dropped")
 
 
 def _check_temperatures(table: RawTable) -> list[str]:
@@ -168,6 +180,8 @@ def drift_data(
     times, speeds, temps, drifts, rows, starts, findings = [], [], [], [], [], [], []
     n = 0
     for table in tables:
+        table, repeats = _without_repeated_rows(table)
+        findings += repeats
         t = checked_time(table, repeats=False)
         _check_temperatures(table)
         wanted = [*sensors, *([SPEED] if use_speed else [])]

@@ -69,7 +69,7 @@ def finding(column: str, kind: str, action: str, *, rows: np.ndarray | None = No
             "rows": rows_list, "spans_s": spans, "action": action, "detail": detail}
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive (start, end) index pairs of the True runs in a boolean array."""
     padded = np.concatenate([[False], mask, [False]])
     edges = np.flatnonzero(np.diff(padded.astype(np.int8)))
@@ -121,7 +121,7 @@ def drop_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
                     rows=table.rows[keep], header_row=table.header_row,
                     ignored_columns=table.ignored_columns, row_unit=table.row_unit)
     time = table.columns[TIME]
-    spans = [(float(time[a] - time[0]), float(time[b] - time[0])) for a, b in _runs(repeated)]
+    spans = [(float(time[a] - time[0]), float(time[b] - time[0])) for a, b in true_runs(repeated)]
     found = finding(TIME, "repeated_rows", "dropped (exact copies of earlier rows)",
                     rows=table.rows[repeated], spans_s=spans, count=int(repeated.sum()),
                     detail=f"{len(spans)} block(s) of rows repeated verbatim, as a logger "
@@ -183,7 +183,7 @@ def remove_spikes(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     out = x.copy()
     idx = ok[spikes]
     out[idx] = med[spikes]
-    spans = [(float(t[ok[a]]), float(t[ok[b]])) for a, b in _runs(spikes)]
+    spans = [(float(t[ok[a]]), float(t[ok[b]])) for a, b in true_runs(spikes)]
     return out, [finding(name, "spike", "replaced by the running median of "
                          f"{2 * cfg.spike_half_window + 1} samples", rows=rows[idx],
                          spans_s=spans, count=int(idx.size),
@@ -204,7 +204,7 @@ def _jumps_away_and_back(ok: np.ndarray, t: np.ndarray, v: np.ndarray,
     accepted = ~candidates
     clean = np.flatnonzero(accepted)
     tv = t[ok]
-    for a, b in _runs(candidates):
+    for a, b in true_runs(candidates):
         before = [int(i) for i in clean[clean < a][-2:]]
         after = [int(i) for i in clean[clean > b][:2]][::-1]  # nearest last, as `before`
         for order, pair in ((range(a, b + 1), before), (range(b, a - 1, -1), after)):
@@ -230,7 +230,7 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     # Beyond the first/last value the nearest value is held (np.interp clamps).
     out[missing] = np.interp(t[missing], t[ok], x[ok])
     short_rows, long_rows, short_spans, long_spans = [], [], [], []
-    for a, b in _runs(missing):
+    for a, b in true_runs(missing):
         left = t[a - 1] if a > 0 else t[a]
         right = t[b + 1] if b + 1 < x.size else t[b]
         if right - left > cfg.max_gap_s:
@@ -311,7 +311,7 @@ def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
         mask = np.zeros(x.size, dtype=bool)
         # (a) exactly repeated values for a long stretch while another sensor moves
         same = np.concatenate([[False], x[ok][1:] == x[ok][:-1]])
-        for a, b in _runs(same):
+        for a, b in true_runs(same):
             a -= 1  # the run starts at the first of the equal values
             i0, i1 = ok[a], ok[b]
             if t[i1] - t[i0] < cfg.stuck_min_s or b - a + 1 < 5:
@@ -328,7 +328,7 @@ def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
             mask[:] = True
         if mask.any():
             stuck[name] = mask
-            spans = [(t[a], t[b]) for a, b in _runs(mask)]
+            spans = [(t[a], t[b]) for a, b in true_runs(mask)]
             found.append(finding(name, "stuck", "excluded from metrics and correction inputs",
                                  rows=rows[mask], spans_s=spans, count=int(mask.sum()),
                                  detail="flat while the other temperature sensors move"))
