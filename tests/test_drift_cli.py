@@ -346,7 +346,8 @@ def test_a_temperature_column_one_file_lacks_is_left_out_whichever_file_comes_fi
     for out in models:
         model = load_drift_model(out)
         assert set(model.spec.sensors) <= {"A_C", "B_C"}
-        assert model.metadata["sensors_left_out"] == {"C_C": [str(second)]}
+        assert model.metadata["sensors_left_out"] == {
+            "C_C": f"not in {second} (a sensor is in every file)"}
     result = run("select", str(second), str(first), "--target", "drift_um")
     assert result.exit_code == 0, result.output
     assert "'C_C' left out" in result.output and "C_C " not in result.output
@@ -379,3 +380,33 @@ def test_predict_reads_no_target_so_an_empty_one_is_no_error(machine, tmp_path):
     assert pred.read_bytes() == again.read_bytes()
     result = run("report", str(model), str(blank), "--out", str(tmp_path / "report"))
     assert result.exit_code == 2 and "column 'drift_um': column has no values" in result.output
+
+
+def test_a_temperature_column_that_never_changes_is_no_sensor(tmp_path):
+    # a thermocouple reading 21 °C throughout got a grade (0.59, its normalised series all
+    # zero) and a cluster of its own, so 'auto' fitted on it
+    columns = synthetic_columns(hours=3.0)
+    columns["K_C"] = np.full(columns["time_s"].size, 21.0)
+    columns["K_C"][5:9] = np.nan                       # gaps aside
+    data = tmp_path / "machine.csv"
+    write_csv(data, columns)
+    out = tmp_path / "m.safetensors"
+    for sensors in ("auto", "all"):
+        result = run("fit", str(data), "--target", "drift_um", "--out", str(out),
+                     "--method", "ridge_dynamic", "--sensors", sensors)
+        assert result.exit_code == 0, result.output
+        assert ("note: temperature column 'K_C' left out: reads 21 in every row (tells "
+                "nothing)") in " ".join(result.output.split())
+        assert "K_C" not in result.output.split("sensors:")[1]
+    result = run("select", str(data), "--target", "drift_um")
+    assert result.exit_code == 0 and "K_C " not in result.output
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(out), "--quiet",
+                 "--method", "ridge_dynamic", "--sensors", "A_C,K_C")   # asked for: used
+    assert result.exit_code == 0, result.output
+    for name in ("A_C", "B_C", "C_C"):
+        columns[name][:] = 20.0 + len(name)
+    write_csv(data, columns)
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(out))
+    assert result.exit_code == 2, result.output
+    assert "every temperature column (A_C, B_C, C_C, K_C) reads one value" in " ".join(
+        result.output.split())

@@ -68,10 +68,8 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
     for f in data.findings:
         typer.echo(f"note: {f['file']}, column {f['column']!r}, rows {f['first_row']}–"
                    f"{f['last_row']}: {f['repair']}", err=True)
-    for name, files in data.left_out.items():
-        typer.echo(f"note: temperature column {name!r} left out: not in {', '.join(files)} "
-                   "(only the columns every file holds are sensors; --sensors LIST names "
-                   "them)", err=True)
+    for name, why in data.left_out.items():
+        typer.echo(f"note: temperature column {name!r} left out: {why}", err=True)
 
 
 @drift_app.command("fit")

@@ -59,7 +59,7 @@ class DriftData:
     displacement columns `targets` (NaN where not measured, or None when the files hold
     none of them).  `segment_starts` are the first row of every file; `rows` the row of
     every sample in its file (1-based line of a CSV file).  `left_out` maps a temperature
-    column some files hold but not all (so not among the sensors) to the files lacking it.
+    column not taken as a sensor (`usable_temperatures`) to the reason.
     """
 
     files: list[str]
@@ -72,7 +72,7 @@ class DriftData:
     segment_starts: np.ndarray
     rows: np.ndarray
     findings: list[dict] = field(default_factory=list)
-    left_out: dict[str, list[str]] = field(default_factory=dict)
+    left_out: dict[str, str] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
@@ -137,20 +137,37 @@ def _check_temperatures(table: RawTable) -> list[str]:
     return names
 
 
-def common_temperatures(tables: Sequence[RawTable]) -> tuple[list[str], dict[str, list[str]]]:
-    """The temperature columns every table holds (in the first's order), and the others
-    with the files lacking each: a sensor one file lacks cannot be a feature of a model
-    fitted on all of them, whichever file is given first."""
+def _constant_value(tables: Sequence[RawTable], name: str) -> float | None:
+    """The one value column `name` holds in every row of every table (gaps aside), or
+    None if it changes (or holds none: refused where its values are read)."""
+    values = np.concatenate([t.columns[name] for t in tables])
+    values = values[~np.isnan(values)]
+    return float(values[0]) if values.size and np.ptp(values) == 0 else None
+
+
+def usable_temperatures(tables: Sequence[RawTable]) -> tuple[list[str], dict[str, str]]:
+    """The temperature columns every table holds (in the first's order) and that change,
+    and why each other one is left out: a sensor one file lacks cannot be a feature of a
+    model fitted on all of them, whichever file is given first, and one that never
+    changes tells nothing (its grade and correlation cluster are artefacts)."""
     held = [_check_temperatures(table) for table in tables]
+    files = ", ".join(t.file for t in tables)
     common = [n for n in held[0] if all(n in names for names in held)]
-    left_out = {n: [t.file for t, names in zip(tables, held, strict=True) if n not in names]
-                for names in held for n in names if n not in common}
     if not common:
         listing = "; ".join(f"{t.file}: {', '.join(names)}"
                             for t, names in zip(tables, held, strict=True))
-        raise InputError(f"no temperature column is in every file ({listing})",
-                         file=", ".join(t.file for t in tables))
-    return common, left_out
+        raise InputError(f"no temperature column is in every file ({listing})", file=files)
+    left_out = {n: "not in " + ", ".join(t.file for t, names in zip(tables, held, strict=True)
+                                         if n not in names) + " (a sensor is in every file)"
+                for names in held for n in names if n not in common}
+    constant = {n: v for n in common if (v := _constant_value(tables, n)) is not None}
+    if len(constant) == len(common):
+        raise InputError(f"every temperature column ({', '.join(common)}) reads one value "
+                         "throughout: no sensor tells how the machine warms (--sensors LIST "
+                         "uses them anyway)", file=files)
+    left_out.update({n: f"reads {v:g} in every row (tells nothing)"
+                     for n, v in constant.items()})
+    return [n for n in common if n not in constant], left_out
 
 
 def drift_data(
@@ -162,17 +179,17 @@ def drift_data(
 ) -> DriftData:
     """Check the tables and assemble a `DriftData`.
 
-    `sensors` None takes the temperature columns every file holds (in the first file's
-    order; the others are `left_out`, whichever file comes first); `targets` must be
-    present in every file when `require_targets`.
+    `sensors` None takes the temperature columns every file holds and that change (in the
+    first file's order; the others are `left_out`, whichever file comes first); `targets`
+    must be present in every file when `require_targets`.
     """
     if not tables:
         raise InputError("no data file given")
     check_distinct_tables(tables, "validation holds one file out per block and would "
                           "score it against a model fitted on its copy")
-    left_out: dict[str, list[str]] = {}
+    left_out: dict[str, str] = {}
     if sensors is None:
-        sensors, left_out = common_temperatures(tables)
+        sensors, left_out = usable_temperatures(tables)
     sensors, targets = list(sensors), list(targets)
     # speed is optional: a column without any value (a logger that exports every channel
     # it has) is no speed, as a file without one
