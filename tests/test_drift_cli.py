@@ -410,3 +410,22 @@ def test_a_temperature_column_that_never_changes_is_no_sensor(tmp_path):
     assert result.exit_code == 2, result.output
     assert "every temperature column (A_C, B_C, C_C, K_C) reads one value" in " ".join(
         result.output.split())
+
+
+def test_predictions_keep_a_unix_time_as_read(machine, tmp_path):
+    # PRED.csv wrote time_s to 6 digits: every row of a logger's Unix time read 1.7e+09
+    _, data, model = machine
+    columns = synthetic_columns(hours=0.5)
+    predictions = []
+    for start in (0.0, 1_700_000_000.25):
+        columns["time_s"] += start
+        data = tmp_path / f"from_{start:.0f}.csv"
+        data.write_text("\n".join([",".join(columns)] + [
+            ",".join(repr(float(v)) for v in row) for row in zip(*columns.values(),
+                                                                   strict=True)]))
+        pred = tmp_path / f"p_{start:.0f}.csv"
+        assert run("predict", str(model), str(data), "--out", str(pred)).exit_code == 0
+        with open(pred) as fh:
+            predictions.append(list(csv.reader(fh))[1:])
+    np.testing.assert_array_equal([float(r[0]) for r in predictions[1]], columns["time_s"])
+    assert [r[1:] for r in predictions[0]] == [r[1:] for r in predictions[1]]
