@@ -414,18 +414,27 @@ def test_a_temperature_column_that_never_changes_is_no_sensor(tmp_path):
 
 def test_predictions_keep_a_unix_time_as_read(machine, tmp_path):
     # PRED.csv wrote time_s to 6 digits: every row of a logger's Unix time read 1.7e+09
-    _, data, model = machine
+    _, _, model = machine
     columns = synthetic_columns(hours=0.5)
+
+    def write_exactly(path):
+        path.write_text("\n".join([",".join(columns)] + [
+            ",".join(repr(float(v)) for v in row) for row in zip(*columns.values(),
+                                                                   strict=True)]))
+
     predictions = []
     for start in (0.0, 1_700_000_000.25):
         columns["time_s"] += start
         data = tmp_path / f"from_{start:.0f}.csv"
-        data.write_text("\n".join([",".join(columns)] + [
-            ",".join(repr(float(v)) for v in row) for row in zip(*columns.values(),
-                                                                   strict=True)]))
+        write_exactly(data)
         pred = tmp_path / f"p_{start:.0f}.csv"
         assert run("predict", str(model), str(data), "--out", str(pred)).exit_code == 0
         with open(pred) as fh:
             predictions.append(list(csv.reader(fh))[1:])
     np.testing.assert_array_equal([float(r[0]) for r in predictions[1]], columns["time_s"])
     assert [r[1:] for r in predictions[0]] == [r[1:] for r in predictions[1]]
+    columns["time_s"][7] = columns["time_s"][6]        # and an error names the time read
+    write_exactly(data)
+    result = run("predict", str(model), str(data), "--out", str(pred))
+    assert result.exit_code == 2 and "time 1700000090.25 s repeats that of line 8" in (
+        " ".join(result.output.split()))

@@ -63,10 +63,11 @@ def checked_time(table: RawTable, *, repeats: bool = True) -> np.ndarray:
     if wrong.size:
         i = int(wrong[0])
         where = f"{table.row_unit} {table.rows[i]}"
-        what = (f"time goes back from {time[i]:g} s ({where}) to {time[i + 1]:g} s; samples "
-                "must be in time order" if step[i] < 0 else
-                f"time {time[i]:g} s repeats that of {where}; each sample needs a later time "
-                "than the one before")
+        # to 15 digits: a logger's Unix time (1.7e9 s) read the same at both rows as %g
+        what = (f"time goes back from {time[i]:.15g} s ({where}) to {time[i + 1]:.15g} s; "
+                "samples must be in time order" if step[i] < 0 else
+                f"time {time[i]:.15g} s repeats that of {where}; each sample needs a later "
+                "time than the one before")
         raise InputError(what, file=table.file, row=int(table.rows[i + 1]), column=TIME)
     return time
 
@@ -100,7 +101,7 @@ def check_values(table: RawTable) -> None:
     if duration > MAX_DURATION_S:
         i = int(np.flatnonzero(time - time[0] > MAX_DURATION_S)[0])
         raise InputError(
-            f"time {time[i]:g} s lies more than {MAX_DURATION_S:g} s after the first sample; "
+            f"time {time[i]:.15g} s lies more than {MAX_DURATION_S:g} s after the first sample; "
             f"a run may last at most {MAX_DURATION_S / 3600:g} h", file=table.file,
             row=int(table.rows[i]), column=TIME)
     interval = float(np.median(np.diff(unique_time)))
