@@ -149,7 +149,8 @@ def predict(
     mean, lo, hi = model.predict(drift_data)
     write_predictions(out, model, drift_data, mean, lo, hi)
     if not quiet:
-        typer.echo(f"wrote {out} ({drift_data.n_samples} rows)")
+        rows = drift_data.n_samples
+        typer.echo(f"wrote {out} ({rows} row{'s' * (rows != 1)})")
 
 
 @drift_app.command("report")
