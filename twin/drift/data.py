@@ -219,9 +219,8 @@ def drift_data(
                                       "no value in any row: read as no speed column")
         if targets and all(name in table.columns for name in targets):
             # predict reads no target: a column left blank for the drift to come is none
-            read = column_with_values if require_targets else lambda table, name: (
-                table.columns[name])
-            drifts.append(np.stack([read(table, name) for name in targets], axis=1))
+            drifts.append(np.stack([column_with_values(table, name) if require_targets
+                                    else table.columns[name] for name in targets], axis=1))
         else:
             drifts.append(np.full((t.size, len(targets)), np.nan))
         times.append(t)
