@@ -155,8 +155,13 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
         sys.exit(EXIT_INTERNAL_ERROR)
     except Exception as exc:  # noqa: BLE001 - click's errors, vendored or not, told here
         if type(exc).__name__ == "NoArgsIsHelpError":  # as typer's rich_format_error tells it
-            app(prog_name=prog_name)  # nothing ran: the help, as typer prints it (exit 2)
-            return
+            # nothing ran: the help, exit 2.  The error made it (ctx.get_help()), and typer's
+            # rich help prints itself there and leaves the message empty; calling the app
+            # again to print it showed the help twice
+            help_text = exc.format_message()  # type: ignore[attr-defined]  # a UsageError
+            if help_text:
+                print(help_text)
+            sys.exit(EXIT_INPUT_ERROR)
         format_message = getattr(exc, "format_message", None)
         if format_message is None:
             print(f"internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
