@@ -171,6 +171,13 @@ def test_fahrenheit_ambient(tmp_path):
     expect_error(write(tmp_path, csv_text(cols)), 2, "ambient_C", "Fahrenheit")
 
 
+def test_fahrenheit_ambient_from_mid_run_names_the_first_row_in_fahrenheit(tmp_path):
+    # a logger switched to °F at sample 60: the error points there, not at the first row
+    cols = warmup()
+    cols["ambient_C"][60:] = cols["ambient_C"][60:] * 1.8 + 32.0
+    expect_error(write(tmp_path, csv_text(cols)), 62, "ambient_C", "Fahrenheit")
+
+
 def test_fahrenheit_sensor(tmp_path):
     cols = warmup()
     cols["T5_C"] = cols["T5_C"] * 1.8 + 32.0

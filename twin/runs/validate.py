@@ -141,10 +141,12 @@ def _check_celsius(table: RawTable, name: str) -> None:
             f"(subtract 273.15)", file=table.file, row=row, column=name)
     lo, hi = FAHRENHEIT_AIR_RANGE_C
     if name in (AMBIENT, COOLANT) and lo < median <= hi:
+        # the first row past the °C range: where a logger switched units mid-run
+        above = int(np.flatnonzero(values > lo)[0])
         raise InputError(
             f"values look like Fahrenheit (median {median:.1f}, an implausible air/coolant "
-            "temperature in °C); the column must be in °C", file=table.file, row=row,
-            column=name)
+            "temperature in °C); the column must be in °C", file=table.file,
+            row=int(table.rows[above]), column=name)
     if name in TEMPERATURES:
         # A run starts near ambient; a sensor reading 1.8·ambient + 32 at the start,
         # far above the ambient, is logging Fahrenheit.
