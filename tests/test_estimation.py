@@ -290,6 +290,27 @@ def test_the_band_learns_the_run_s_own_misfit(tmp_path, spindle_model):
     assert 80.0 <= coverage[1] <= 97.0
 
 
+def test_each_thermocouple_s_band_learns_its_own_misfit(tmp_path, spindle_model):
+    """One noisy thermocouple (T5, 0.25 K) among quiet ones (0.02 K): its band widens to its
+    noise and covers about 90 % of its samples, the quiet ones' stay narrow.  With one band
+    variance and scale shared by T1..T5, the quiet sensors carried a share of T5's noise
+    and T5 was covered too little (the pooled coverage alone looked right)."""
+    def noisy_housing(t, temps):
+        temps[:, 4] += 0.25 * np.random.default_rng(5).standard_normal(t.size)
+
+    run = make_run(tmp_path / "t5.csv", spindle_model, minutes=10, edit=noisy_housing)
+    replay = estimate(run, spindle_model, sensor_lag_s=0.0)[1]
+    lo, hi = band_of(replay)
+    late = replay.time_s > 300
+    width = np.mean((hi - lo)[late, :5], axis=0)
+    meas = run.at(replay.time_s)
+    coverage = [band_coverage(meas.T_C[late, j:j + 1], lo[late, j:j + 1], hi[late, j:j + 1])
+                for j in range(5)]
+    assert 1.645 * 2 * 0.25 * 0.8 < width[4] < 1.645 * 2 * 0.25 * 1.5
+    assert np.all(width[:4] < 0.5 * width[4])
+    assert 80.0 <= coverage[4] <= 97.0
+
+
 def test_band_coverage_counts_finite_samples_inside():
     measured = np.array([[1.0, np.nan], [2.0, 5.0], [3.0, 0.0]])
     lo = np.array([[0.5, 0.0], [2.5, 4.0], [3.5, np.nan]])
