@@ -311,6 +311,24 @@ def test_each_thermocouple_s_band_learns_its_own_misfit(tmp_path, spindle_model)
     assert 80.0 <= coverage[4] <= 97.0
 
 
+def test_the_prior_s_first_window_miss_does_not_widen_the_band(tmp_path, spindle_model):
+    """A front bearing at 2.2× its nominal heat (2.6 prior σ): the first window runs kelvins
+    cold, the first analysis puts the twin back within a few tenths, and the band after it
+    stays a few tenths wide.  Learned from window 0's misfit (the prior's error, which
+    the analysis removes), T1's band was 35 K wide in window 1 and still 8 K in window 5."""
+    factors = {**TRUE_FACTORS, "H_front": 2.2}
+    run = make_run(tmp_path / "hot.csv", spindle_model, minutes=6, factors=factors)
+    replay = estimate(run, spindle_model, sensor_lag_s=0.0)[1]
+    lo, hi = band_of(replay)
+    meas = run.at(replay.time_s)
+    after = replay.time_s > 60
+    error = np.abs(replay.T_twin_C - meas.T_C)[after, 0]
+    assert np.max(error) < 0.5  # the analysis did its job
+    assert np.max((hi - lo)[after, 0]) < 2.0
+    # and it still holds the samples (a twin of the exact model: hardly any miss)
+    assert band_coverage(meas.T_C[after], lo[after, :5], hi[after, :5]) >= 70.0
+
+
 def test_band_coverage_counts_finite_samples_inside():
     measured = np.array([[1.0, np.nan], [2.0, 5.0], [3.0, 0.0]])
     lo = np.array([[0.5, 0.0], [2.5, 4.0], [3.5, np.nan]])

@@ -216,7 +216,10 @@ Band
     suites' runs sit at 89–91 %.  With one variance and scale shared by T1..T5 (before
     2026-11-27) the pooled coverage was 90 % but the housing's T5 was covered 58–84 % and
     the rings' T1/T3 94–100 % on nearly every run, and where the speed changed every 20–40 s
-    T5 (within 0.23 K of the twin) carried the rings' 4.3 K band.
+    T5 (within 0.23 K of the twin) carried the rings' 4.3 K band.  Window 0 teaches the
+    band nothing: its misfit is the prior's error, which the first analysis removes.
+    Learned from it, a front bearing at 2.2× its nominal heat (2.6 prior σ) left T1's band
+    35 K wide in window 1 and 8 K in window 5 while the twin was within 0.35 K.
 
 Stops: at 0 rpm the bearing and motor heat are zero, so their factors have no effect; a
 stopped window's analysis keeps their mean and spread (what would move them is only
@@ -459,7 +462,8 @@ class EnsembleEstimator:
                 self._rng,
             )
         else:
-            self._calibrate_band(f)
+            if f.window > 1:  # window 0 missed by the prior's error: not the band's to learn
+                self._calibrate_band(f)
             with threadpool_limits(1):
                 self._ensemble = self._analysis(f)
         ens = self._ensemble
