@@ -608,6 +608,37 @@ def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
     assert abs(after - before) < 0.05
 
 
+def test_speed_changes_on_window_boundaries_leave_the_factors_free(tmp_path, spindle_model):
+    """The speed changes every minute on the minute: each window runs at the speed its
+    forecast had, so each analysis may move the factors.  They were all held (the next
+    window's speed differing from the last forecast's read as an unforeseen change), and
+    the factors stayed at the prior's 1.0 for the whole run."""
+    from twin.runs import write_run
+
+    model = spindle_model
+    speeds = [4000.0, 9000.0, 13000.0, 6000.0, 11000.0, 3000.0, 12000.0, 8000.0]
+    T = np.full(model.n_dofs, 24.0)
+    times, temps = [0.0], [model.sensor_matrix @ T]
+    for speed in np.repeat(speeds, 15):  # loads at the rings' temperatures every step
+        s = model.sensor_matrix @ T
+        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
+                                T_sleeves_C=(s[1], s[3]))
+        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
+        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
+            times.append(times[-1] + 4.0)
+            temps.append(model.sensor_matrix @ T_step)
+        T = T_step
+    t, temps = np.array(times), np.array(temps)
+    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
+    write_run(tmp_path / "steps.csv", {"time_s": t, "speed_rpm": speed_col,
+                                       "ambient_C": np.full(t.size, 24.0),
+                                       **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
+    est, replay, _ = estimate(read_run(tmp_path / "steps.csv"), model, sensor_lag_s=0.0)
+    found = factors_of(est.config.parameters, np.array(list(est.log_factors.values())))
+    assert abs(found["H_front"] / TRUE_FACTORS["H_front"] - 1.0) < 0.1, found
+    assert abs(found["motor"] - 1.0) > 0.05, found  # moved off the prior (truth 1.2)
+
+
 @pytest.mark.slow
 def test_on_a_plant_suite_the_estimator_beats_open_loop_and_its_band_is_calibrated(tmp_path):
     """A small suite of the emulated spindle (model-form error, steps, stops, faults): the
