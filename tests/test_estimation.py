@@ -49,6 +49,29 @@ def make_run(path, model, minutes=12, factors=TRUE_FACTORS, edit=None):
     return read_run(path)
 
 
+def minute_speeds_run(path, model, speeds):  # noqa: ANN001, ANN201 - a twin.runs.Run
+    """A recorded run of the twin model with `TRUE_FACTORS`, one speed (rpm) per minute
+    changing on the minute, its loads following its rings every 4 s step, no noise."""
+    from twin.runs import write_run
+
+    T = np.full(model.n_dofs, 24.0)
+    times, temps = [0.0], [model.sensor_matrix @ T]
+    for speed in np.repeat(speeds, 15):
+        s = model.sensor_matrix @ T
+        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
+                                T_sleeves_C=(s[1], s[3]))
+        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
+        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
+            times.append(times[-1] + 4.0)
+            temps.append(model.sensor_matrix @ T_step)
+        T = T_step
+    t, temps = np.array(times), np.array(temps)
+    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
+    write_run(path, {"time_s": t, "speed_rpm": speed_col, "ambient_C": np.full(t.size, 24.0),
+                     **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
+    return read_run(path)
+
+
 def estimate(run, model, **config):
     est = EnsembleEstimator(model, EstimatorConfig(**config))
     windows = []
@@ -569,27 +592,9 @@ def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
 
 
 def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
-    from twin.runs import write_run
-
     model = spindle_model
     speeds = [9000.0] * 5 + [0.0] * 4 + [9000.0] * 3  # rpm per minute: a 4-minute stop
-    T = np.full(model.n_dofs, 24.0)
-    times, temps = [0.0], [model.sensor_matrix @ T]
-    for speed in np.repeat(speeds, 15):  # loads at the rings' temperatures every step
-        s = model.sensor_matrix @ T
-        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
-                                T_sleeves_C=(s[1], s[3]))
-        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
-        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
-            times.append(times[-1] + 4.0)
-            temps.append(model.sensor_matrix @ T_step)
-        T = T_step
-    t, temps = np.array(times), np.array(temps)
-    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
-    write_run(tmp_path / "stop.csv", {"time_s": t, "speed_rpm": speed_col,
-                                      "ambient_C": np.full(t.size, 24.0),
-                                      **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
-    run = read_run(tmp_path / "stop.csv")
+    run = minute_speeds_run(tmp_path / "stop.csv", model, speeds)
     est, replay, windows = estimate(run, model, sensor_lag_s=0.0)  # the data have no lag
     stopped = [c for k, (c, _) in enumerate(windows) if speeds[k] == 0.0]
     assert stopped and all(c.H_front_W_m3 == 0.0 and c.H_rear_W_m3 == 0.0 for c in stopped)
@@ -613,27 +618,10 @@ def test_speed_changes_on_window_boundaries_leave_the_factors_free(tmp_path, spi
     forecast had, so each analysis may move the factors.  They were all held (the next
     window's speed differing from the last forecast's read as an unforeseen change), and
     the factors stayed at the prior's 1.0 for the whole run."""
-    from twin.runs import write_run
-
     model = spindle_model
     speeds = [4000.0, 9000.0, 13000.0, 6000.0, 11000.0, 3000.0, 12000.0, 8000.0]
-    T = np.full(model.n_dofs, 24.0)
-    times, temps = [0.0], [model.sensor_matrix @ T]
-    for speed in np.repeat(speeds, 15):  # loads at the rings' temperatures every step
-        s = model.sensor_matrix @ T
-        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
-                                T_sleeves_C=(s[1], s[3]))
-        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
-        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
-            times.append(times[-1] + 4.0)
-            temps.append(model.sensor_matrix @ T_step)
-        T = T_step
-    t, temps = np.array(times), np.array(temps)
-    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
-    write_run(tmp_path / "steps.csv", {"time_s": t, "speed_rpm": speed_col,
-                                       "ambient_C": np.full(t.size, 24.0),
-                                       **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
-    est, replay, _ = estimate(read_run(tmp_path / "steps.csv"), model, sensor_lag_s=0.0)
+    run = minute_speeds_run(tmp_path / "steps.csv", model, speeds)
+    est, _, _ = estimate(run, model, sensor_lag_s=0.0)
     found = factors_of(est.config.parameters, np.array(list(est.log_factors.values())))
     assert abs(found["H_front"] / TRUE_FACTORS["H_front"] - 1.0) < 0.1, found
     assert abs(found["motor"] - 1.0) > 0.05, found  # moved off the prior (truth 1.2)
