@@ -49,6 +49,29 @@ def make_run(path, model, minutes=12, factors=TRUE_FACTORS, edit=None):
     return read_run(path)
 
 
+def minute_speeds_run(path, model, speeds):  # noqa: ANN001, ANN201 - a twin.runs.Run
+    """A recorded run of the twin model with `TRUE_FACTORS`, one speed (rpm) per minute
+    changing on the minute, its loads following its rings every 4 s step, no noise."""
+    from twin.runs import write_run
+
+    T = np.full(model.n_dofs, 24.0)
+    times, temps = [0.0], [model.sensor_matrix @ T]
+    for speed in np.repeat(speeds, 15):
+        s = model.sensor_matrix @ T
+        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
+                                T_sleeves_C=(s[1], s[3]))
+        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
+        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
+            times.append(times[-1] + 4.0)
+            temps.append(model.sensor_matrix @ T_step)
+        T = T_step
+    t, temps = np.array(times), np.array(temps)
+    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
+    write_run(path, {"time_s": t, "speed_rpm": speed_col, "ambient_C": np.full(t.size, 24.0),
+                     **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
+    return read_run(path)
+
+
 def estimate(run, model, **config):
     est = EnsembleEstimator(model, EstimatorConfig(**config))
     windows = []
@@ -288,6 +311,45 @@ def test_the_band_learns_the_run_s_own_misfit(tmp_path, spindle_model):
     assert widths[1] > widths[0] + 0.05  # the quiet band is mostly the members' spread
     assert 1.645 * 2 * 0.15 * 0.8 < widths[1] < 1.645 * 2 * 0.15 * 1.5
     assert 80.0 <= coverage[1] <= 97.0
+
+
+def test_each_thermocouple_s_band_learns_its_own_misfit(tmp_path, spindle_model):
+    """One noisy thermocouple (T5, 0.25 K) among quiet ones (0.02 K): its band widens to its
+    noise and covers about 90 % of its samples, the quiet ones' stay narrow.  With one band
+    variance and scale shared by T1..T5, the quiet sensors carried a share of T5's noise
+    and T5 was covered too little (the pooled coverage alone looked right)."""
+    def noisy_housing(t, temps):
+        temps[:, 4] += 0.25 * np.random.default_rng(5).standard_normal(t.size)
+
+    run = make_run(tmp_path / "t5.csv", spindle_model, minutes=10, edit=noisy_housing)
+    replay = estimate(run, spindle_model, sensor_lag_s=0.0)[1]
+    lo, hi = band_of(replay)
+    late = replay.time_s > 300
+    width = np.mean((hi - lo)[late, :5], axis=0)
+    meas = run.at(replay.time_s)
+    coverage = [band_coverage(meas.T_C[late, j:j + 1], lo[late, j:j + 1], hi[late, j:j + 1])
+                for j in range(5)]
+    assert 1.645 * 2 * 0.25 * 0.8 < width[4] < 1.645 * 2 * 0.25 * 1.5
+    assert np.all(width[:4] < 0.5 * width[4])
+    assert 80.0 <= coverage[4] <= 97.0
+
+
+def test_the_prior_s_first_window_miss_does_not_widen_the_band(tmp_path, spindle_model):
+    """A front bearing at 2.2× its nominal heat (2.6 prior σ): the first window runs kelvins
+    cold, the first analysis puts the twin back within a few tenths, and the band after it
+    stays a few tenths wide.  Learned from window 0's misfit (the prior's error, which
+    the analysis removes), T1's band was 35 K wide in window 1 and still 8 K in window 5."""
+    factors = {**TRUE_FACTORS, "H_front": 2.2}
+    run = make_run(tmp_path / "hot.csv", spindle_model, minutes=6, factors=factors)
+    replay = estimate(run, spindle_model, sensor_lag_s=0.0)[1]
+    lo, hi = band_of(replay)
+    meas = run.at(replay.time_s)
+    after = replay.time_s > 60
+    error = np.abs(replay.T_twin_C - meas.T_C)[after, 0]
+    assert np.max(error) < 0.5  # the analysis did its job
+    assert np.max((hi - lo)[after, 0]) < 2.0
+    # and it still holds the samples (a twin of the exact model: hardly any miss)
+    assert band_coverage(meas.T_C[after], lo[after, :5], hi[after, :5]) >= 70.0
 
 
 def test_band_coverage_counts_finite_samples_inside():
@@ -530,27 +592,9 @@ def test_a_speed_change_inside_a_window_is_rerun_with_the_recorded_speed(
 
 
 def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
-    from twin.runs import write_run
-
     model = spindle_model
     speeds = [9000.0] * 5 + [0.0] * 4 + [9000.0] * 3  # rpm per minute: a 4-minute stop
-    T = np.full(model.n_dofs, 24.0)
-    times, temps = [0.0], [model.sensor_matrix @ T]
-    for speed in np.repeat(speeds, 15):  # loads at the rings' temperatures every step
-        s = model.sensor_matrix @ T
-        bc = nominal_conditions(model, speed, 24.0, None, T_bearings_C=(s[0], s[2]),
-                                T_sleeves_C=(s[1], s[3]))
-        loads = apply_factors(bc, TRUE_FACTORS).to_thermal_loads()
-        for T_step in model.thermal.transient(loads, 4.0).march(T, 1):
-            times.append(times[-1] + 4.0)
-            temps.append(model.sensor_matrix @ T_step)
-        T = T_step
-    t, temps = np.array(times), np.array(temps)
-    speed_col = np.array(speeds)[np.minimum((t // 60.0).astype(int), len(speeds) - 1)]
-    write_run(tmp_path / "stop.csv", {"time_s": t, "speed_rpm": speed_col,
-                                      "ambient_C": np.full(t.size, 24.0),
-                                      **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
-    run = read_run(tmp_path / "stop.csv")
+    run = minute_speeds_run(tmp_path / "stop.csv", model, speeds)
     est, replay, windows = estimate(run, model, sensor_lag_s=0.0)  # the data have no lag
     stopped = [c for k, (c, _) in enumerate(windows) if speeds[k] == 0.0]
     assert stopped and all(c.H_front_W_m3 == 0.0 and c.H_rear_W_m3 == 0.0 for c in stopped)
@@ -567,6 +611,20 @@ def test_a_stop_cools_down_and_the_factors_come_back(tmp_path, spindle_model):
     # the bearing-heat factor of before the stop is what the restart uses
     before, after = windows[4][1]["H_front"], windows[9][1]["H_front"]
     assert abs(after - before) < 0.05
+
+
+def test_speed_changes_on_window_boundaries_leave_the_factors_free(tmp_path, spindle_model):
+    """The speed changes every minute on the minute: each window runs at the speed its
+    forecast had, so each analysis may move the factors.  They were all held (the next
+    window's speed differing from the last forecast's read as an unforeseen change), and
+    the factors stayed at the prior's 1.0 for the whole run."""
+    model = spindle_model
+    speeds = [4000.0, 9000.0, 13000.0, 6000.0, 11000.0, 3000.0, 12000.0, 8000.0]
+    run = minute_speeds_run(tmp_path / "steps.csv", model, speeds)
+    est, _, _ = estimate(run, model, sensor_lag_s=0.0)
+    found = factors_of(est.config.parameters, np.array(list(est.log_factors.values())))
+    assert abs(found["H_front"] / TRUE_FACTORS["H_front"] - 1.0) < 0.1, found
+    assert abs(found["motor"] - 1.0) > 0.05, found  # moved off the prior (truth 1.2)
 
 
 @pytest.mark.slow
