@@ -154,9 +154,46 @@ def test_twin_simulate_output_reads_without_spikes(tmp_path, spindle_model):
 def test_speed_steps_are_not_spikes(tmp_path):
     cols = warmup()
     cols["speed_rpm"][150:] = 12000.0
-    cols["speed_rpm"][151] = 0.0  # a real (if brief) stop is data, not a spike
+    cols["speed_rpm"][151:156] = 0.0  # a real (if brief) stop is data, not a spike
+    cols["speed_rpm"][200] = 6000.0  # a step of one sample up to a new speed: data too
+    cols["speed_rpm"][201:] = 6000.0
     run = read_run(write(tmp_path, csv_text(cols)))
     assert run.quality == []
+    np.testing.assert_array_equal(run.speed_rpm, cols["speed_rpm"])
+
+
+@pytest.mark.parametrize("glitch", [0.0, 3000.0])
+def test_one_sample_speed_glitch_takes_its_neighbours_speed(tmp_path, glitch):
+    # A window takes its start sample's speed: one 0 rpm sample at 120 s stopped the
+    # twin for the whole third minute.  No spindle stops and restarts within 2 s.
+    cols = warmup()
+    cols["speed_rpm"][120] = glitch
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "glitch", "speed_rpm")
+    assert f["rows"] == [122] and f["spans_s"] == [[120.0, 120.0]]
+    assert (run.speed_rpm == 9000.0).all()
+    assert run.before(np.array([120.0])).speed_rpm[0] == 9000.0
+
+
+def test_one_sample_speed_change_is_data_when_its_neighbours_lie_far_apart(tmp_path):
+    # at 0.1 Hz a single 0 rpm sample is a stop of 10-20 s: kept
+    cols = warmup(n=60, dt=10.0)
+    cols["speed_rpm"][30] = 0.0
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert run.quality == []
+    assert run.speed_rpm[30] == 0.0
+
+
+def test_speed_dropout_holds_the_last_speed(tmp_path):
+    # a linear fill ramped across the step the gap hid: 9000 -> 3000 rpm in 10 s
+    cols = warmup()
+    cols["speed_rpm"][150:] = 3000.0
+    cols["speed_rpm"][145:155] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "dropout", "speed_rpm")
+    assert f["action"] == "held at the last speed"
+    np.testing.assert_array_equal(run.speed_rpm[145:155], 9000.0)
+    assert run.speed_rpm[155] == 3000.0
 
 
 def test_stuck_sensor_exact_value(tmp_path):

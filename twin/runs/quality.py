@@ -1,8 +1,10 @@
 """Data-quality repairs of a recorded run, each reported as a finding (never silent).
 
 Repaired here, in this order: duplicate timestamps (merged), spikes (robust Hampel-type
-filter), NaN dropouts and short time gaps (linear interpolation up to `max_gap_s`; longer
-ones are interpolated for continuity but excluded from the metrics), noisy sensors
+filter; for the speed, a command, only one-sample glitches between equal neighbours),
+NaN dropouts and short time gaps (linear interpolation up to `max_gap_s`, the speed held
+at its last value; longer ones are filled for continuity but excluded from the metrics),
+noisy sensors
 (centred moving average), stuck sensors (flat while the others move: excluded), dead
 thermocouples (no value in the whole run: excluded).  A
 finding is a plain JSON-serialisable dict:
@@ -44,6 +46,10 @@ class QualityConfig:
     smooth_target_C: float = 0.05
     smooth_target_um: float = 0.1
     smooth_max_s: float = 30.0
+    speed_glitch_max_s: float = 10.0
+    """A single speed sample unlike its two equal neighbours, which lie at most this far
+    apart, is a logging glitch: no spindle stops or changes speed and comes back within
+    a few seconds (it takes seconds to ramp), and thermally such a blip is nothing."""
 
 
 @dataclass
@@ -218,9 +224,36 @@ def _jumps_away_and_back(ok: np.ndarray, t: np.ndarray, v: np.ndarray,
     return candidates & ~accepted
 
 
+def repair_speed_glitches(t: np.ndarray, x: np.ndarray, rows: np.ndarray,
+                          cfg: QualityConfig) -> tuple[np.ndarray, list[dict]]:
+    """Replace one-sample speed glitches (`QualityConfig.speed_glitch_max_s`) by their
+    neighbours' speed.  The spike filter does not suit a speed: its steps are commands,
+    and a glitch is told by its neighbours agreeing, not by a noise level.  A glitch
+    matters because a window takes the speed of its start's sample: a single 0 rpm there
+    would stop the twin for a minute."""
+    ok = np.flatnonzero(~np.isnan(x))
+    if ok.size < 3:
+        return x, []
+    v, tv = x[ok], t[ok]
+    glitch = np.zeros(ok.size, dtype=bool)
+    glitch[1:-1] = ((v[:-2] == v[2:]) & (v[1:-1] != v[:-2])
+                    & (tv[2:] - tv[:-2] <= cfg.speed_glitch_max_s))
+    if not glitch.any():
+        return x, []
+    out = x.copy()
+    idx = ok[glitch]
+    out[idx] = v[np.flatnonzero(glitch) - 1]
+    return out, [finding(SPEED, "glitch", "replaced by the speed on both sides of it",
+                         rows=rows[idx], spans_s=[(float(t[i]), float(t[i])) for i in idx],
+                         count=int(idx.size),
+                         detail="one sample off equal neighbours at most "
+                                f"{cfg.speed_glitch_max_s:g} s apart")]
+
+
 def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
                   cfg: QualityConfig) -> tuple[np.ndarray, np.ndarray, list[dict]]:
-    """Interpolate NaN runs linearly in time; runs longer than `max_gap_s` are excluded."""
+    """Interpolate NaN runs linearly in time (a speed, a command that holds until the
+    next, keeps its last value); runs longer than `max_gap_s` are excluded."""
     valid = np.ones(x.size, dtype=bool)
     missing = np.isnan(x)
     if not missing.any():
@@ -229,6 +262,13 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     out = x.copy()
     # Beyond the first/last value the nearest value is held (np.interp clamps).
     out[missing] = np.interp(t[missing], t[ok], x[ok])
+    if name == SPEED:
+        # a linear fill would ramp across a step the gap hides; the last value holds
+        # (before the first value, the first, as above)
+        last = np.maximum.accumulate(np.where(ok, np.arange(x.size), -1))
+        held = missing & (last >= 0)
+        out[held] = x[last[held]]
+    how = "held at the last speed" if name == SPEED else "linearly interpolated in time"
     short_rows, long_rows, short_spans, long_spans = [], [], [], []
     for a, b in true_runs(missing):
         left = t[a - 1] if a > 0 else t[a]
@@ -243,7 +283,7 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     found = []
     if short_rows:
         r = np.concatenate(short_rows)
-        found.append(finding(name, "dropout", "linearly interpolated in time", rows=r,
+        found.append(finding(name, "dropout", how, rows=r,
                              spans_s=short_spans, count=r.size,
                              detail=f"missing values, gaps up to {cfg.max_gap_s:g} s"))
     if long_rows:
@@ -370,9 +410,11 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
     raw = {n: v.copy() for n, v in columns.items()}
     valid: dict[str, np.ndarray] = {}
     for name, x in columns.items():
-        if name != SPEED:  # speed steps are real; a spindle speed is a command, not noise
+        if name != SPEED:
             x, found = remove_spikes(name, time, x, rows, cfg)
-            findings += found
+        else:  # speed steps are real; a spindle speed is a command, not noise
+            x, found = repair_speed_glitches(time, x, rows, cfg)
+        findings += found
         x, valid[name], found = fill_dropouts(name, time, x, rows, cfg)
         findings += found
         columns[name] = x

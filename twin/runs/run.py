@@ -179,6 +179,10 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
     table, repeats = drop_repeated_rows(table)
     check_structure(table)
     check_values(table)
+    # The speed limit holds for the speeds as written: the repair replaces a one-sample
+    # speed glitch, but one beyond the spindle's limit is a corrupt value to be told.
+    check_operating_range(table.file, table.rows, {SPEED: table.columns[SPEED]},
+                          max_speed_rpm)
     fixed = repair(table, config)
     check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm)
     quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
