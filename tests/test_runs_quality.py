@@ -240,6 +240,19 @@ def test_noisy_sensor_smoothed(tmp_path):
     assert kinds(run) == {"noisy"}
 
 
+def test_noisy_ambient_is_told_without_peers(tmp_path):
+    # the ambient has no peer column: its finding said "(others 0 °C)"
+    cols = noisy_warmup()
+    cols["ambient_C"] = cols["ambient_C"] + np.random.default_rng(9).normal(0.0, 0.6, 600)
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "noisy", "ambient_C")
+    assert f["detail"].startswith("noise 0.") and "others" not in f["detail"]
+    cols = noisy_warmup()
+    cols["T5_C"] = cols["T5_C"] + np.random.default_rng(9).normal(0.0, 0.6, 600)
+    f = one(read_run(write(tmp_path, csv_text(cols))), "noisy", "T5_C")
+    assert "(others 0.0" in f["detail"]  # the thermocouples' median noise, about 0.05 °C
+
+
 def test_time_offset_and_ignored_and_empty_columns(tmp_path):
     cols = warmup()
     cols["time_s"] = cols["time_s"] + 1000.0

@@ -317,11 +317,12 @@ def time_gaps(t: np.ndarray, rows: np.ndarray,
     return gaps, found
 
 
-def smooth_noisy(name: str, t: np.ndarray, x: np.ndarray, sigma: float, others: float,
-                 cfg: QualityConfig) -> tuple[np.ndarray, list[dict]]:
-    """Smooth a sensor far noisier than its peers with a centred moving average."""
+def smooth_noisy(name: str, t: np.ndarray, x: np.ndarray, sigma: float,
+                 others: float | None, cfg: QualityConfig) -> tuple[np.ndarray, list[dict]]:
+    """Smooth a sensor far noisier than its peers (`others`: their median noise; None for
+    a column without peers, the ambient, say) with a centred moving average."""
     floor = _unit_floor(name, cfg.noisy_floor_C, cfg.noisy_floor_um)
-    if sigma <= max(floor, cfg.noisy_ratio * others):
+    if sigma <= max(floor, cfg.noisy_ratio * (others or 0.0)):
         return x, []
     target = _unit_floor(name, cfg.smooth_target_C, cfg.smooth_target_um)
     interval = float(np.median(np.diff(t)))
@@ -335,7 +336,8 @@ def smooth_noisy(name: str, t: np.ndarray, x: np.ndarray, sigma: float, others: 
     return out, [finding(name, "noisy", f"smoothed by a centred moving average of {width} "
                          f"samples ({width * interval:g} s)", count=x.size,
                          spans_s=[(t[0], t[-1])],
-                         detail=f"noise {sigma:.3g} {unit} (others {others:.3g} {unit})")]
+                         detail=f"noise {sigma:.3g} {unit}" + (
+                             "" if others is None else f" (others {others:.3g} {unit})"))]
 
 
 def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
@@ -427,7 +429,7 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
         present = [n for n in group if n in columns]
         for name in present:
             peers = [sigmas[n] for n in present if n != name]
-            others = float(np.median(peers)) if peers else 0.0
+            others = float(np.median(peers)) if peers else None
             columns[name], found = smooth_noisy(name, time, columns[name], sigmas[name],
                                                 others, cfg)
             findings += found
