@@ -237,6 +237,62 @@ def test_bad_speed_profiles(tmp_path, text, row, column):
     assert (info.value.row, info.value.column) == (row, column)
 
 
+def _run_and_profile_text(change) -> str:  # noqa: ANN001
+    """A recorded run of 31 rows 10 s apart, which is a valid speed profile too (a profile
+    reads its time_s, speed_rpm and ambient_C), with its lines changed by `change`."""
+    lines = ["time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C"]
+    lines += [f"{10 * i},6000,22.0,{22 + 0.01 * i:.2f},22.1,22.2,22.3,22.4" for i in range(31)]
+    return "\n".join(change(lines)) + "\n"
+
+
+def _cell(lines: list[str], line: int, column: int, value: str) -> list[str]:
+    cells = lines[line - 1].split(",")
+    cells[column] = value
+    return lines[:line - 1] + [",".join(cells)] + lines[line:]
+
+
+@pytest.mark.parametrize("change", [
+    lambda lines: [],  # empty file
+    lambda lines: ["# name: run", ""],  # comments only
+    lambda lines: lines[:1],  # a header and no data
+    lambda lines: [",".join(c for c in ln.split(",")[:1] + ln.split(",")[2:]) for ln in lines],
+    lambda lines: _cell(lines, 3, 1, "abc"),
+    lambda lines: _cell(lines, 3, 0, ""),  # no time
+    lambda lines: lines[:2] + [lines[3], lines[2]] + lines[4:],  # time goes back
+    lambda lines: _cell(lines, 3, 1, "-10"),
+    lambda lines: lines[:2] + [lines[2] + ",1"] + lines[3:],  # a field too many
+], ids=["empty", "comments-only", "header-only", "no-speed-column", "not-a-number",
+        "no-time", "time-goes-back", "negative-speed", "field-count"])
+def test_a_profile_is_refused_in_the_words_of_the_run_reader(tmp_path, change):
+    # the profile reader was a reader of its own: the same file was "empty speed profile"
+    # to synth and "empty file: no header row and no data" to replay, a blank time "'' is
+    # not a finite number" and "time is missing", time going back "time must increase
+    # from row to row" and "time goes back from 20 s (line 3) to 10 s"
+    from twin.runs import read_run
+
+    path = tmp_path / "run.csv"
+    path.write_text(_run_and_profile_text(change))
+    with pytest.raises(InputError) as as_run:
+        read_run(path)
+    with pytest.raises(InputError) as as_profile:
+        read_speed_profile(path)
+    assert str(as_profile.value) == str(as_run.value)
+
+
+@pytest.mark.parametrize("cell", ["", "nan", "NA"])
+def test_a_profile_step_without_a_value_is_called_missing(tmp_path, cell):
+    # a blank speed was "'' is not a finite number": no number was there to be infinite
+    path = tmp_path / "p.csv"
+    path.write_text(f"time_s,speed_rpm,ambient_C\n0,6000,22\n60,{cell},22\n120,0,{cell}\n")
+    with pytest.raises(InputError) as info:
+        read_speed_profile(path)
+    assert str(info.value) == f"{path}, row 3, column 'speed_rpm': value is missing"
+    path.write_text(f"time_s,speed_rpm,ambient_C\n0,6000,22\n60,0,{cell}\n")
+    with pytest.raises(InputError) as info:
+        read_speed_profile(path)
+    assert str(info.value) == f"{path}, row 3, column 'ambient_C': value is missing"
+
+
 def test_scenario_and_profile_take_the_range_replay_takes(tmp_path):
     from twin.contract import OPERATING_TEMPERATURE_C
 

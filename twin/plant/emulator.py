@@ -33,7 +33,6 @@ from pathlib import Path
 import numpy as np
 
 from twin.contract import SENSOR_NAMES
-from twin.errors import InputError
 from twin.lag import first_order_lag
 from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
@@ -49,6 +48,7 @@ from twin.plant.truth import (
     truth_tables,
     xy_drift_um,
 )
+from twin.runs.validate import check_speed_limit
 
 DT_S = 2.0
 """Truth time step, s (the twin uses 4 s)."""
@@ -227,11 +227,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         model = SpindleModel.load(size_factor=scenario.model.size_factor)
     spec = model.spec
     limit = spec.spindle.max_speed_rpm
-    fastest = int(np.argmax(speed.values))
-    if speed.values[fastest] > limit:
-        raise InputError(f"speed {speed.values[fastest]:g} rpm exceeds the spindle's limit "
-                         f"{limit:g} rpm", file=profile_name, column="speed_rpm",
-                         row=None if profile is None else profile.row_of(fastest))
+    rows = profile.rows if profile is not None and profile.rows else None
+    check_speed_limit(profile_name, rows, speed.values, limit)
 
     # the first two streams are those of the runs before model-form error existed
     truth_seed, noise_seed, form_seed, place_seed = np.random.SeedSequence(seed).spawn(4)

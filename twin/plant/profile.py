@@ -11,18 +11,23 @@ row.
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 
-import numpy as np
-
-from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
-from twin.paths import read_input_text
 from twin.plant.timetable import StepTable
-from twin.runs.csv_format import check_header, csv_records, without_trailing_blanks
-from twin.runs.table import parse_cell
+from twin.runs.csv_format import read_csv_table
+from twin.runs.schema import AMBIENT, SPEED, TIME
+from twin.runs.validate import (
+    check_operating_temperature,
+    check_speed_sign,
+    checked_time,
+    complete_column,
+    required_column,
+)
+
+PROFILE_COLUMNS = (TIME, SPEED, AMBIENT)
+"""The columns a speed profile sets; any other is read over (and named by the command)."""
 
 
 @dataclass(frozen=True)
@@ -36,66 +41,32 @@ class SpeedProfile:
     """Header columns the profile does not read (a recorded run's T1_C.., a coolant_C or a
     misspelt ambient), for the command to tell."""
 
-    def row_of(self, step: int) -> int | None:
-        """The file line of step `step`, or None."""
-        return self.rows[step] if step < len(self.rows) else None
-
 
 def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
-    """Read a speed profile; errors name the file, line and column."""
-    file = str(path)
-    lines = read_input_text(path, column="--profile").split("\n")
-    header: list[str] | None = None
-    header_line = 0
-    rows: list[tuple[int, list[str]]] = []
-    for number, line in enumerate(lines, start=1):
-        if not line.strip() or line.lstrip().startswith("#"):
-            continue
-        fields = [f.strip() for f in next(csv_records([line], file, [number]))]
-        if header is None:
-            fields = without_trailing_blanks(fields)
-            check_header(fields, file, number)
-            header, header_line = fields, number
-        else:
-            rows.append((number, without_trailing_blanks(fields, len(header))))
-    if header is None:
-        raise InputError("empty speed profile", file=file)
-    for name in ("time_s", "speed_rpm"):
-        if name not in header:
-            raise InputError("missing required column", file=file, row=header_line, column=name)
-    wanted = ["time_s", "speed_rpm"] + (["ambient_C"] if "ambient_C" in header else [])
-    if not rows:
-        raise InputError("no rows after the header", file=file, row=header_line)
-    values = np.empty((len(rows), len(wanted)))
-    for k, (number, fields) in enumerate(rows):
-        if len(fields) != len(header):
-            raise InputError(f"expected {len(header)} fields, found {len(fields)}", file=file,
-                             row=number)
-        for j, name in enumerate(wanted):
-            cell = fields[header.index(name)]
-            value = parse_cell(cell, file, number, name)
-            if not math.isfinite(value):
-                raise InputError(f"{cell!r} is not a finite number", file=file, row=number,
-                                 column=name)
-            values[k, j] = value
-        time, speed = values[k, 0], values[k, 1]
-        if k == 0 and time != 0:
-            raise InputError(f"the first row must be at 0 s, the run's start (got {time:g} s): "
-                             "add a row at 0 s with the speed until then (0 rpm: standing)",
-                             file=file, row=number, column="time_s")
-        if time < 0:
-            raise InputError("time must be ≥ 0", file=file, row=number, column="time_s")
-        if k and time <= values[k - 1, 0]:
-            raise InputError("time must increase from row to row", file=file, row=number,
-                             column="time_s")
-        if speed < 0:
-            raise InputError(f"negative speed {speed:g} rpm", file=file, row=number,
-                             column="speed_rpm")
-        low, high = OPERATING_TEMPERATURE_C
-        if len(wanted) == 3 and not low <= values[k, 2] <= high:
-            raise InputError(f"ambient {values[k, 2]:g} °C is outside the {low:g}..{high:g} °C "
-                             "the twin models", file=file, row=number, column="ambient_C")
-    ambient = StepTable(values[:, 0], values[:, 2]) if len(wanted) == 3 else None
-    return SpeedProfile(StepTable(values[:, 0], values[:, 1]), ambient,
-                        tuple(number for number, _ in rows),
-                        tuple(name for name in header if name not in wanted))
+    """Read a speed profile; errors name the file, line and column.
+
+    Read and checked by the recorded-run reader and checks (`twin.runs`), so a problem
+    both files can have (an empty file, a missing column, a cell that is no number, time
+    out of order, a negative speed, an ambient outside the modelled range) is told in the
+    same words; unlike a run, a profile may have no gap (no repair fills a step in) and
+    no time given twice (a step lasts a while).
+    """
+    table = read_csv_table(path, PROFILE_COLUMNS.__contains__, option="--profile",
+                           max_rows=None)
+    required_column(table, TIME)
+    required_column(table, SPEED)
+    time = complete_column(table, TIME, "time")
+    if time[0] != 0:
+        raise InputError(f"the first row must be at 0 s, the run's start (got {time[0]:g} s): "
+                         "add a row at 0 s with the speed until then (0 rpm: standing)",
+                         file=table.file, row=int(table.rows[0]), column=TIME)
+    checked_time(table, repeats=False)
+    speed = complete_column(table, SPEED)
+    check_speed_sign(table)
+    ambient = None
+    if AMBIENT in table.columns:
+        values = complete_column(table, AMBIENT)
+        check_operating_temperature(table.file, table.rows, AMBIENT, values)
+        ambient = StepTable(time, values)
+    return SpeedProfile(StepTable(time, speed), ambient,
+                        tuple(int(row) for row in table.rows), tuple(table.ignored_columns))

@@ -21,15 +21,18 @@ from twin.runs.table import RawTable, parse_cell
 
 
 def read_csv_table(path: str | os.PathLike[str],
-                   keep: Callable[[str], bool] | None = None) -> RawTable:
+                   keep: Callable[[str], bool] | None = None, *,
+                   option: str | None = None, max_rows: int | None = MAX_SAMPLES) -> RawTable:
     """Read a CSV recorded run into a `RawTable` (no validation beyond parsing).
 
     `keep(name)` says which columns to read (default: the recorded-run schema); the
-    others are listed in `RawTable.ignored_columns`.
+    others are listed in `RawTable.ignored_columns`.  `option` is the command-line option
+    that named the file (a file that cannot be read names it); `max_rows` the most data
+    rows taken (None: any number; a speed profile's steps are no samples).
     """
     file = str(path)
     keep = keep or ALL_COLUMNS.__contains__
-    text = read_input_text(path)
+    text = read_input_text(path, column=option)
 
     # Split on '\n' only: editors number lines that way (str.splitlines would also
     # break on form feeds and Unicode separators).
@@ -62,9 +65,9 @@ def read_csv_table(path: str | os.PathLike[str],
     check_header(header, file, header_line)
     if not data_lines:
         raise InputError("no data rows after the header", file=file, row=header_line)
-    if len(data_lines) > MAX_SAMPLES:
-        raise InputError(f"{len(data_lines)} data rows; a run may hold at most {MAX_SAMPLES} "
-                         "samples (resample it)", file=file, row=data_numbers[MAX_SAMPLES])
+    if max_rows is not None and len(data_lines) > max_rows:
+        raise InputError(f"{len(data_lines)} data rows; a run may hold at most {max_rows} "
+                         "samples (resample it)", file=file, row=data_numbers[max_rows])
 
     known = [(i, name) for i, name in enumerate(header) if keep(name)]
     ignored = [name for name in header if not keep(name)]

@@ -3,8 +3,11 @@
 Each raises `InputError` naming the file, the row (1-based line in a CSV file) and the
 column.  Anything a repair can fix (duplicates, dropouts, spikes, stuck or noisy sensors)
 is left to `twin.runs.quality`.  The column and time checks (`required_column`,
-`column_with_values`, `checked_time`) serve the drift data too (`twin.drift.data`), so a
-file refused by both commands is refused in the same words.
+`column_with_values`, `complete_column`, `checked_time`) serve the drift data
+(`twin.drift.data`) and the emulator's speed profile (`twin.plant.profile`) too, as do the
+speed and temperature checks (`check_speed_sign`, `check_speed_limit`,
+`check_operating_temperature`), so a file refused by several commands is refused in the
+same words.
 """
 
 from __future__ import annotations
@@ -50,14 +53,22 @@ def column_with_values(table: RawTable, name: str) -> np.ndarray:
     return values
 
 
+def complete_column(table: RawTable, name: str, what: str = "value") -> np.ndarray:
+    """The column `name` (`required_column`), or InputError at the first row without a
+    value (`what` is missing): for the columns no repair may fill in."""
+    values = required_column(table, name)
+    missing = np.flatnonzero(np.isnan(values))
+    if missing.size:
+        raise InputError(f"{what} is missing", file=table.file,
+                         row=int(table.rows[missing[0]]), column=name)
+    return values
+
+
 def checked_time(table: RawTable, *, repeats: bool = True) -> np.ndarray:
     """The time column, every row holding one, in time order; a time repeating the one
-    before is refused unless `repeats` (a run merges such samples, drift features do not)."""
-    time = required_column(table, TIME)
-    missing = np.flatnonzero(np.isnan(time))
-    if missing.size:
-        raise InputError("time is missing", file=table.file, row=int(table.rows[missing[0]]),
-                         column=TIME)
+    before is refused unless `repeats` (a run merges such samples, drift features and a
+    speed profile's steps do not)."""
+    time = complete_column(table, TIME, "time")
     step = np.diff(time)
     wrong = np.flatnonzero(step < 0 if repeats else step <= 0)
     if wrong.size:
@@ -110,16 +121,20 @@ def check_values(table: RawTable) -> None:
             f"median sample interval {interval:g} s is longer than {MAX_SAMPLE_INTERVAL_S:g} s "
             "(at least one sample per 10 s is needed)", file=table.file, column=TIME)
 
+    check_speed_sign(table)
+    for name in CELSIUS_COLUMNS:
+        if name in table.columns:
+            _check_celsius(table, name)
+
+
+def check_speed_sign(table: RawTable) -> None:
+    """InputError at the first negative speed (0 is a stop; there is no reverse)."""
     speed = table.columns[SPEED]
     negative = np.flatnonzero(speed < 0)
     if negative.size:
         i = int(negative[0])
         raise InputError(f"negative speed {speed[i]:g} rpm", file=table.file,
                          row=int(table.rows[i]), column=SPEED)
-
-    for name in CELSIUS_COLUMNS:
-        if name in table.columns:
-            _check_celsius(table, name)
 
 
 def _check_celsius(table: RawTable, name: str) -> None:
@@ -167,19 +182,31 @@ def check_operating_range(file: str, rows: np.ndarray, columns: dict[str, np.nda
     Checked on the repaired values (a spike the repair removes is no error) so that a
     replay never meets a value it cannot simulate; the error names the file row.
     """
-    speed = columns[SPEED]
-    over = np.flatnonzero(speed > max_speed_rpm)
+    check_speed_limit(file, rows, columns[SPEED], max_speed_rpm)
+    for name in (AMBIENT, COOLANT):
+        if name in columns:
+            check_operating_temperature(file, rows, name, columns[name])
+
+
+def check_speed_limit(file: str | None, rows: np.ndarray | None, speed: np.ndarray,
+                      max_speed_rpm: float) -> None:
+    """InputError at the first speed above the spindle's limit (`rows`: the file row of
+    each value, None if not read from a file)."""
+    over = np.flatnonzero(np.asarray(speed) > max_speed_rpm)
     if over.size:
         i = int(over[0])
         raise InputError(f"speed {speed[i]:g} rpm exceeds the spindle's limit "
-                         f"{max_speed_rpm:g} rpm", file=file, row=int(rows[i]), column=SPEED)
+                         f"{max_speed_rpm:g} rpm", file=file,
+                         row=None if rows is None else int(rows[i]), column=SPEED)
+
+
+def check_operating_temperature(file: str, rows: np.ndarray, name: str,
+                                values: np.ndarray) -> None:
+    """InputError at the first air or coolant temperature of column `name` outside the
+    range the twin models (`twin.contract.OPERATING_TEMPERATURE_C`)."""
     lo, hi = OPERATING_TEMPERATURE_C
-    for name in (AMBIENT, COOLANT):
-        if name not in columns:
-            continue
-        values = columns[name]
-        outside = np.flatnonzero((values < lo) | (values > hi))
-        if outside.size:
-            i = int(outside[0])
-            raise InputError(f"{values[i]:g} °C is outside the {lo:g}..{hi:g} °C the twin "
-                             "models", file=file, row=int(rows[i]), column=name)
+    outside = np.flatnonzero((values < lo) | (values > hi))
+    if outside.size:
+        i = int(outside[0])
+        raise InputError(f"{values[i]:g} °C is outside the {lo:g}..{hi:g} °C the twin "
+                         "models", file=file, row=int(rows[i]), column=name)
