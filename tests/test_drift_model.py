@@ -287,19 +287,19 @@ def _set(*keys_value):
 @pytest.mark.parametrize(("change", "field", "message"), [
     (_set("features", "taus_min", "10,30,90"), "features.taus_min", "valid list"),
     (_set("features", "taus_min", []), "features.taus_min", "at least 1 item"),
-    (_set("features", "taus_min", [10.0, -30.0, 90.0]), "features.taus_min.1", "greater than 0"),
+    (_set("features", "taus_min", [10.0, -30.0, 90.0]), "features.taus_min[1]", "greater than 0"),
     (_set("features", "taus_min", [10.0, 30.0]), "features",
      "3 sensors and 2 lags make 15 feature columns; the weights take 20"),
     (_set("features", "reference_C", [20.0]), "features", "1 reference temperatures"),
-    (_set("features", "reference_C", 2, "20.5"), "features.reference_C.2", "valid number"),
-    (_set("features", "reference_C", 0, float("nan")), "features.reference_C.0", "finite"),
+    (_set("features", "reference_C", 2, "20.5"), "features.reference_C[2]", "valid number"),
+    (_set("features", "reference_C", 0, float("nan")), "features.reference_C[0]", "finite"),
     (_set("features", "sensors", []), "features.sensors", "at least 1 item"),
     (_set("features", "sensors", "A_C"), "features.sensors", "valid list"),
     (_set("features", "sensors", 1, "A_C"), "features.sensors", "'A_C' is listed twice"),
     (_set("features", "sensors", 0, "drift_um"), "features.sensors", "does not end in _C"),
     (_set("features", "groups", ["rise"]), "features.groups", "takes the feature groups rise, "
      "lag, speed"),
-    (_set("features", "groups", ["rise", "lags"]), "features.groups.1", "'rise', 'lag'"),
+    (_set("features", "groups", ["rise", "lags"]), "features.groups[1]", "'rise', 'lag'"),
     (_set("features", "cache", 1), "features.cache", "unknown field"),
     (_set("interval", {}), "interval.kind", "missing"),
     (_set("interval", "kind", "gauss"), "interval.kind", "'conformal' or 'scaled_posterior'"),
@@ -307,7 +307,7 @@ def _set(*keys_value):
      "factor"),
     (_set("interval", "half_width_um", [0.4, 0.4]), "interval.half_width_um", "2 values for 1"),
     (_set("interval", "half_width_um", "0.4"), "interval.half_width_um", "valid list"),
-    (_set("interval", "half_width_um", [-0.4]), "interval.half_width_um.0",
+    (_set("interval", "half_width_um", [-0.4]), "interval.half_width_um[0]",
      "greater than or equal to 0"),
     (_set("targets", "drift_um"), "targets", "valid list"),
     (_set("targets", ["drift_um", "tilt_um"]), "interval.half_width_um", "1 value for 2"),
@@ -318,7 +318,7 @@ def _set(*keys_value):
     (_set("metadata", "validation", "methods", "ridge_dynamic", "rmse_um", {}),
      "metadata.validation.methods.ridge_dynamic.rmse_um", "no value for target 'drift_um'"),
     (_set("metadata", "ranking", "sensors", 0, "mean_grade", None),
-     "metadata.ranking.sensors.0.mean_grade", "valid number"),
+     "metadata.ranking.sensors[0].mean_grade", "valid number"),
 ])
 def test_damaged_metadata_of_a_file_without_its_checksum_names_the_field(
         ridge_model, data_file, tmp_path, change, field, message):

@@ -75,28 +75,28 @@ def test_design_example_scenario_parses(tmp_path):
     ("[bearing_heat.front]\ntime_s = [0, 300]\nfactor = [1.0]\n", 1, "bearing_heat.front",
      "1 values for 2 times"),
     ("[sensors]\nlag_s = 8\nnoise_c = 1\n", 3, "sensors.noise_c", "unknown key"),
-    ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck.0", "unknown sensor"),
-    ("\n[coolant]\ntime_s = [0]\ninlet_C = [300]\n", 4, "coolant.inlet_C.0", "less than"),
+    ("[faults]\nstuck = [\"T9\"]\n", 2, "faults.stuck[0]", "unknown sensor"),
+    ("\n[coolant]\ntime_s = [0]\ninlet_C = [300]\n", 4, "coolant.inlet_C[0]", "less than"),
     # the one plausible range (twin.contract.OPERATING_TEMPERATURE_C): a coolant at 50 °C
     # was emulated in full and then refused as a run replay would read as Fahrenheit
-    ("[coolant]\ntime_s = [0, 60]\ninlet_C = [20, 50]\n", 3, "coolant.inlet_C.1",
+    ("[coolant]\ntime_s = [0, 60]\ninlet_C = [20, 50]\n", 3, "coolant.inlet_C[1]",
      "less than or equal to 45"),
-    ("[ambient]\ntime_s = [0]\nambient_C = [-41]\n", 3, "ambient.ambient_C.0",
+    ("[ambient]\ntime_s = [0]\nambient_C = [-41]\n", 3, "ambient.ambient_C[0]",
      "greater than or equal to -40"),
     ("[contact_resistance.front]\ntime_s = [0, 60]\nfactor = [1.0, 0.0]\n", 3,
-     "contact_resistance.front.factor.1", "greater than 0"),
+     "contact_resistance.front.factor[1]", "greater than 0"),
     ("[ambient]\ntime_s = [0, 0]\nambient_C = [20, 21]\n", 1, "ambient", "increasing"),
     ("[faults]\ndropouts = [{sensor = \"T1\", start_s = 60, end_s = 10}]\n", 2,
-     "faults.dropouts.0", "end_s"),
+     "faults.dropouts[0]", "end_s"),
     ("x = [\n", 1, None, "not valid TOML"),
     # model-form error tables (issue 12)
     ("[film.housng]\ntime_s = [0]\nfactor = [1]\n", 1, "film.housng", "unknown key"),
     ("[material]\nconductivty = 0.9\n", 2, "material.conductivty", "unknown key"),
     ("\n[sensors]\nplacement_mm = -1\n", 3, "sensors.placement_mm", "greater than or equal"),
-    ("[motor_heat]\ntime_s = [0]\nfactor = [0]\n", 3, "motor_heat.factor.0", "greater than 0"),
+    ("[motor_heat]\ntime_s = [0]\nfactor = [0]\n", 3, "motor_heat.factor[0]", "greater than 0"),
     ("[material]\nexpansion = 3\n", 2, "material.expansion", "less than or equal to 2"),
     # a boolean or a quoted number is a slip, not a factor (lax parsing read true as 1.0)
-    ("[motor_heat]\ntime_s = [0]\nfactor = [true]\n", 3, "motor_heat.factor.0",
+    ("[motor_heat]\ntime_s = [0]\nfactor = [true]\n", 3, "motor_heat.factor[0]",
      "valid number"),
     ("[sensors]\nlag_s = \"8\"\n", 2, "sensors.lag_s", "valid number"),
 ])
@@ -112,18 +112,18 @@ def test_bad_scenarios(text, row, column, words):
     # a list's bad item is named on its own line, not on its key's (the first line of the
     # list): in a list of ten dropouts the key's line said nothing of which one was wrong
     ('[faults]\ndropouts = [{sensor = "T4", start_s = 600, end_s = 660},\n'
-     '            {sensor = "T9", start_s = 700, end_s = 760}]\n', 3, "faults.dropouts.1.sensor"),
+     '            {sensor = "T9", start_s = 700, end_s = 760}]\n', 3, "faults.dropouts[1].sensor"),
     ('[faults]\nspikes = [\n  # one per sensor\n  {sensor = "T1", time_s = 60},\n'
-     '  {sensor = "T2", time_s = 120, size = 500.0},\n]\n', 5, "faults.spikes.1.size"),
-    ('[faults]\nstuck = ["T1", "T2",\n         "T7"]\n', 3, "faults.stuck.2"),
+     '  {sensor = "T2", time_s = 120, size = 500.0},\n]\n', 5, "faults.spikes[1].size"),
+    ('[faults]\nstuck = ["T1", "T2",\n         "T7"]\n', 3, "faults.stuck[2]"),
     ('[bearing_heat.front]\ntime_s = [0, 300, 600]\nfactor = [\n  1.0, # "x" [\n  1.1,\n'
-     '  -1.0,\n]\n', 6, "bearing_heat.front.factor.2"),
+     '  -1.0,\n]\n', 6, "bearing_heat.front.factor[2]"),
     # arrays of tables: the item's own [[header]] or its key under it
     ('[[faults.dropouts]]\nsensor = "T4"\nstart_s = 600\nend_s = 660\n'
      '[[faults.dropouts]]\nsensor = "T3"\nstart_s = 700\nend_s = 650\n', 5,
-     "faults.dropouts.1"),
+     "faults.dropouts[1]"),
     ('[[faults.spikes]]\nsensor = "T4"\ntime_s = 60\n[[faults.spikes]]\nsensor = "T5"\n'
-     'time_s = 60\nsize = 1e3\n', 7, "faults.spikes.1.size"),
+     'time_s = 60\nsize = 1e3\n', 7, "faults.spikes[1].size"),
 ])
 def test_a_list_items_error_names_the_items_line(text, row, column):
     with pytest.raises(InputError) as info:
@@ -142,7 +142,7 @@ def test_toml_errors_name_the_line_and_key_not_a_row_and_column(tmp_path):
     with pytest.raises(InputError) as info:
         parse_scenario("[material]\nconductivty = 0.9\n", "bad.toml")
     assert str(info.value) == ("bad.toml, line 2, key 'material.conductivty': unknown key "
-                               "(check the spelling)")
+                               "(check the spelling and the unit in the name)")
     with pytest.raises(InputError) as info:
         parse_scenario("x = [\n", "bad.toml")
     assert str(info.value).startswith("bad.toml, line 1: not valid TOML")
@@ -174,6 +174,75 @@ def test_toml_errors_name_the_line_and_key_not_a_row_and_column(tmp_path):
     assert "column 'ambient'" not in result.output and not (tmp_path / "run.csv").exists()
 
 
+def _spec_text(old: str, new: str) -> str:
+    from twin.spindle.spec import DEFAULT_SPEC_PATH
+
+    text = DEFAULT_SPEC_PATH.read_text()
+    assert old in text
+    return text.replace(old, new, 1)
+
+
+@pytest.mark.parametrize("scenario, spec_old, spec_new", [
+    # a misspelt key: the scenario said "(check the spelling)", the spec "(check the
+    # spelling and the unit in the name)"
+    ("[sensors]\nnoise_c = 0.1\n", "max_speed_rpm = 15000.0",
+     "max_speed_rpm = 15000.0\nmax_speed = 1.0"),
+    # a value where a table belongs: "a valid dictionary or instance of Sensors" and
+    # "... of MeshOptions" named classes of the code, not anything in the file
+    ("sensors = 1\n", "[mesh]\nelement_size_mm = 7.0\nmin_elements_across = 2\n", ""),
+])
+def test_scenario_and_spec_word_one_problem_alike(tmp_path, scenario, spec_old, spec_new):
+    from twin.spindle.spec import load_spec
+
+    with pytest.raises(InputError) as as_scenario:
+        parse_scenario(scenario, "bad.toml")
+    spec = tmp_path / "spec.toml"
+    text = _spec_text(spec_old, spec_new)
+    if spec_new == "":  # the table taken out above comes back as a value on top
+        text = "mesh = 1\n" + text
+    spec.write_text(text)
+    with pytest.raises(InputError) as as_spec:
+        load_spec(spec)
+    assert as_scenario.value.reason == as_spec.value.reason
+    assert "instance of" not in as_scenario.value.reason
+
+
+def test_toml_files_word_a_validators_message_and_more_problems_alike(tmp_path):
+    from twin.spindle.spec import load_spec
+
+    # a validator's own words: the spec kept pydantic's "Value error, " before them
+    spec = tmp_path / "spec.toml"
+    spec.write_text(_spec_text("r_outer_mm = 55.0", "r_outer_mm = 5.0"))
+    with pytest.raises(InputError) as info:
+        load_spec(spec)
+    assert info.value.reason == "r_outer_mm must be larger than r_inner_mm"
+    assert info.value.column.startswith("parts[")  # a list's item as a spec names it
+    # a second problem: the spec said "(and 1 more problem)", the scenario nothing
+    spec.write_text(_spec_text("max_speed_rpm = 15000.0",
+                               "max_speed_rpm = 15000.0\nmax_speed = 1.0\nmin_speed = 0"))
+    with pytest.raises(InputError) as as_spec:
+        load_spec(spec)
+    with pytest.raises(InputError) as as_scenario:
+        parse_scenario("[sensors]\nnoise_c = 0.1\nlag = 2\n", "bad.toml")
+    assert as_scenario.value.reason == as_spec.value.reason
+    assert as_spec.value.reason.endswith(" (and 1 more problem)")
+
+
+def test_toml_text_that_is_not_utf8_names_its_line_as_a_line(tmp_path):
+    # read as a CSV file is, its bad byte was at "row 2" of a file of lines and keys
+    from twin.spindle.spec import load_spec
+
+    scenario, spec = tmp_path / "s.toml", tmp_path / "spec.toml"
+    scenario.write_bytes(b"[sensors]\nnoise_C = 0.1  # caf\xe9\n")
+    spec.write_bytes(b"# caf\xe9\n" + _spec_text("[spindle]", "\n[spindle]").encode())
+    with pytest.raises(InputError) as as_scenario:
+        load_scenario(scenario)
+    with pytest.raises(InputError) as as_spec:
+        load_spec(spec)
+    assert str(as_scenario.value) == f"{scenario}, line 2, option '--scenario': not UTF-8 text"
+    assert str(as_spec.value) == f"{spec}, line 1: not UTF-8 text"
+
+
 def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     # a spike at 99999 s in a 5-min run landed on its last sample; a late dropout vanished
     from typer.testing import CliRunner
@@ -188,7 +257,7 @@ def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     with pytest.raises(InputError, match=r"spike at 99999 s is after the run's end \(300 s\)"
                        ) as info:
         load_scenario(path, duration_s=300.0)
-    assert (info.value.row, info.value.column) == (3, "faults.spikes.1.time_s")  # its line
+    assert (info.value.row, info.value.column) == (3, "faults.spikes[1].time_s")  # its line
     path.write_text('[faults]\ndropouts = [{sensor = "T3", start_s = 400, end_s = 460}]\n')
     with pytest.raises(InputError, match="dropout from 400 s is after the run's end"):
         load_scenario(path, duration_s=300.0)
@@ -196,7 +265,7 @@ def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     result = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "5",
                                       "--ambient", "22", "--seed", "1", "--scenario", str(path),
                                       "--out", str(out)])
-    assert result.exit_code == 2 and "faults.dropouts.0.start_s" in result.output
+    assert result.exit_code == 2 and "faults.dropouts[0].start_s" in result.output
     assert not out.exists()
 
 

@@ -12,7 +12,7 @@ import copy
 import functools
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, Self
 
 EXIT_INPUT_ERROR = 2
@@ -27,6 +27,9 @@ class InputError(ValueError):
     ROW = "row"
     COLUMN = "column"
     """How `where` calls the row and the column (a table's words; `TomlError` has its own)."""
+    MISSING = "missing"
+    UNKNOWN = "unknown field"
+    """What `validation_problem` calls a value left out and a name the schema lacks."""
 
     def __init__(
         self,
@@ -70,14 +73,46 @@ class InputError(ValueError):
         where = self.where()
         return f"{where}: {self.reason}" if where else self.reason
 
+    @classmethod
+    def validation_problem(cls, exc: Any) -> tuple[tuple, str]:
+        """The location (pydantic's `loc`) and the words of the first problem of a pydantic
+        `ValidationError` (duck-typed: this module loads no library), with the class's
+        words for a missing and an unknown name: one reading of pydantic's messages for
+        every typed file (a scenario, a spindle spec, a model file's metadata)."""
+        first = exc.errors()[0]
+        # pydantic's words for a nested model ("a valid dictionary or instance of
+        # Metadata") name a class of ours, not anything in the file; a validator's own
+        # message comes after "Value error, "
+        message = first["msg"].removeprefix("Value error, ").split(" or instance of ")[0]
+        if first["type"] == "missing":  # pydantic's "Field required"
+            message = cls.MISSING
+        elif first["type"] == "extra_forbidden":
+            message = cls.UNKNOWN
+        return tuple(first["loc"]), message
+
+
+def key_path(loc: Sequence[object]) -> str:
+    """A place in nested data as a user reads it: `faults.dropouts[1].sensor` (a table's key
+    after a dot, a list's item by its index in brackets), '' for the top."""
+    path = ""
+    for item in loc:
+        if isinstance(item, int):
+            path += f"[{item}]"
+        else:
+            path += ("." if path else "") + str(item)
+    return path
+
 
 class TomlError(InputError):
     """Bad TOML input (a scenario, a spindle spec): `file, line 3, key 'faults.stuck'`.
-    Its row is the line and its column the dotted key (of a value or a table): told as
-    the CSV reader's "row" and "column", a user looked for a column in a TOML file."""
+    Its row is the line and its column the key (of a value or a table, `key_path`: a
+    list's item as `faults.dropouts[1]`): told as the CSV reader's "row" and "column", a
+    user looked for a column in a TOML file."""
 
     ROW = "line"
     COLUMN = "key"
+    MISSING = "missing required key"
+    UNKNOWN = "unknown key (check the spelling and the unit in the name)"
 
     def __init__(self, message: str, *, file: str | None = None, line: int | None = None,
                  key: str | None = None) -> None:
@@ -97,18 +132,9 @@ class MetadataError(InputError):
 
     @classmethod
     def from_validation(cls, exc: Any, file: str) -> MetadataError:
-        """The first problem of a pydantic `ValidationError` (duck-typed: this module
-        loads no library), at its dotted field."""
-        first = exc.errors()[0]
-        field = ".".join(str(k) for k in first["loc"]) or None
-        # pydantic's words for a nested model ("a valid dictionary or instance of
-        # Metadata") name a class of ours, not anything in the file
-        message = first["msg"].removeprefix("Value error, ").split(" or instance of ")[0]
-        if first["type"] == "missing":
-            message = "missing"
-        elif first["type"] == "extra_forbidden":
-            message = "unknown field"
-        return cls(message, file=file, field=field)
+        """The first problem of a pydantic `ValidationError`, at its field."""
+        loc, message = cls.validation_problem(exc)
+        return cls(message, file=file, field=key_path(loc) or None)
 
 
 def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:

@@ -13,8 +13,9 @@ import re
 import stat
 import tomllib
 from pathlib import Path
+from typing import Any
 
-from twin.errors import InputError, TomlError
+from twin.errors import InputError, TomlError, key_path
 
 MAX_INPUT_BYTES = 512 * 2**20
 """Largest input file read (512 MiB): a day of 10 Hz samples as CSV is under 100 MiB."""
@@ -84,6 +85,22 @@ def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
         raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
 
 
+MAX_TOML_BYTES = 2**20
+"""Largest TOML input (a scenario, a spindle spec): the bundled spec is 15 kB."""
+
+
+def read_toml(path: str | os.PathLike[str], *, column: str | None = None,
+              max_bytes: int = MAX_TOML_BYTES) -> tuple[str, dict]:
+    """The text of a TOML input file and its data (`parse_toml`); a file that cannot be
+    read as text is a TomlError too, so its line is called a line (`read_input_text`
+    counts a CSV file's lines as rows).  `column`: the option that named the file."""
+    try:
+        text = read_input_text(path, column=column, max_bytes=max_bytes)
+    except InputError as exc:
+        raise TomlError(exc.reason, file=exc.file, line=exc.row, key=exc.column) from None
+    return text, parse_toml(text, str(path), column)
+
+
 def parse_toml(text: str, file: str, column: str | None = None) -> dict:
     """TOML text as a dict; a syntax error names its line, and nesting too deep for the
     parser (thousands of `[`) is refused instead of exhausting the stack."""
@@ -97,6 +114,23 @@ def parse_toml(text: str, file: str, column: str | None = None) -> dict:
         raise TomlError(f"not valid TOML: {exc}", file=file, line=row, key=column) from None
     except RecursionError:
         raise TomlError("not valid TOML: nested too deeply", file=file, key=column) from None
+
+
+def toml_error(text: str | None, file: str, loc: tuple, message: str,
+               more: int = 0) -> TomlError:
+    """TomlError at `loc` (`('faults', 'dropouts', 1)`) of a TOML file, at its line when
+    the `text` is known; `more`: how many other problems the file has."""
+    if more > 0:
+        message += f" (and {more} more problem{'s' if more > 1 else ''})"
+    return TomlError(message, file=file, line=None if text is None else toml_line_of(text, loc),
+                     key=key_path(loc) or None)
+
+
+def toml_validation_error(exc: Any, text: str | None, file: str) -> TomlError:
+    """The first problem of a pydantic `ValidationError` of TOML data (a scenario, a
+    spindle spec) as a TomlError: one wording for every TOML file."""
+    loc, message = TomlError.validation_problem(exc)
+    return toml_error(text, file, loc, message, exc.error_count() - 1)
 
 
 def toml_line_of(text: str, loc: tuple) -> int | None:

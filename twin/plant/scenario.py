@@ -37,7 +37,7 @@ Sensors and faults:
                    spikes = [{sensor, time_s, size}]   (size in °C or µm)
     [model]        size_factor     (mesh refinement of the truth model; < 1 is finer)
 
-Unknown keys are errors naming the file and line (a typo must not silently fall back to
+Unknown keys are errors naming the file, line and key (a typo must not silently fall back to
 a default).  `dump_scenario` writes a `Scenario` back as TOML that parses to the same
 values (the `twin synth --suite` files).
 """
@@ -58,8 +58,7 @@ from pydantic import (
 )
 
 from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
-from twin.errors import TomlError
-from twin.paths import parse_toml, read_input_text, toml_line_of
+from twin.paths import parse_toml, read_toml, toml_error, toml_validation_error
 from twin.plant.timetable import TimeTable
 
 SENSOR_COLUMNS = {
@@ -230,20 +229,15 @@ class Scenario(_Strict):
 
 
 def parse_scenario(text: str, file: str = "<scenario>") -> Scenario:
-    """Parse scenario TOML text; errors name the file, line and dotted key."""
-    data = parse_toml(text, file)
+    """Parse scenario TOML text; errors name the file, line and key."""
+    return _validated(text, parse_toml(text, file), file)
+
+
+def _validated(text: str, data: dict, file: str) -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = tuple(err["loc"])
-        message = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":
-            message = "unknown key (check the spelling)"
-        elif err["type"] == "missing":  # pydantic's "Field required"
-            message = "missing required key"
-        raise TomlError(message, file=file, line=toml_line_of(text, loc),
-                        key=".".join(str(k) for k in loc) or None) from None
+        raise toml_validation_error(exc, text, file) from None
 
 
 def dump_scenario(scenario: Scenario, header: str = "") -> str:
@@ -265,8 +259,8 @@ def load_scenario(path: str | os.PathLike[str] | None,
     the run never reaches is an error (a spike was put on the last sample)."""
     if path is None:
         return Scenario()
-    text = read_input_text(path, column="--scenario", max_bytes=2**20)
-    scenario = parse_scenario(text, str(path))
+    text, data = read_toml(path, column="--scenario")
+    scenario = _validated(text, data, str(path))
     if duration_s is not None:
         _check_fault_times(scenario.faults, duration_s, text, str(path))
     return scenario
@@ -280,5 +274,4 @@ def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) 
              for k, drop in enumerate(faults.dropouts) if drop.start_s > duration_s]
     if late:
         loc, what = late[0]
-        raise TomlError(f"{what} is after the run's end ({duration_s:g} s)", file=file,
-                        line=toml_line_of(text, loc), key=".".join(map(str, loc)))
+        raise toml_error(text, file, loc, f"{what} is after the run's end ({duration_s:g} s)")

@@ -27,8 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from twin.contract import SENSOR_NAMES
 from twin.data import bundled_path
-from twin.errors import TomlError
-from twin.paths import parse_toml, read_input_text, toml_line_of
+from twin.paths import read_toml, toml_error, toml_validation_error
 
 DEFAULT_SPEC_PATH = bundled_path("meshes", "reference_spindle.toml").resolve()
 """The bundled reference spindle (package data, `twin.data`)."""
@@ -366,21 +365,17 @@ class SpindleSpec(_Strict):
 
 
 class _SpecErrors(ValueError):
-    """Cross-field problems, each (field path, message); turned into InputError."""
+    """Cross-field problems, each (field path, message); turned into TomlError."""
 
     def __init__(self, errors: list[tuple[str, str]]) -> None:
         self.errors = errors
         super().__init__("; ".join(f"{f}: {m}" for f, m in errors))
 
 
-def _field_path(loc: tuple) -> str:
-    path = ""
-    for item in loc:
-        if isinstance(item, int):
-            path += f"[{item}]"
-        else:
-            path += ("." if path else "") + str(item)
-    return path or "<top>"
+def _loc(path: str) -> tuple:
+    """`parts[3].region` as a pydantic location, ('parts', 3, 'region')."""
+    return tuple(int(index) if index else key
+                 for index, key in re.findall(r"\[(\d+)\]|([^.\[\]]+)", path))
 
 
 def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> SpindleSpec:
@@ -389,26 +384,16 @@ def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> S
     try:
         return SpindleSpec.model_validate(data)
     except ValidationError as exc:
-        first = exc.errors()[0]
-        cause = first.get("ctx", {}).get("error")
-        if isinstance(cause, _SpecErrors):
-            field_name, message = cause.errors[0]
-            more = len(cause.errors) - 1
-        else:
-            field_name, message = _field_path(first["loc"]), first["msg"]
-            if first["type"] == "missing":
-                message = "missing required key"
-            elif first["type"] == "extra_forbidden":
-                message = "unknown key (check the spelling and the unit in the name)"
-            more = exc.error_count() - 1
-        suffix = f" (and {more} more problem{'s' if more > 1 else ''})" if more > 0 else ""
-        row = None if text is None else toml_line_of(text, tuple(re.findall(r"[^.\[\]]+",
-                                                                             field_name)))
-        raise TomlError(f"{message}{suffix}", file=source, line=row, key=field_name) from None
+        cause = exc.errors()[0].get("ctx", {}).get("error")
+        if not isinstance(cause, _SpecErrors):
+            raise toml_validation_error(exc, text, source) from None
+        field_name, message = cause.errors[0]
+        raise toml_error(text, source, _loc(field_name), message,
+                         len(cause.errors) - 1) from None
 
 
 def load_spec(path: str | Path | None = None) -> SpindleSpec:
     """Read and validate a spindle spec TOML (None: the bundled reference spindle)."""
     path = Path(path) if path is not None else DEFAULT_SPEC_PATH
-    text = read_input_text(path, max_bytes=2**20)
-    return parse_spec(parse_toml(text, str(path)), str(path), text)
+    text, data = read_toml(path)
+    return parse_spec(data, str(path), text)
