@@ -244,6 +244,39 @@ def test_the_two_kinds_of_model_file_are_named_where_the_other_is_expected(ridge
     assert result.exit_code == 2 and "twin drift predict" in result.output
 
 
+def _safetensors(metadata: dict[str, str] | None) -> bytes:
+    from safetensors.numpy import save
+
+    return save({"w": np.zeros(2)}, metadata=metadata)
+
+
+@pytest.mark.parametrize("data", [
+    b"",
+    b"not a model\n",
+    b"\xff" * 64,
+    _safetensors(None),  # safetensors, but no model's metadata
+    _safetensors({"other_tool": "{}"}),
+], ids=["empty", "text", "bytes", "no-metadata", "foreign-metadata"])
+def test_the_two_model_loaders_refuse_a_file_that_is_neither_in_the_same_words(tmp_path,
+                                                                                data):
+    # the correction loader said "not a readable safetensors model file (Error while
+    # deserializing header: ...)" and "no 'spindle_twin' metadata: not a spindle-twin
+    # correction model", the drift loader "not a spindle-twin drift model file
+    # (safetensors with 'spindle_twin_drift' metadata)" of any of these
+    from twin.correction.modelfile import load_model
+
+    path = tmp_path / "m.safetensors"
+    path.write_bytes(data)
+    with pytest.raises(InputError) as as_correction:
+        load_model(path)
+    with pytest.raises(InputError) as as_drift:
+        load_drift_model(path)
+    words = as_correction.value.reason.replace("'spindle_twin' metadata", "KEY metadata")
+    assert words.replace("correction model", "MODEL") == as_drift.value.reason.replace(
+        "'spindle_twin_drift' metadata", "KEY metadata").replace("drift model", "MODEL")
+    assert as_drift.value.file == str(path)
+
+
 def _with_document(raw: bytes, change, path, checksum: bool = True):
     """A copy of the model file bytes `raw` at `path`, its JSON changed by `change`, and
     without the JSON's checksum unless `checksum` (a file written before it existed)."""

@@ -37,14 +37,11 @@ from twin.correction.features import (
 from twin.correction.network import CONFIGS, NetConfig, TrainedNet
 from twin.errors import InputError, MetadataError
 from twin.io.atomic import write_bytes
-from twin.paths import read_input_bytes
+from twin.modelfile import CORRECTION, read_model_file
 
-FORMAT = "spindle-twin-correction"
-VERSION = 1
-METADATA_KEY = "spindle_twin"
-DRIFT_METADATA_KEY = "spindle_twin_drift"
-"""`twin.drift.modelfile`'s key, to name a drift model given where a correction model is
-expected (spelt here: the drift package stays unloaded by replay)."""
+FORMAT = CORRECTION.format
+VERSION = CORRECTION.version
+METADATA_KEY = CORRECTION.key
 PARTS = ("hidden_weight", "hidden_bias", "output_weight", "output_bias",
          "x_offset", "x_scale", "y_offset", "y_scale")
 
@@ -140,39 +137,12 @@ def save_model(model: CorrectionModel, path: str | Path) -> Path:
 def load_model(path: str | Path, option: str | None = "--model") -> CorrectionModel:
     """Read and check a model file; any problem raises InputError naming the file (and
     `option`, the command-line option that gave it, if any)."""
-    from safetensors import SafetensorError
-    from safetensors.numpy import load
-
     path = Path(path)
-    raw = read_input_bytes(path, column=option, max_bytes=64 * 2**20)
-    try:
-        tensors = load(raw)
-        header_len = int.from_bytes(raw[:8], "little")
-        header = json.loads(raw[8 : 8 + header_len])
-    except (SafetensorError, ValueError, UnicodeDecodeError, RecursionError) as exc:
-        raise InputError(f"not a readable safetensors model file ({exc})", file=str(path)) from None
-    try:
-        meta = json.loads(header.get("__metadata__", {})[METADATA_KEY])
-    except (KeyError, TypeError, AttributeError, json.JSONDecodeError, RecursionError):
-        metadata = header.get("__metadata__") if isinstance(header, dict) else None
-        if isinstance(metadata, dict) and DRIFT_METADATA_KEY in metadata:
-            raise InputError("is a drift model (twin drift fit), not a correction model: "
-                             "use it with 'twin drift predict' or 'twin drift report'",
-                             file=str(path)) from None
-        raise InputError(
-            f"no '{METADATA_KEY}' metadata: not a spindle-twin correction model", file=str(path)
-        ) from None
-    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-        raise InputError(f"metadata format is not {FORMAT!r}", file=str(path))
+    tensors, meta = read_model_file(path, CORRECTION, option=option, max_bytes=64 * 2**20)
     try:
         _Metadata.model_validate(meta)
     except ValidationError as exc:
         raise MetadataError.from_validation(exc, str(path)) from None
-    if meta.get("version") != VERSION:
-        raise InputError(
-            f"model version {meta.get('version')!r} is not supported (expected {VERSION})",
-            file=str(path),
-        )
     config = CONFIGS.get(meta.get("config"))
     if config is None:
         raise InputError(f"unknown network configuration {meta.get('config')!r} (expected "

@@ -29,11 +29,11 @@ from twin.drift.model import DriftModel
 from twin.drift.modeldoc import ModelDocument
 from twin.errors import InputError, MetadataError
 from twin.io.atomic import write_bytes
-from twin.paths import read_input_bytes
+from twin.modelfile import DRIFT, read_model_file
 
-FORMAT = "spindle-twin-drift"
-VERSION = 1
-METADATA_KEY = "spindle_twin_drift"
+FORMAT = DRIFT.format
+VERSION = DRIFT.version
+METADATA_KEY = DRIFT.key
 VALIDATION = "validation."
 """Prefix of the tensors holding the out-of-fold validation (shown by `twin drift report`)."""
 
@@ -69,41 +69,10 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
     return write_bytes(path, data)
 
 
-def _is_correction_model(raw: bytes) -> bool:
-    """Whether the safetensors bytes carry `twin.correction.modelfile`'s metadata key."""
-    from twin.correction.modelfile import METADATA_KEY as CORRECTION_KEY
-
-    try:
-        header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
-        return CORRECTION_KEY in header["__metadata__"]
-    except (ValueError, KeyError, TypeError, UnicodeDecodeError):
-        return False
-
-
 def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
     """Read and check a drift model file; any problem raises InputError naming the file."""
-    from safetensors import SafetensorError
-    from safetensors.numpy import load
-
     file = str(path)
-    raw = read_input_bytes(path)
-    try:
-        tensors = load(raw)
-        header = json.loads(raw[8 : 8 + int.from_bytes(raw[:8], "little")])
-        doc = json.loads(header["__metadata__"][METADATA_KEY])
-    except (SafetensorError, ValueError, KeyError, TypeError, UnicodeDecodeError,
-            RecursionError):
-        if _is_correction_model(raw):
-            raise InputError("is a correction model (twin train), not a drift model: use it "
-                             "with 'twin replay --model' or 'twin model-info'",
-                             file=file) from None
-        raise InputError("not a spindle-twin drift model file (safetensors with "
-                         f"'{METADATA_KEY}' metadata)", file=file) from None
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        raise InputError(f"metadata format is not {FORMAT!r}", file=file)
-    if doc.get("version") != VERSION:
-        raise InputError(f"model version {doc.get('version')!r} is not supported "
-                         f"(expected {VERSION})", file=file)
+    tensors, doc = read_model_file(path, DRIFT)
     if doc.get("method") not in METHODS:
         raise InputError(f"unknown method {doc.get('method')!r}", file=file)
     for name, array in tensors.items():
