@@ -258,11 +258,18 @@ def _input(session: SessionState, st: Statement, depth: int) -> None:
     target = Path(os.path.realpath(base / name))
     if not target.is_relative_to(base):
         raise st.error(f"/INPUT file {name!r} lies outside the deck's folder {str(base)!r}")
-    if not target.is_file():
+    if not target.exists():  # a symlink loop too
         raise st.error(f"/INPUT file {name!r} not found in {str(base)!r}")
     shown = str(Path(st.file).parent / name) if st.file and not st.file.startswith("<") else name
+    try:
+        program = read_deck(target, shown)
+    except ApdlError as exc:
+        if exc.line is not None:
+            raise
+        # a folder or a fifo was "not found"; the file's problem at the /INPUT's line
+        raise st.error(f"/INPUT file {name!r}: {exc.reason}") from None
     session.inputs.append(target)
-    execute(session, read_deck(target, shown), depth + 1)
+    execute(session, program, depth + 1)
 
 
 def _repeat(session: SessionState, previous: Statement | None, st: Statement) -> None:

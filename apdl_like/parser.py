@@ -22,6 +22,8 @@ from functools import lru_cache
 from pathlib import Path
 
 from apdl_like.errors import ApdlError
+from twin.errors import InputError
+from twin.paths import read_input_bytes
 
 MAX_DECK_BYTES = 20_000_000  # far above any real deck; stops accidental binary/huge input
 MAX_LINE_CHARS = 640  # the APDL command-line limit
@@ -304,21 +306,14 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
 
 
 def read_deck(path: Path, shown: str | None = None) -> Program:
-    """Read and parse a deck file, with the size limit checked before reading."""
+    """Read and parse a deck file: a regular file of at most `MAX_DECK_BYTES`, checked
+    before a byte is read and refused in the words of every input of the twin
+    (`twin.paths.read_input_bytes`)."""
     name = shown or str(path)
     try:
-        size = path.stat().st_size
-    except OSError as exc:
-        raise ApdlError(f"cannot read deck: {exc.strerror}", file=name) from None
-    if size > MAX_DECK_BYTES:
-        raise ApdlError(
-            f"deck is {size / 1e6:.1f} MB, over the {MAX_DECK_BYTES // 1_000_000} MB limit",
-            file=name,
-        )
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ApdlError(f"cannot read deck: {exc.strerror}", file=name) from None
+        data = read_input_bytes(path, max_bytes=MAX_DECK_BYTES)
+    except InputError as exc:
+        raise ApdlError(exc.reason, file=name) from None
     try:
         text = data.decode("utf-8-sig")  # a Windows editor's byte-order mark is no command
     except UnicodeDecodeError:

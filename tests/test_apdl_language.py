@@ -15,6 +15,7 @@ from apdl_like.expressions import evaluate
 from apdl_like.interpreter import MAX_LOOP_ITERATIONS
 from apdl_like.parser import lex_line, parse_deck
 from apdl_like.session import Session
+from twin.errors import InputError
 
 
 def run(text: str, **kw) -> Session:
@@ -228,6 +229,33 @@ def test_file_size_limit(tmp_path, monkeypatch):
     big.write_text("A = 1\n" * 50)
     with pytest.raises(ApdlError, match="over the 0 MB limit|larger than"):
         Session().run_file(big)
+
+
+def test_a_deck_file_is_refused_in_the_words_of_every_input(tmp_path, monkeypatch):
+    # the deck reader checked its file itself: "deck is 0.0 MB, over the 0 MB limit" and
+    # "cannot read deck: ..." where every other input says what twin.paths says
+    import apdl_like.parser as parser
+    from twin.paths import read_input_bytes
+
+    monkeypatch.setattr(parser, "MAX_DECK_BYTES", 100)
+    big = tmp_path / "big.inp"
+    big.write_text("A = 1\n" * 50)
+    for path in (big, tmp_path / "missing.inp"):
+        with pytest.raises(InputError) as as_input:
+            read_input_bytes(path, max_bytes=100)
+        with pytest.raises(ApdlError) as as_deck:
+            Session().run_file(path)
+        assert str(as_deck.value) == str(as_input.value)
+
+
+def test_input_of_a_folder_says_so_at_the_input_line(tmp_path):
+    # /INPUT of a folder was "not found" in a folder where it plainly was
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "main.inp").write_text("A = 1\n/INPUT,sub\n")
+    with pytest.raises(ApdlError) as info:
+        Session().run_file(tmp_path / "main.inp")
+    assert info.value.line == 2 and info.value.reason == ("/INPUT file 'sub': is a folder, "
+                                                          "not a file")
 
 
 # -------------------------------------------------------------- fuzzing
