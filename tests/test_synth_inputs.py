@@ -472,3 +472,24 @@ def test_a_profile_with_a_spreadsheets_trailing_separators_reads(tmp_path):
     path.write_text("time_s,speed_rpm,,\n0,6000,,\n600,9000,\n")
     profile = read_speed_profile(path)
     assert list(profile.speed_rpm.values) == [6000.0, 9000.0] and profile.ignored == ()
+
+
+def test_a_toml_file_that_cannot_be_read_names_its_option(tmp_path):
+    # --scenario named its option ("s.toml, option '--scenario': cannot read file ..."),
+    # --spec of twin mesh and twin simulate did not
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    missing = tmp_path / "missing.toml"
+    runs = {
+        "--scenario": ["synth", "--speed", "6000", "--minutes", "2", "--ambient", "22",
+                       "--seed", "1", "--scenario", str(missing), "--out",
+                       str(tmp_path / "run.csv")],
+        "--spec": ["mesh", "--spec", str(missing), "--out", str(tmp_path / "m.msh")],
+    }
+    for option, args in runs.items():
+        result = CliRunner().invoke(app, args)
+        assert result.exit_code == 2
+        assert result.output == (f"error: {missing}, option {option!r}: cannot read file: "
+                                 "No such file or directory\n")

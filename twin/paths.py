@@ -98,10 +98,10 @@ def read_toml(path: str | os.PathLike[str], *, column: str | None = None,
         text = read_input_text(path, column=column, max_bytes=max_bytes)
     except InputError as exc:
         raise TomlError(exc.reason, file=exc.file, line=exc.row, key=exc.column) from None
-    return text, parse_toml(text, str(path), column)
+    return text, parse_toml(text, str(path))
 
 
-def parse_toml(text: str, file: str, column: str | None = None) -> dict:
+def parse_toml(text: str, file: str) -> dict:
     """TOML text as a dict; a syntax error names its line, and nesting too deep for the
     parser (thousands of `[`) is refused instead of exhausting the stack."""
     try:
@@ -111,9 +111,9 @@ def parse_toml(text: str, file: str, column: str | None = None) -> dict:
         row = int(match.group(1)) if match else None
         if row is None and "end of document" in str(exc):
             row = text.rstrip("\n").count("\n") + 1
-        raise TomlError(f"not valid TOML: {exc}", file=file, line=row, key=column) from None
+        raise TomlError(f"not valid TOML: {exc}", file=file, line=row) from None
     except RecursionError:
-        raise TomlError("not valid TOML: nested too deeply", file=file, key=column) from None
+        raise TomlError("not valid TOML: nested too deeply", file=file) from None
 
 
 def toml_error(text: str | None, file: str, loc: tuple, message: str,

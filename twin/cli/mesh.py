@@ -27,7 +27,7 @@ def mesh(
 
     check_out_file(out, inputs=[spec], suffixes=(".msh",))
     _keep_the_bundled_mesh(out, spec, size_factor)
-    the_spec = load_spec(spec)
+    the_spec = load_spec(spec, option="--spec")
     result = build_mesh(the_spec, size_factor)
     write_msh(result, out)
     if not quiet:

@@ -53,7 +53,7 @@ def simulate_command(
     check_out_dir(out, inputs=[spec],
                   owned=["fields"], files=["keypoints.csv", "fields.pvd", "summary.json"])
     # validate the operating point before the (slower) model build
-    check_operating_options(load_spec(spec), speed, ambient, coolant)
+    check_operating_options(load_spec(spec, option="--spec"), speed, ambient, coolant)
     model = SpindleModel.load(spec, size_factor=size_factor)
     every = field_every if field_every > 0 else minutes * 60.0
     result = simulate(model, speed, minutes, ambient, coolant, field_every_s=every)

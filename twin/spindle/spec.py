@@ -392,8 +392,10 @@ def parse_spec(data: dict, source: str = "<spec>", text: str | None = None) -> S
                          len(cause.errors) - 1) from None
 
 
-def load_spec(path: str | Path | None = None) -> SpindleSpec:
-    """Read and validate a spindle spec TOML (None: the bundled reference spindle)."""
+def load_spec(path: str | Path | None = None, *, option: str | None = None) -> SpindleSpec:
+    """Read and validate a spindle spec TOML (None: the bundled reference spindle);
+    `option`: the command-line option that named it (a file that cannot be read names it,
+    as a scenario's names `--scenario`)."""
     path = Path(path) if path is not None else DEFAULT_SPEC_PATH
-    text, data = read_toml(path)
+    text, data = read_toml(path, column=option)
     return parse_spec(data, str(path), text)
