@@ -18,7 +18,12 @@ from twin.runs.parquet_format import read_parquet_table, write_parquet_table
 from twin.runs.quality import QualityConfig, drop_repeated_rows, finding, repair
 from twin.runs.schema import AMBIENT, COOLANT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
-from twin.runs.validate import check_operating_range, check_structure, check_values
+from twin.runs.validate import (
+    check_operating_range,
+    check_speed_limit,
+    check_structure,
+    check_values,
+)
 
 # one reader and one writer per format, chosen by file suffix (meshio's registry)
 _READERS = {".csv": read_csv_table, ".parquet": read_parquet_table, ".pq": read_parquet_table}
@@ -181,8 +186,7 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
     check_values(table)
     # The speed limit holds for the speeds as written: the repair replaces a one-sample
     # speed glitch, but one beyond the spindle's limit is a corrupt value to be told.
-    check_operating_range(table.file, table.rows, {SPEED: table.columns[SPEED]},
-                          max_speed_rpm)
+    check_speed_limit(table.file, table.rows, table.columns[SPEED], max_speed_rpm)
     fixed = repair(table, config)
     check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm)
     quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
