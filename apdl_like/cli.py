@@ -23,7 +23,7 @@ import typer
 from twin.errors import InputError, report_errors, run_console_script
 from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
-from twin.paths import regular_file_info
+from twin.paths import check_input_file, regular_file_info
 from twin.version import version_option
 
 app = typer.Typer(
@@ -75,7 +75,7 @@ def run(
         if not spindle:
             raise InputError("--start needs --spindle (a state of the reference spindle's "
                              "nodes)")
-        regular_file_info(start, use="read start state")
+        check_input_file(start, column="--start")  # a folder, a fifo, too large to read
     check_out_dir(out, inputs=[deck, *([start] if start is not None else [])],
                   files=["params.json", "log.txt"])
     session = _spindle_session(deck.parent, strict) if spindle else Session(

@@ -103,3 +103,22 @@ def test_quiet_keeps_the_unknown_command_warnings(tmp_path):
     assert result.stdout == ""
     assert result.stderr == (f"warning: {deck}:2: FROBNICATE: unknown or unsupported command "
                              "FROBNICATE; ignored\n")
+
+
+def test_start_state_too_large_to_read_is_refused_before_any_work(tmp_path):
+    # --start was checked to be a file but read whole by meshio whatever its size
+    from typer.testing import CliRunner
+
+    from apdl_like.cli import app
+    from twin.paths import MAX_INPUT_BYTES
+
+    deck = tmp_path / "w.inp"
+    deck.write_text("/SOLU\n", encoding="utf-8")
+    start = tmp_path / "huge.vtu"
+    with start.open("wb") as f:  # sparse: no disk used
+        f.truncate(MAX_INPUT_BYTES + 1)
+    result = CliRunner().invoke(app, ["run", str(deck), "--spindle", "--out",
+                                      str(tmp_path / "out"), "--start", str(start)])
+    assert result.exit_code == 2, result.output
+    assert "huge.vtu, option '--start'" in result.output and "larger than" in result.output
+    assert not (tmp_path / "out").exists()
