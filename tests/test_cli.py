@@ -12,7 +12,7 @@ import typer
 from typer.testing import CliRunner
 
 from twin.cli import COMMANDS, app
-from twin.errors import InputError, report_errors
+from twin.errors import InputError, TomlError, report_errors
 
 COMMAND_NAMES = [name for name, _ in COMMANDS]
 
@@ -144,6 +144,19 @@ def test_report_errors_maps_errors_to_exit_codes(error, code, message):
     assert "Traceback" not in result.output
 
 
+def test_an_errors_row_is_told_in_its_files_unit():
+    # a CSV file's row is its line (RawTable.row_unit); a Parquet file's, a data row
+    assert str(InputError("bad", file="run.csv", row=4, column="T1_C", row_unit="line")) == (
+        "run.csv, line 4, column 'T1_C': bad")
+    assert str(InputError("bad", file="run.parquet", row=4)) == "run.parquet, row 4: bad"
+    # located() fills in a row with its unit, and keeps a row already known with its own
+    err = InputError("bad", column="T1_C").located("run.csv", 7, row_unit="line")
+    assert str(err) == "run.csv, line 7, column 'T1_C': bad"
+    err = InputError("bad", row=4, row_unit="line").located("run.csv", 9, "T1_C", "row")
+    assert str(err) == "run.csv, line 4, column 'T1_C': bad"
+    assert str(TomlError("bad", file="s.toml", line=2, key="a")) == "s.toml, line 2, key 'a': bad"
+
+
 def test_report_errors_lets_typer_exit_through():
     result = CliRunner().invoke(_wrapped_app(typer.Exit(3)), ["fail"])
     assert result.exit_code == 3
@@ -271,14 +284,14 @@ def test_apdl_like_help(args):
     assert "Usage: " in result.output
 
 
-def test_synth_profile_over_the_speed_limit_names_its_row(tmp_path):
+def test_synth_profile_over_the_speed_limit_names_its_line(tmp_path):
     profile = tmp_path / "p.csv"
     profile.write_text("time_s,speed_rpm\n0,6000\n60,99000\n120,6000\n")
     result = CliRunner().invoke(app, [
         "synth", "--profile", str(profile), "--minutes", "3", "--ambient", "25", "--seed", "1",
         "--out", str(tmp_path / "run.csv"), "--quiet"])
     assert result.exit_code == 2, result.output
-    assert f"{profile}, row 3, column 'speed_rpm'" in result.output
+    assert f"{profile}, line 3, column 'speed_rpm'" in result.output
     assert "15000 rpm" in result.output and "Traceback" not in result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["p.csv"]
 

@@ -83,14 +83,14 @@ def _bad(tmp_path, change):
 
 
 @pytest.mark.parametrize(("change", "target", "expected"), [
-    (lambda c: None, "nope_um", "bad.csv, row 1, column 'nope_um'"),
+    (lambda c: None, "nope_um", "bad.csv, line 1, column 'nope_um'"),
     (lambda c: [c.pop(k) for k in ("A_C", "B_C", "C_C")], "drift_um",
-     "bad.csv, row 1: no temperature columns"),
-    (lambda c: c["time_s"].__setitem__(5, 0.0), "drift_um", "bad.csv, row 7, column 'time_s'"),
+     "bad.csv, line 1: no temperature columns"),
+    (lambda c: c["time_s"].__setitem__(5, 0.0), "drift_um", "bad.csv, line 7, column 'time_s'"),
     (lambda c: c["C_C"].__setitem__(slice(None), np.nan), "drift_um",
-     "bad.csv, row 2, column 'C_C'"),
+     "bad.csv, line 2, column 'C_C'"),
 ])
-def test_bad_data_exits_2_naming_file_row_and_column(tmp_path, change, target, expected):
+def test_bad_data_exits_2_naming_file_line_and_column(tmp_path, change, target, expected):
     data = _bad(tmp_path, change)
     result = run("fit", str(data), "--target", target, "--out", str(tmp_path / "m.safetensors"))
     assert result.exit_code == 2, result.output
@@ -120,7 +120,7 @@ def test_unknown_method_and_sensor_are_bad_input(machine, tmp_path):
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--method", "magic")
     assert result.exit_code == 2 and "unknown method" in result.output
     result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", "Z_C")
-    assert result.exit_code == 2 and f"{data}, row 1, column 'Z_C'" in result.output
+    assert result.exit_code == 2 and f"{data}, line 1, column 'Z_C'" in result.output
     for listed in ("A_C,drift_um", ",", "speed_rpm"):
         result = run("fit", str(data), "--target", "drift_um", "--out", out, "--sensors", listed)
         assert result.exit_code == 2 and "option '--sensors'" in result.output, result.output
@@ -298,7 +298,7 @@ def test_listed_sensors_need_not_be_the_first_files_every_column(tmp_path):
     result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
                  "--method", "ridge_dynamic", "--sensors", "A_C,C_C", "--quiet")
     assert result.exit_code == 2, result.output
-    assert f"{second}, row 1, column 'C_C': missing required column" in result.output
+    assert f"{second}, line 1, column 'C_C': missing required column" in result.output
 
 
 def test_an_empty_speed_column_is_no_speed_column(tmp_path):
@@ -322,7 +322,7 @@ def test_an_empty_speed_column_is_no_speed_column(tmp_path):
                "--method", "ridge_dynamic", "--quiet").exit_code == 0
     result = run("predict", str(speed_model), str(second), "--out", str(pred))
     assert result.exit_code == 2, result.output
-    assert f"{second}, row 2, column 'speed_rpm': column has no values" in result.output
+    assert f"{second}, line 2, column 'speed_rpm': column has no values" in result.output
 
 
 @pytest.mark.parametrize("sensors", ["auto", "all", "2"])

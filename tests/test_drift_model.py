@@ -119,6 +119,38 @@ def test_time_going_back_names_the_line(tmp_path):
     assert (err.value.row, err.value.column) == (12, "time_s")   # header is line 1
 
 
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_drift_data_errors_name_a_csv_files_line_and_a_parquet_files_row(tmp_path, suffix):
+    # the location said "row 13" of a CSV file whose message spoke of "line 12"
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    columns = synthetic_columns(hours=0.5)
+    columns["time_s"][10] = columns["time_s"][8]
+    path = tmp_path / f"bad{suffix}"
+    if suffix == ".csv":
+        write_csv(path, columns, metadata="# machine: m1\n")  # header line 2, sample 10 line 13
+        where, before = "line 13", "line 12"
+    else:
+        pq.write_table(pa.table(columns), path)
+        where, before = "row 11", "row 10"
+    with pytest.raises(InputError) as err:
+        read_drift_data([path], targets=["drift_um"])
+    assert str(err.value) == (f"{path}, {where}, column 'time_s': time goes back from 135 s "
+                              f"({before}) to 120 s; samples must be in time order")
+    del columns["A_C"], columns["B_C"], columns["C_C"]
+    path.unlink()
+    if suffix == ".csv":  # the header's line; a Parquet file has none to name
+        write_csv(path, columns, metadata="# machine: m1\n")
+        message = f"{path}, line 2: no temperature columns (names ending in _C)"
+    else:
+        pq.write_table(pa.table(columns), path)
+        message = f"{path}: no temperature columns (names ending in _C)"
+    with pytest.raises(InputError) as err:
+        read_drift_data([path], targets=["drift_um"])
+    assert str(err.value) == message
+
+
 def test_a_repeated_time_is_an_error(tmp_path):
     columns = synthetic_columns(hours=0.5)
     columns["time_s"][10] = columns["time_s"][9]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -141,12 +142,79 @@ def test_empty_file(tmp_path):
 def test_time_going_back(tmp_path):
     cols = warmup()
     cols["time_s"][50] = 10.0
-    err = expect_error(write(tmp_path, csv_text(cols)), 52, "time_s", "time goes back")
-    assert "from 49 s (line 51) to 10 s" in err.reason  # the CSV's editor lines
+    path = write(tmp_path, csv_text(cols))
+    err = expect_error(path, 52, "time_s", "time goes back")
+    # the CSV's editor lines, in the location as in the words: the location said "row 52"
+    # of a message that spoke of "line 51"
+    assert str(err).startswith(f"{path}, line 52, column 'time_s': time goes back from 49 s "
+                               "(line 51) to 10 s")
     path = tmp_path / "back.parquet"
     write_run(path, cols)
     err = expect_error(path, 51, "time_s", "time goes back")
-    assert "from 49 s (row 50) to 10 s" in err.reason  # a Parquet file has rows, no lines
+    # a Parquet file has rows, no lines
+    assert str(err).startswith(f"{path}, row 51, column 'time_s': time goes back from 49 s "
+                               "(row 50) to 10 s")
+
+
+def _ambient_out_of_range(cols: dict[str, np.ndarray]) -> None:
+    cols["ambient_C"][10:60] = 50.0  # over 45 °C; the median stays 25 °C: not Fahrenheit
+
+
+def _kelvin(cols: dict[str, np.ndarray]) -> None:
+    cols["T2_C"] += 273.15
+    cols["T2_C"][:10] = np.nan  # named at its first value
+
+
+@pytest.mark.parametrize(("change", "column", "words", "limit"), [
+    (lambda c: c["speed_rpm"].__setitem__(10, -5.0), "speed_rpm", "negative speed -5 rpm",
+     math.inf),
+    (lambda c: c["speed_rpm"].__setitem__(10, 99000.0), "speed_rpm",
+     "speed 99000 rpm exceeds the spindle's limit 15000 rpm", 15000.0),
+    (_ambient_out_of_range, "ambient_C", "50 °C is outside the -40..45 °C", math.inf),
+    (_kelvin, "T2_C", "values look like Kelvin", math.inf),
+    (lambda c: c["time_s"].__setitem__(10, np.nan), "time_s", "time is missing", math.inf),
+], ids=["negative_speed", "speed_limit", "ambient_range", "kelvin", "no_time"])
+def test_a_csv_error_names_the_line_a_parquet_error_the_data_row(tmp_path, change, column,
+                                                                   words, limit):
+    """The same fault at sample 10 is at line 14 of a CSV file (two metadata lines and
+    the header before it) and at row 11 of a Parquet file: the location says which, as
+    an editor and a table viewer number them (a CSV error said "row 14")."""
+    cols = warmup()
+    change(cols)
+    csv_path = write(tmp_path, csv_text(cols, "# name: x\n\n"))
+    parquet_path = tmp_path / "run.parquet"
+    write_run(parquet_path, cols, {"name": "x"})
+    found = []
+    for path, where in ((csv_path, "line 14"), (parquet_path, "row 11")):
+        with pytest.raises(InputError) as info:
+            read_run(path, max_speed_rpm=limit)
+        assert str(info.value).startswith(f"{path}, {where}, column '{column}': "), info.value
+        assert words in info.value.reason, info.value.reason
+        found.append(info.value.reason)
+    assert found[0] == found[1]  # told in the same words but for the place
+
+
+def test_a_bad_cell_is_at_a_csv_files_line_and_a_parquet_files_row(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    cols = warmup()
+    text = csv_text(cols, "# name: x\n").splitlines()
+    fields = text[12].split(",")  # sample 10 on line 13: the header is line 2
+    fields[1] = "fast"
+    text[12] = ",".join(fields)
+    path = write(tmp_path, "\n".join(text) + "\n")
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    assert str(info.value) == f"{path}, line 13, column 'speed_rpm': cannot read 'fast' as a number"
+    table = {k: list(v) for k, v in cols.items()}
+    table["speed_rpm"] = [str(v) for v in cols["speed_rpm"]]
+    table["speed_rpm"][10] = "fast"
+    path = tmp_path / "run.parquet"
+    pq.write_table(pa.table(table), path)
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    assert str(info.value) == f"{path}, row 11, column 'speed_rpm': cannot read 'fast' as a number"
 
 
 def test_too_short_for_two_windows(tmp_path):
@@ -273,7 +341,7 @@ def test_files_with_bare_cr_line_ends_read_as_with_lf(tmp_path):
 
 @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
 def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
-    # Excel's "Unicode text" is UTF-16: "row 1: not UTF-8 text" left the user guessing
+    # Excel's "Unicode text" is UTF-16: "line 1: not UTF-8 text" left the user guessing
     path = tmp_path / "run.csv"
     text = csv_text(warmup(), "# name: Prüfstand\n")
     path.write_bytes(("\ufeff" if encoding.endswith("be") else "").encode(encoding)
@@ -282,7 +350,7 @@ def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
         read_run(path)
     assert str(info.value) == f"{path}: UTF-16 text; save it as UTF-8"
     path.write_bytes(text.encode("latin-1"))  # not UTF-8, but no UTF-16 either
-    with pytest.raises(InputError, match="row 1: not UTF-8 text"):
+    with pytest.raises(InputError, match=", line 1: not UTF-8 text"):
         read_run(path)
 
 

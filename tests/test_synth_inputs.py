@@ -304,6 +304,9 @@ def test_bad_speed_profiles(tmp_path, text, row, column):
     with pytest.raises(InputError) as info:
         read_speed_profile(path)
     assert (info.value.row, info.value.column) == (row, column)
+    # a profile is a CSV file: its place is called a line, as an editor numbers it (the
+    # location said "row 3" of a file whose first data row was line 3)
+    assert str(info.value).startswith(f"{path}, line {row}"), info.value
 
 
 def _run_and_profile_text(change) -> str:  # noqa: ANN001
@@ -355,11 +358,11 @@ def test_a_profile_step_without_a_value_is_called_missing(tmp_path, cell):
     path.write_text(f"time_s,speed_rpm,ambient_C\n0,6000,22\n60,{cell},22\n120,0,{cell}\n")
     with pytest.raises(InputError) as info:
         read_speed_profile(path)
-    assert str(info.value) == f"{path}, row 3, column 'speed_rpm': value is missing"
+    assert str(info.value) == f"{path}, line 3, column 'speed_rpm': value is missing"
     path.write_text(f"time_s,speed_rpm,ambient_C\n0,6000,22\n60,0,{cell}\n")
     with pytest.raises(InputError) as info:
         read_speed_profile(path)
-    assert str(info.value) == f"{path}, row 3, column 'ambient_C': value is missing"
+    assert str(info.value) == f"{path}, line 3, column 'ambient_C': value is missing"
 
 
 def test_scenario_and_profile_take_the_range_replay_takes(tmp_path):

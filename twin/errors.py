@@ -26,7 +26,8 @@ class InputError(ValueError):
 
     ROW = "row"
     COLUMN = "column"
-    """How `where` calls the row and the column (a table's words; `TomlError` has its own)."""
+    """How `where` calls the row and the column (a table's words; `TomlError` has its own);
+    an error's `row_unit` says otherwise where the row is a file's line (a CSV table)."""
     MISSING = "missing"
     UNKNOWN = "unknown field"
     """What `validation_problem` calls a value left out and a name the schema lacks."""
@@ -38,34 +39,42 @@ class InputError(ValueError):
         file: str | None = None,
         row: int | None = None,
         column: str | None = None,
+        row_unit: str | None = None,
     ) -> None:
         super().__init__(message)
         self.reason = message
         self.file = file
         self.row = row
         self.column = column
+        # what `where` calls the row: "line" for a text file's line (a CSV table's, as an
+        # editor numbers them: `RawTable.row_unit`), else the class's word
+        self.row_unit = row_unit or self.ROW
 
     def where(self) -> str:
-        """The location as the message shows it (`data.csv, row 3, column 'T_C'`), or ''.
+        """The location as the message shows it (`data.csv, line 3, column 'T_C'`, a
+        Parquet file's `data.parquet, row 3, column 'T_C'`), or ''.
         A command-line option in the column's place is called one (`RUN.csv, option
         '--time'`): a user reading "column '--out'" looked for it in a file."""
         where = []
         if self.file is not None:
             where.append(str(self.file))
         if self.row is not None:
-            where.append(f"{self.ROW} {self.row}")
+            where.append(f"{self.row_unit} {self.row}")
         if self.column is not None:
             kind = "option" if self.column.startswith("--") else self.COLUMN
             where.append(f"{kind} {self.column!r}")
         return ", ".join(where)
 
     def located(self, file: str | None = None, row: int | None = None,
-                column: str | None = None) -> Self:
+                column: str | None = None, row_unit: str | None = None) -> Self:
         """The same error with its location filled in where it was still unknown (a
-        reader's error re-raised by the caller that knows the file)."""
+        reader's error re-raised by the caller that knows the file); a row filled in comes
+        with `row_unit` (default: the error's own), a row already known keeps its unit."""
         err = copy.copy(self)
         err.file = self.file if self.file is not None else file
-        err.row = self.row if self.row is not None else row
+        if self.row is None and row is not None:
+            err.row = row
+            err.row_unit = row_unit or self.row_unit
         err.column = self.column if self.column is not None else column
         return err
 
@@ -106,8 +115,8 @@ def key_path(loc: Sequence[object]) -> str:
 class TomlError(InputError):
     """Bad TOML input (a scenario, a spindle spec): `file, line 3, key 'faults.stuck'`.
     Its row is the line and its column the key (of a value or a table, `key_path`: a
-    list's item as `faults.dropouts[1]`): told as the CSV reader's "row" and "column", a
-    user looked for a column in a TOML file."""
+    list's item as `faults.dropouts[1]`): told as a table's "row" and "column", a user
+    looked for a column in a TOML file."""
 
     ROW = "line"
     COLUMN = "key"

@@ -82,7 +82,8 @@ def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
             raise InputError("UTF-16 text; save it as UTF-8", file=str(path),
                              column=column) from None
         line = data[: exc.start].count(b"\n") + 1
-        raise InputError("not UTF-8 text", file=str(path), row=line, column=column) from None
+        raise InputError("not UTF-8 text", file=str(path), row=line, column=column,
+                         row_unit="line") from None
 
 
 MAX_TOML_BYTES = 2**20
@@ -92,8 +93,8 @@ MAX_TOML_BYTES = 2**20
 def read_toml(path: str | os.PathLike[str], *, column: str | None = None,
               max_bytes: int = MAX_TOML_BYTES) -> tuple[str, dict]:
     """The text of a TOML input file and its data (`parse_toml`); a file that cannot be
-    read as text is a TomlError too, so its line is called a line (`read_input_text`
-    counts a CSV file's lines as rows).  `column`: the option that named the file."""
+    read as text is a TomlError too, told as a syntax error is (`file, line 2: ...`).
+    `column`: the option that named the file."""
     try:
         text = read_input_text(path, column=column, max_bytes=max_bytes)
     except InputError as exc:

@@ -132,8 +132,7 @@ def _without_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
 def _check_temperatures(table: RawTable) -> list[str]:
     names = temperature_columns(table)
     if not names:
-        raise InputError("no temperature columns (names ending in _C)", file=table.file,
-                         row=table.header_row)
+        raise table.error("no temperature columns (names ending in _C)", table.header_row)
     return names
 
 

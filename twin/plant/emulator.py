@@ -228,7 +228,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     spec = model.spec
     limit = spec.spindle.max_speed_rpm
     rows = profile.rows if profile is not None and profile.rows else None
-    check_speed_limit(profile_name, rows, speed.values, limit)
+    check_speed_limit(profile_name, rows, speed.values, limit,
+                      row_unit=profile.row_unit if profile is not None else "row")
 
     # the first two streams are those of the runs before model-form error existed
     truth_seed, noise_seed, form_seed, place_seed = np.random.SeedSequence(seed).spawn(4)

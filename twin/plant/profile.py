@@ -14,7 +14,6 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from twin.errors import InputError
 from twin.plant.timetable import StepTable
 from twin.runs.csv_format import read_csv_table
 from twin.runs.schema import AMBIENT, SPEED, TIME
@@ -40,6 +39,8 @@ class SpeedProfile:
     ignored: tuple[str, ...] = ()
     """Header columns the profile does not read (a recorded run's T1_C.., a coolant_C or a
     misspelt ambient), for the command to tell."""
+    row_unit: str = "line"
+    """What an error calls a place of `rows` (the CSV reader's word, `RawTable.row_unit`)."""
 
 
 def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
@@ -57,16 +58,18 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
     required_column(table, SPEED)
     time = complete_column(table, TIME, "time")
     if time[0] != 0:
-        raise InputError(f"the first row must be at 0 s, the run's start (got {time[0]:g} s): "
-                         "add a row at 0 s with the speed until then (0 rpm: standing)",
-                         file=table.file, row=int(table.rows[0]), column=TIME)
+        raise table.error(f"the first row must be at 0 s, the run's start (got {time[0]:g} s): "
+                          "add a row at 0 s with the speed until then (0 rpm: standing)",
+                          table.rows[0], TIME)
     checked_time(table, repeats=False)
     speed = complete_column(table, SPEED)
     check_speed_sign(table)
     ambient = None
     if AMBIENT in table.columns:
         values = complete_column(table, AMBIENT)
-        check_operating_temperature(table.file, table.rows, AMBIENT, values)
+        check_operating_temperature(table.file, table.rows, AMBIENT, values,
+                                    row_unit=table.row_unit)
         ambient = StepTable(time, values)
     return SpeedProfile(StepTable(time, speed), ambient,
-                        tuple(int(row) for row in table.rows), tuple(table.ignored_columns))
+                        tuple(int(row) for row in table.rows), tuple(table.ignored_columns),
+                        table.row_unit)

@@ -19,6 +19,10 @@ from twin.paths import read_input_text
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
 from twin.runs.table import RawTable, parse_cell
 
+LINE = "line"
+"""What an error calls a place in a CSV file (`RawTable.row_unit`): its line, numbered as an
+editor numbers them, not a data row (`bad.csv, line 4, column 'T1_C'`)."""
+
 
 def read_csv_table(path: str | os.PathLike[str],
                    keep: Callable[[str], bool] | None = None, *,
@@ -64,10 +68,12 @@ def read_csv_table(path: str | os.PathLike[str],
         raise InputError("empty file: no header row and no data", file=file)
     check_header(header, file, header_line)
     if not data_lines:
-        raise InputError("no data rows after the header", file=file, row=header_line)
+        raise InputError("no data rows after the header", file=file, row=header_line,
+                         row_unit=LINE)
     if max_rows is not None and len(data_lines) > max_rows:
         raise InputError(f"{len(data_lines)} data rows; a run may hold at most {max_rows} "
-                         "samples (resample it)", file=file, row=data_numbers[max_rows])
+                         "samples (resample it)", file=file, row=data_numbers[max_rows],
+                         row_unit=LINE)
 
     known = [(i, name) for i, name in enumerate(header) if keep(name)]
     ignored = [name for name in header if not keep(name)]
@@ -77,14 +83,14 @@ def read_csv_table(path: str | os.PathLike[str],
         fields = without_trailing_blanks(fields, len(header))
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields as in the header, found "
-                             f"{len(fields)}", file=file, row=line)
+                             f"{len(fields)}", file=file, row=line, row_unit=LINE)
         row = values[k]
         for j, (i, name) in enumerate(known):
-            row[j] = parse_cell(fields[i], file, line, name)
+            row[j] = parse_cell(fields[i], file, line, name, LINE)
     columns = {name: values[:, j].copy() for j, (_, name) in enumerate(known)}
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
-                    ignored_columns=ignored)
+                    ignored_columns=ignored, row_unit=LINE)
 
 
 def without_trailing_blanks(fields: list[str], width: int | None = None) -> list[str]:
@@ -106,10 +112,11 @@ def check_header(header: list[str], file: str, line: int) -> None:
     check_comma_separated(header, file, line)
     for position, name in enumerate(header, start=1):
         if not name:
-            raise InputError(f"header field {position} is empty", file=file, row=line)
+            raise InputError(f"header field {position} is empty", file=file, row=line,
+                             row_unit=LINE)
         if header.count(name) > 1:
             raise InputError("column appears twice in the header", file=file, row=line,
-                             column=name)
+                             column=name, row_unit=LINE)
 
 
 def check_comma_separated(header: list[str], file: str, line: int) -> None:
@@ -121,7 +128,7 @@ def check_comma_separated(header: list[str], file: str, line: int) -> None:
             if separator in header[0]:
                 raise InputError(f"the header is one column holding {separator!r}: the file is "
                                  f"separated by {separator!r}; write it comma-separated, with "
-                                 "decimal points", file=file, row=line)
+                                 "decimal points", file=file, row=line, row_unit=LINE)
 
 
 def csv_records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
@@ -137,10 +144,11 @@ def csv_records(lines: list[str], file: str, numbers: list[int]) -> Iterator[lis
             return
         except csv.Error as exc:
             line = numbers[min(reader.line_num, len(numbers)) - 1]
-            raise InputError(f"not a readable CSV line ({exc})", file=file, row=line) from None
+            raise InputError(f"not a readable CSV line ({exc})", file=file, row=line,
+                             row_unit=LINE) from None
         if reader.line_num != k + 1:
             raise InputError("a quoted cell runs over several lines", file=file,
-                             row=numbers[k])
+                             row=numbers[k], row_unit=LINE)
         k += 1
         yield fields
 

@@ -17,6 +17,10 @@ from twin.paths import check_input_file
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
 from twin.runs.table import RawTable, parse_cell
 
+ROW = "row"
+"""What an error calls a place in a Parquet file (`RawTable.row_unit`): its data row,
+1-based (`bad.parquet, row 3, column 'T1_C'`)."""
+
 
 def _is_tool_metadata(key: str) -> bool:
     # Written by pandas/pyarrow themselves, not by the user.
@@ -40,11 +44,11 @@ def _column_values(column, file: str, name: str) -> np.ndarray:  # noqa: ANN001 
         bad = np.flatnonzero(np.isinf(values))
         if bad.size:
             raise InputError("not a finite number", file=file, row=int(bad[0]) + 1,
-                             column=name)
+                             column=name, row_unit=ROW)
         return values
     if pa.types.is_string(kind) or pa.types.is_large_string(kind):
         texts = column.to_pylist()
-        return np.array([math.nan if text is None else parse_cell(text, file, i, name)
+        return np.array([math.nan if text is None else parse_cell(text, file, i, name, ROW)
                          for i, text in enumerate(texts, start=1)], dtype=float)
     raise InputError(f"column type {kind} is not numeric", file=file, column=name)
 
@@ -64,7 +68,7 @@ def read_parquet_table(path: str | os.PathLike[str],
         if parquet.metadata.num_rows > MAX_SAMPLES:
             raise InputError(f"{parquet.metadata.num_rows} data rows; a run may hold at most "
                              f"{MAX_SAMPLES} samples (resample it)", file=file,
-                             row=MAX_SAMPLES + 1)
+                             row=MAX_SAMPLES + 1, row_unit=ROW)
         table = parquet.read()
     except (OSError, pa.ArrowException) as exc:
         raise InputError(f"not a readable Parquet file: {exc}", file=file) from None
@@ -88,7 +92,7 @@ def read_parquet_table(path: str | os.PathLike[str],
     ignored = [name for name in table.column_names if not keep(name)]
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.arange(1, table.num_rows + 1, dtype=np.int64),
-                    ignored_columns=ignored, row_unit="row")
+                    ignored_columns=ignored, row_unit=ROW)
 
 
 def write_parquet_table(

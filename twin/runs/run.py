@@ -168,10 +168,11 @@ def read_run(path: str | os.PathLike[str], config: QualityConfig | None = None,
              max_speed_rpm: float = math.inf) -> RecordedRun:
     """Read, validate and repair a recorded run (CSV or Parquet, by file suffix).
 
-    Hard errors raise `InputError` with the file, the row (1-based line in a CSV file)
-    and the column: besides the format, a run longer than `MAX_DURATION_S`, a speed above
-    `max_speed_rpm` (the spindle's limit: pass the spec's) or an ambient or coolant outside
-    `OPERATING_TEMPERATURE_C` is refused here, before any replay.  Repairs are listed in
+    Hard errors raise `InputError` with the file, the line (of a CSV file, as an editor
+    numbers them) or row (a Parquet file's data row) and the column: besides the format,
+    a run longer than `MAX_DURATION_S`, a speed above `max_speed_rpm` (the spindle's
+    limit: pass the spec's) or an ambient or coolant outside `OPERATING_TEMPERATURE_C` is
+    refused here, before any replay.  Repairs are listed in
     `RecordedRun.quality`.
     """
     return run_from_table(read_table(path), config, max_speed_rpm)
@@ -186,9 +187,11 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
     check_values(table)
     # The speed limit holds for the speeds as written: the repair replaces a one-sample
     # speed glitch, but one beyond the spindle's limit is a corrupt value to be told.
-    check_speed_limit(table.file, table.rows, table.columns[SPEED], max_speed_rpm)
+    check_speed_limit(table.file, table.rows, table.columns[SPEED], max_speed_rpm,
+                      row_unit=table.row_unit)
     fixed = repair(table, config)
-    check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm)
+    check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm,
+                          row_unit=table.row_unit)
     quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
                        detail="unknown column name") for n in table.ignored_columns]
     quality += repeats + fixed.findings

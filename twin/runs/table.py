@@ -38,6 +38,13 @@ class RawTable:
     def n_samples(self) -> int:
         return int(self.rows.size)
 
+    def error(self, message: str, row: int | None = None,
+              column: str | None = None) -> InputError:
+        """InputError in this table's file at `row` (one of `rows`, or `header_row`), called
+        a line or a row as the file has them (`row_unit`)."""
+        return InputError(message, file=self.file, row=None if row is None else int(row),
+                          column=column, row_unit=self.row_unit)
+
 
 MISSING_TOKENS = frozenset({"", "nan", "na", "n/a", "null", "none"})
 """Cell texts (case-insensitive, after stripping blanks) that mean "no value"."""
@@ -50,20 +57,22 @@ MAX_NUMBER_CHARS = 64
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
-def parse_cell(cell: str, file: str, row: int, column: str) -> float:
-    """One cell of a run table as a float (NaN for a missing value), or `InputError`."""
+def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> float:
+    """One cell of a run table as a float (NaN for a missing value), or `InputError` at
+    `row` (a "line" or a "row", as `RawTable.row_unit`)."""
     text = cell.strip()
     if len(text) > MAX_NUMBER_CHARS:
         raise InputError(f"a cell of {len(text)} characters is not a number", file=file,
-                         row=row, column=column)
+                         row=row, column=column, row_unit=row_unit)
     if text.lower() in MISSING_TOKENS:
         return math.nan
     if not _NUMBER.fullmatch(text):
         raise InputError(f"cannot read {cell!r} as a number", file=file, row=row,
-                         column=column)
+                         column=column, row_unit=row_unit)
     value = float(text)
     if math.isinf(value):
-        raise InputError(f"{cell!r} is not a finite number", file=file, row=row, column=column)
+        raise InputError(f"{cell!r} is not a finite number", file=file, row=row, column=column,
+                         row_unit=row_unit)
     return value
 
 

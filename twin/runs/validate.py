@@ -1,8 +1,9 @@
 """Hard errors of a recorded run: problems no repair can honestly fix.
 
-Each raises `InputError` naming the file, the row (1-based line in a CSV file) and the
-column.  Anything a repair can fix (duplicates, dropouts, spikes, stuck or noisy sensors)
-is left to `twin.runs.quality`.  The column and time checks (`required_column`,
+Each raises `InputError` naming the file, the line (a CSV file's, as an editor numbers
+them) or row (a Parquet file's data row; `RawTable.row_unit`) and the column.  Anything a
+repair can fix (duplicates, dropouts, spikes, stuck or noisy sensors) is left to
+`twin.runs.quality`.  The column and time checks (`required_column`,
 `column_with_values`, `complete_column`, `checked_time`) serve the drift data
 (`twin.drift.data`) and the emulator's speed profile (`twin.plant.profile`) too, as do the
 speed and temperature checks (`check_speed_sign`, `check_speed_limit`,
@@ -11,6 +12,8 @@ same words.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -39,8 +42,7 @@ to the second is Fahrenheit: 45–130 °F is 7–54 °C, any room or coolant log
 def required_column(table: RawTable, name: str) -> np.ndarray:
     """The column `name`, or InputError at the header if the file lacks it."""
     if name not in table.columns:
-        raise InputError("missing required column", file=table.file, row=table.header_row,
-                         column=name)
+        raise table.error("missing required column", table.header_row, name)
     return table.columns[name]
 
 
@@ -48,8 +50,7 @@ def column_with_values(table: RawTable, name: str) -> np.ndarray:
     """The column `name` (`required_column`), or InputError if no row holds a value."""
     values = required_column(table, name)
     if np.isnan(values).all():
-        raise InputError("column has no values", file=table.file, row=int(table.rows[0]),
-                         column=name)
+        raise table.error("column has no values", table.rows[0], name)
     return values
 
 
@@ -59,8 +60,7 @@ def complete_column(table: RawTable, name: str, what: str = "value") -> np.ndarr
     values = required_column(table, name)
     missing = np.flatnonzero(np.isnan(values))
     if missing.size:
-        raise InputError(f"{what} is missing", file=table.file,
-                         row=int(table.rows[missing[0]]), column=name)
+        raise table.error(f"{what} is missing", table.rows[missing[0]], name)
     return values
 
 
@@ -79,7 +79,7 @@ def checked_time(table: RawTable, *, repeats: bool = True) -> np.ndarray:
                 "samples must be in time order" if step[i] < 0 else
                 f"time {time[i]:.15g} s repeats that of {where}; each sample needs a later "
                 "time than the one before")
-        raise InputError(what, file=table.file, row=int(table.rows[i + 1]), column=TIME)
+        raise table.error(what, table.rows[i + 1], TIME)
     return time
 
 
@@ -94,8 +94,8 @@ def check_structure(table: RawTable) -> None:
         if name not in TEMPERATURES:
             column_with_values(table, name)
     if all(np.isnan(table.columns[name]).all() for name in TEMPERATURES):
-        raise InputError("no temperature sensor has a value (T1_C..T5_C all empty)",
-                         file=table.file, row=int(table.rows[0]), column=TEMPERATURES[0])
+        raise table.error("no temperature sensor has a value (T1_C..T5_C all empty)",
+                          table.rows[0], TEMPERATURES[0])
     checked_time(table)
 
 
@@ -105,21 +105,19 @@ def check_values(table: RawTable) -> None:
     unique_time = np.unique(time)
     duration = float(unique_time[-1] - unique_time[0])
     if duration < 2 * WINDOW_S:
-        raise InputError(
+        raise table.error(
             f"the run lasts {duration:g} s; the twin needs at least two {WINDOW_S:g} s "
-            f"windows ({2 * WINDOW_S:g} s)", file=table.file, row=int(table.rows[-1]),
-            column=TIME)
+            f"windows ({2 * WINDOW_S:g} s)", table.rows[-1], TIME)
     if duration > MAX_DURATION_S:
         i = int(np.flatnonzero(time - time[0] > MAX_DURATION_S)[0])
-        raise InputError(
+        raise table.error(
             f"time {time[i]:.15g} s lies more than {MAX_DURATION_S:g} s after the first sample; "
-            f"a run may last at most {MAX_DURATION_S / 3600:g} h", file=table.file,
-            row=int(table.rows[i]), column=TIME)
+            f"a run may last at most {MAX_DURATION_S / 3600:g} h", table.rows[i], TIME)
     interval = float(np.median(np.diff(unique_time)))
     if interval > MAX_SAMPLE_INTERVAL_S:
-        raise InputError(
+        raise table.error(
             f"median sample interval {interval:g} s is longer than {MAX_SAMPLE_INTERVAL_S:g} s "
-            "(at least one sample per 10 s is needed)", file=table.file, column=TIME)
+            "(at least one sample per 10 s is needed)", column=TIME)
 
     check_speed_sign(table)
     for name in CELSIUS_COLUMNS:
@@ -133,8 +131,7 @@ def check_speed_sign(table: RawTable) -> None:
     negative = np.flatnonzero(speed < 0)
     if negative.size:
         i = int(negative[0])
-        raise InputError(f"negative speed {speed[i]:g} rpm", file=table.file,
-                         row=int(table.rows[i]), column=SPEED)
+        raise table.error(f"negative speed {speed[i]:g} rpm", table.rows[i], SPEED)
 
 
 def _check_celsius(table: RawTable, name: str) -> None:
@@ -145,23 +142,21 @@ def _check_celsius(table: RawTable, name: str) -> None:
     below = np.flatnonzero(values < -273.15)
     if below.size:
         i = int(below[0])
-        raise InputError(f"{values[i]:g} °C is below absolute zero", file=table.file,
-                         row=int(table.rows[i]), column=name)
+        raise table.error(f"{values[i]:g} °C is below absolute zero", table.rows[i], name)
     median = float(np.median(finite))
     first = int(np.flatnonzero(~np.isnan(values))[0])
-    row = int(table.rows[first])
+    row = table.rows[first]
     if median > KELVIN_MEDIAN_C:
-        raise InputError(
+        raise table.error(
             f"values look like Kelvin (median {median:.2f}); the column must be in °C "
-            f"(subtract 273.15)", file=table.file, row=row, column=name)
+            f"(subtract 273.15)", row, name)
     lo, hi = FAHRENHEIT_AIR_RANGE_C
     if name in (AMBIENT, COOLANT) and lo < median <= hi:
         # the first row past the °C range: where a logger switched units mid-run
         above = int(np.flatnonzero(values > lo)[0])
-        raise InputError(
+        raise table.error(
             f"values look like Fahrenheit (median {median:.1f}, an implausible air/coolant "
-            "temperature in °C); the column must be in °C", file=table.file,
-            row=int(table.rows[above]), column=name)
+            "temperature in °C); the column must be in °C", table.rows[above], name)
     if name in TEMPERATURES:
         # A run starts near ambient; a sensor reading 1.8·ambient + 32 at the start,
         # far above the ambient, is logging Fahrenheit.
@@ -169,44 +164,47 @@ def _check_celsius(table: RawTable, name: str) -> None:
         a0 = np.nanmedian(ambient[:5]) if np.isfinite(ambient[:5]).any() else np.nan
         t0 = float(np.median(finite[:5]))
         if np.isfinite(a0) and t0 > a0 + 25.0 and abs(t0 - (1.8 * a0 + 32.0)) < 2.0:
-            raise InputError(
+            raise table.error(
                 f"values look like Fahrenheit (starts at {t0:.1f} with ambient {a0:.1f} °C "
-                f"= {1.8 * a0 + 32:.1f} °F); the column must be in °C", file=table.file,
-                row=row, column=name)
+                f"= {1.8 * a0 + 32:.1f} °F); the column must be in °C", row, name)
 
 
 def check_operating_range(file: str, rows: np.ndarray, columns: dict[str, np.ndarray],
-                          max_speed_rpm: float) -> None:
+                          max_speed_rpm: float, *, row_unit: str) -> None:
     """Speed within the spindle's limit, ambient and coolant within the twin's envelope.
 
     Checked on the repaired values (a spike the repair removes is no error) so that a
-    replay never meets a value it cannot simulate; the error names the file row.
+    replay never meets a value it cannot simulate; the error names the file's line or row
+    (`row_unit`, as `RawTable.row_unit`).
     """
-    check_speed_limit(file, rows, columns[SPEED], max_speed_rpm)
+    check_speed_limit(file, rows, columns[SPEED], max_speed_rpm, row_unit=row_unit)
     for name in (AMBIENT, COOLANT):
         if name in columns:
-            check_operating_temperature(file, rows, name, columns[name])
+            check_operating_temperature(file, rows, name, columns[name], row_unit=row_unit)
 
 
-def check_speed_limit(file: str | None, rows: np.ndarray | None, speed: np.ndarray,
-                      max_speed_rpm: float) -> None:
-    """InputError at the first speed above the spindle's limit (`rows`: the file row of
-    each value, None if not read from a file)."""
+def check_speed_limit(file: str | None, rows: Sequence[int] | np.ndarray | None,
+                      speed: np.ndarray, max_speed_rpm: float, *, row_unit: str) -> None:
+    """InputError at the first speed above the spindle's limit (`rows`: the file line or
+    row of each value, as `row_unit` calls it; None if not read from a file)."""
     over = np.flatnonzero(np.asarray(speed) > max_speed_rpm)
     if over.size:
         i = int(over[0])
         raise InputError(f"speed {speed[i]:g} rpm exceeds the spindle's limit "
                          f"{max_speed_rpm:g} rpm", file=file,
-                         row=None if rows is None else int(rows[i]), column=SPEED)
+                         row=None if rows is None else int(rows[i]), column=SPEED,
+                         row_unit=row_unit)
 
 
 def check_operating_temperature(file: str, rows: np.ndarray, name: str,
-                                values: np.ndarray) -> None:
+                                values: np.ndarray, *, row_unit: str) -> None:
     """InputError at the first air or coolant temperature of column `name` outside the
-    range the twin models (`twin.contract.OPERATING_TEMPERATURE_C`)."""
+    range the twin models (`twin.contract.OPERATING_TEMPERATURE_C`); `rows` and
+    `row_unit` as for `check_speed_limit`."""
     lo, hi = OPERATING_TEMPERATURE_C
     outside = np.flatnonzero((values < lo) | (values > hi))
     if outside.size:
         i = int(outside[0])
         raise InputError(f"{values[i]:g} °C is outside the {lo:g}..{hi:g} °C the twin "
-                         "models", file=file, row=int(rows[i]), column=name)
+                         "models", file=file, row=int(rows[i]), column=name,
+                         row_unit=row_unit)
