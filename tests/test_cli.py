@@ -622,3 +622,71 @@ def test_export_cdb_names_what_is_wrong_with_its_mesh(tmp_path):
         assert result.exit_code == 2, result.output
         assert result.output.startswith(f"error: {tmp_path / name}, option '--mesh': {words}")
     assert not (tmp_path / "x.cdb").exists()
+
+
+def _run_module(tmp_path, name: str, source: str, *args: str) -> subprocess.CompletedProcess:
+    """`python -m NAME ARGS` of a module written into tmp_path, with this checkout importable."""
+    (tmp_path / name).mkdir()
+    (tmp_path / name / "__main__.py").write_text(source)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), root]))
+    return subprocess.run([sys.executable, "-m", name, *args], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_ctrl_c_ending_a_string_exec_still_exits_130_under_python_m(tmp_path):
+    # a Ctrl-C that lands in a string exec (a dataclass's generated methods, compiled while
+    # a module loads) leaves CPython noting an unhandled KeyboardInterrupt, and under
+    # `python -m` the process then killed itself by SIGINT after printing "interrupted":
+    # about one Ctrl-C in four of `python -m twin replay` ended so (returncode -2)
+    source = (
+        "import typer\n"
+        "from twin.errors import report_errors, run_console_script\n"
+        "def go() -> None:\n"
+        "    exec('raise KeyboardInterrupt')\n"
+        "app = typer.Typer()\n"
+        "app.command('go')(report_errors(go))\n"
+        "app.command('other')(lambda: None)\n"
+        "run_console_script(app, 'probe')\n"
+    )
+    proc = _run_module(tmp_path, "ctrlc_probe", source, "go")
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr == "interrupted\n"
+
+
+def test_ctrl_c_while_twin_loads_its_commands_exits_130(tmp_path):
+    # `python -m twin` interrupted while importing the commands: a traceback, then death
+    # by SIGINT
+    source = (
+        "import builtins, runpy, sys\n"
+        "real_import = builtins.__import__\n"
+        "def interrupting(name, *args, **kwargs):\n"
+        "    if name == 'twin.cli':\n"
+        "        exec('raise KeyboardInterrupt')\n"
+        "    return real_import(name, *args, **kwargs)\n"
+        "builtins.__import__ = interrupting\n"
+        "sys.argv = ['twin', '--help']\n"
+        "runpy.run_module('twin', run_name='__main__')\n"
+    )
+    proc = _run_module(tmp_path, "load_probe", source)
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr == "interrupted\n"
+
+
+
+def test_ctrl_c_while_the_options_are_read_is_told(capsys, monkeypatch):
+    # typer turns a KeyboardInterrupt while it reads the options into exit code 130 without
+    # a word (a Ctrl-C some 0.1 s into `twin replay` ended so)
+    from twin.errors import run_console_script
+
+    def interrupted(value: int) -> int:
+        raise KeyboardInterrupt
+
+    probe = typer.Typer()
+    probe.command("go")(report_errors(lambda x=typer.Option(0, callback=interrupted): None))
+    probe.command("other")(lambda: None)
+    monkeypatch.setattr(sys, "argv", ["probe", "go"])
+    with pytest.raises(SystemExit) as exit_:
+        run_console_script(probe, "probe")
+    assert exit_.value.code == 130
+    assert capsys.readouterr().err == "interrupted\n"

@@ -13,12 +13,13 @@ import functools
 import os
 import sys
 from collections.abc import Callable, Sequence
-from typing import Any, Self
+from typing import Any, NoReturn, Self
 
 EXIT_INPUT_ERROR = 2
 EXIT_INTERNAL_ERROR = 1
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports Ctrl-C
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports `cmd | head`
+INTERRUPTED = "interrupted"  # the one line a Ctrl-C prints
 
 
 class InputError(ValueError):
@@ -162,7 +163,8 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
         except Exit:
             raise
         except KeyboardInterrupt:
-            print("interrupted", file=sys.stderr)
+            print(INTERRUPTED, file=sys.stderr)
+            _interrupt_told.append(True)
             raise Exit(EXIT_INTERRUPTED) from None
         except BrokenPipeError:
             # the reader went away (`twin model-info M | head`): not an error of ours;
@@ -183,8 +185,11 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
     a usage block and a box that wraps the message over several lines."""
     from typer import Abort
 
+    _interrupt_told.clear()
     try:
         code = app(prog_name=prog_name, standalone_mode=False)
+    except KeyboardInterrupt:  # while typer builds the command line from the functions
+        exit_interrupted()
     except Abort:
         print("aborted", file=sys.stderr)
         sys.exit(EXIT_INTERNAL_ERROR)
@@ -209,4 +214,32 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
         message = message.replace(": Value error, ", ": ", 1)
         print(f"error: {message}{hint}", file=sys.stderr)
         sys.exit(getattr(exc, "exit_code", EXIT_INPUT_ERROR))
+    if code == EXIT_INTERRUPTED:
+        # typer turns a Ctrl-C while it reads the options into this code without a word
+        exit_interrupted()
     sys.exit(code if isinstance(code, int) else 0)
+
+
+_interrupt_told: list[bool] = []
+"""Not empty once `report_errors` has told a Ctrl-C (`run_console_script` empties it): a
+Ctrl-C typer or the loading caught is told by `exit_interrupted`, and none twice."""
+
+
+def exit_interrupted() -> NoReturn:
+    """End the process after a Ctrl-C: one line (`interrupted`), exit code 130."""
+    if not _interrupt_told:
+        print(INTERRUPTED, file=sys.stderr)
+    forget_keyboard_interrupt()
+    sys.exit(EXIT_INTERRUPTED)
+
+
+def forget_keyboard_interrupt() -> None:
+    """Clear CPython's note that a KeyboardInterrupt ended a string exec or eval.
+
+    A Ctrl-C landing in one (a dataclass's generated methods are compiled so, while a
+    module loads) is noted as unhandled even when a caller catches it; under `python -m`
+    the interpreter then ends the process by SIGINT once it has exited with 130 (one
+    Ctrl-C of `python -m twin replay` in four did).  The note is cleared when a string
+    exec starts, so an empty one clears it; a console script never reads it.
+    """
+    exec("")
