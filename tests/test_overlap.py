@@ -100,6 +100,36 @@ def test_a_start_that_fails_leaves_no_child_waiting(tmp_path):
     assert side.join() is None and not done.exists()
 
 
+
+@pytest.mark.usefixtures("needs_fork")
+def test_a_ctrl_c_reaching_the_child_as_it_is_forked_stays_in_the_child(monkeypatch):
+    # Ctrl-C goes to the whole process group: a child interrupted before its own code
+    # began raised KeyboardInterrupt in the frames it shares with the parent and ran on as
+    # a second copy of the parent (its handlers, its report, "interrupted" twice)
+    import signal
+
+    import twin.loop.overlap
+
+    parent = os.getpid()
+    real_fork = os.fork
+
+    def fork_then_ctrl_c() -> int:
+        pid = real_fork()
+        if pid == 0:
+            os.kill(os.getpid(), signal.SIGINT)
+        return pid
+
+    monkeypatch.setattr(twin.loop.overlap.os, "fork", fork_then_ctrl_c)
+    try:
+        with ForkedTask(lambda _: "done") as side:
+            side.start()
+            with pytest.raises(ForkedTaskError, match="KeyboardInterrupt"):
+                side.join()
+    except BaseException:
+        if os.getpid() != parent:
+            os._exit(3)  # the child came back here: the parent's join reports exit code 3
+        raise
+
 def test_without_fork_start_runs_prepare_and_task_here_in_order(tmp_path):
     calls = []
     side = ForkedTask(lambda arg: calls.append(("task", arg, os.getpid())) or "done",

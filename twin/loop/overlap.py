@@ -31,7 +31,8 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from types import TracebackType
 
 _GO = b"g"
@@ -84,15 +85,21 @@ class ForkedTask:
         # the child's garbage collector leaves the objects it inherits alone: walking them
         # would cost it time and copy the pages it shares with the parent (Python's gc docs)
         gc.freeze()
-        pid = os.fork()
-        if pid == 0:  # the child: never returns into the parent's frames
-            os.close(go_w)
-            os.close(result_r)
-            _child(self._prepare, self._task, go_r, result_w)
-        gc.unfreeze()
-        os.close(go_r)
-        os.close(result_w)
-        self._pid, self._go, self._result = pid, go_w, result_r
+        try:
+            with held_interrupts() as mask:
+                pid = os.fork()
+                if pid == 0:  # the child: never returns into the parent's frames
+                    os.close(go_w)
+                    os.close(result_r)
+                    _child(self._prepare, self._task, go_r, result_w, mask)
+                gc.unfreeze()
+                os.close(go_r)
+                os.close(result_w)
+                self._pid, self._go, self._result = pid, go_w, result_r
+        except KeyboardInterrupt:  # held during the fork: no `with` will end this child
+            if self._pid is not None:
+                self.join()
+            raise
 
     def start(self, argument: str = "") -> None:
         """The task's inputs are ready: run task(argument) (in the child, or here without a
@@ -152,11 +159,14 @@ class ForkedTask:
 
 
 def _child(prepare: Callable[[], object] | None, task: Callable[[str], str | None],
-           go: int, result: int) -> None:
+           go: int, result: int, mask: set[signal.Signals]) -> None:
     """The forked child's whole life; ends the process with os._exit (no cleanup of the
-    parent's state: its buffers, atexit handlers and `finally` blocks are the parent's)."""
+    parent's state: its buffers, atexit handlers and `finally` blocks are the parent's).
+    Ctrl-C, held since before the fork, is let in here (`mask`, the parent's signal mask
+    before `held_interrupts`): it fails the task, as any error does."""
     code = 1
     try:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
         failure = None
         if prepare is not None:
             try:
@@ -180,6 +190,20 @@ def _child(prepare: Callable[[], object] | None, task: Callable[[str], str | Non
             pass
     finally:
         os._exit(code)
+
+
+@contextmanager
+def held_interrupts() -> Iterator[set[signal.Signals]]:
+    """Hold back SIGINT (Ctrl-C, which reaches the whole process group) while this thread
+    forks: a child interrupted before its own code begins would raise KeyboardInterrupt in
+    the frames it shares with the parent and run on as a second parent.  Yields the signal
+    mask to restore, which a child restores where it can take the interrupt; the parent's
+    is restored on leaving, and a Ctrl-C that came meanwhile is raised then."""
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield mask
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def _checked(value: object) -> str | None:
