@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 import typer
@@ -690,3 +692,48 @@ def test_ctrl_c_while_the_options_are_read_is_told(capsys, monkeypatch):
         run_console_script(probe, "probe")
     assert exit_.value.code == 130
     assert capsys.readouterr().err == "interrupted\n"
+
+
+def _ctrl_c_swallowed() -> None:
+    try:  # as a library's bare `except:` around an import does
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(5)
+    except BaseException:  # noqa: BLE001
+        pass
+
+
+def _ctrl_c_wrapped() -> None:
+    try:  # as pydantic's schema builder does (SchemaError: ... KeyboardInterrupt)
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(5)
+    except KeyboardInterrupt as exc:
+        raise RuntimeError('Error building "literal" validator') from exc
+
+
+class _InterruptedWhileCollected:
+    def __del__(self) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(5)
+
+
+def _ctrl_c_unraisable() -> None:
+    # a weakref callback or __del__ (importlib's module locks have one): "Exception
+    # ignored in ..." and a traceback, and the Ctrl-C was lost
+    _InterruptedWhileCollected()
+
+
+@pytest.mark.parametrize("command", [_ctrl_c_swallowed, _ctrl_c_wrapped, _ctrl_c_unraisable])
+def test_a_ctrl_c_a_library_swallows_or_wraps_is_still_told(command, capsys, monkeypatch):
+    # a Ctrl-C early in `twin replay --jobs 2` was lost (the whole batch ran, exit 0), or
+    # was 'internal error: SchemaError: ...' with exit code 1
+    from twin.errors import run_console_script
+
+    probe = typer.Typer()
+    probe.command("go")(report_errors(command))
+    probe.command("other")(lambda: None)
+    monkeypatch.setattr(sys, "argv", ["probe", "go"])
+    with pytest.raises(SystemExit) as exit_:
+        run_console_script(probe, "probe")
+    assert exit_.value.code == 130
+    assert capsys.readouterr().err == "interrupted\n"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

@@ -11,8 +11,10 @@ from __future__ import annotations
 import copy
 import functools
 import os
+import signal
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any, NoReturn, Self
 
 EXIT_INPUT_ERROR = 2
@@ -153,29 +155,78 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     # typer is needed only once a command is wired, never by the library
     from typer import Exit
 
+    def interrupted() -> Exit:
+        _ctrl_c.clear()
+        print(INTERRUPTED, file=sys.stderr)
+        _interrupt_told.append(True)
+        return Exit(EXIT_INTERRUPTED)
+
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            return func(*args, **kwargs)
+            result = func(*args, **kwargs)
+            raise_if_interrupted()
+            return result
         except InputError as exc:
             print(f"error: {exc}", file=sys.stderr)
             raise Exit(EXIT_INPUT_ERROR) from None
         except Exit:
             raise
         except KeyboardInterrupt:
-            print(INTERRUPTED, file=sys.stderr)
-            _interrupt_told.append(True)
-            raise Exit(EXIT_INTERRUPTED) from None
+            raise interrupted() from None
         except BrokenPipeError:
             # the reader went away (`twin model-info M | head`): not an error of ours;
             # silence the final flush and exit as a SIGPIPE'd process would
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             raise Exit(EXIT_BROKEN_PIPE) from None
         except Exception as exc:  # noqa: BLE001 - the last line of defence of a CLI
+            if _ctrl_c:  # a library made Ctrl-C its own error (pydantic's SchemaError)
+                raise interrupted() from None
             print(f"internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
             raise Exit(EXIT_INTERNAL_ERROR) from None
 
     return wrapper
+
+
+_ctrl_c: list[bool] = []
+"""Not empty once Ctrl-C was pressed in a `run_console_script` and until a command told it."""
+
+
+def raise_if_interrupted() -> None:
+    """Raise KeyboardInterrupt if Ctrl-C was pressed and no command has told it yet: a
+    library swallowed it (a `try: ... except:` around an import, a weakref callback), and a
+    long command asks here between its steps.  (Only under `run_console_script`.)"""
+    if _ctrl_c:
+        raise KeyboardInterrupt
+
+
+def _note_ctrl_c(signum: int, frame: object) -> None:
+    _ctrl_c.append(True)
+    raise KeyboardInterrupt
+
+
+def _unraisable(unraisable: Any) -> None:
+    # "Exception ignored in ...": a Ctrl-C that landed in a weakref callback or __del__ is
+    # no traceback to print; it is noted, and told as Ctrl-C
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        sys.__unraisablehook__(unraisable)
+
+
+@contextmanager
+def _ctrl_c_noted() -> Iterator[None]:
+    """Note every Ctrl-C while a console script runs (see `raise_if_interrupted`); a SIGINT
+    that is ignored (`nohup`, a background job) or someone else's is left alone."""
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield
+        return
+    hook = sys.unraisablehook
+    signal.signal(signal.SIGINT, _note_ctrl_c)
+    sys.unraisablehook = _unraisable
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        sys.unraisablehook = hook
 
 
 def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
@@ -186,8 +237,10 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
     from typer import Abort
 
     _interrupt_told.clear()
+    _ctrl_c.clear()
     try:
-        code = app(prog_name=prog_name, standalone_mode=False)
+        with _ctrl_c_noted():
+            code = app(prog_name=prog_name, standalone_mode=False)
     except KeyboardInterrupt:  # while typer builds the command line from the functions
         exit_interrupted()
     except Abort:

@@ -15,7 +15,7 @@ from twin.cli.inputs import (
     expand_run_folders,
     method_list,
 )
-from twin.errors import InputError
+from twin.errors import InputError, raise_if_interrupted
 from twin.io.destinations import check_out_dir
 
 
@@ -94,8 +94,10 @@ def replay(
 
         def tell(name: str, status: str) -> None:
             progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
+            raise_if_interrupted()  # a Ctrl-C a library swallowed stops the batch here
 
         try:
+            raise_if_interrupted()  # the solver's imports may have swallowed one
             result = replay_batch(
                 paths,
                 out,
