@@ -232,6 +232,43 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
     assert [a["run"] for a in result.accuracies] == ["hot_9000", "hot_12000"]
 
 
+
+@pytest.mark.parametrize("when", ["after a run", "as the workers start"])
+def test_ctrl_c_stops_the_worker_processes_and_their_queued_runs(runs_dir, tmp_path, when,
+                                                                 monkeypatch):
+    # Ctrl-C in a --jobs batch: the pool was shut down waiting for every queued run, so the
+    # batch went on replaying (and a worker caught between runs printed a traceback)
+    import multiprocessing
+    from contextlib import contextmanager
+
+    import twin.loop.batch
+    from twin.loop.batch import replay_batch
+
+    runs = []
+    for k in range(8):
+        runs.append(tmp_path / f"run{k}.csv")
+        shutil.copy(runs_dir / "hot_9000.csv", runs[-1])
+    out = tmp_path / "out"
+
+    def ctrl_c(name: str, status: str) -> None:
+        raise KeyboardInterrupt
+
+    @contextmanager
+    def ctrl_c_held_back():  # a Ctrl-C held back while the workers were forked
+        yield
+        raise KeyboardInterrupt
+
+    if when != "after a run":
+        monkeypatch.setattr(twin.loop.batch, "held_interrupts", ctrl_c_held_back)
+    with pytest.raises(KeyboardInterrupt):
+        replay_batch(runs, out, ["open_loop"], None, jobs=2, progress=ctrl_c)
+    assert multiprocessing.active_children() == []
+    done = [p.name for p in out.iterdir() if (p / ".done.json").exists()]
+    # the one told, and at most one per worker finishing then
+    assert len(done) <= (3 if when == "after a run" else 0), done
+    assert [p.name for p in out.iterdir() if p.name.startswith(".")] == []
+    assert all(p.name in done for p in out.iterdir() if p.is_dir())
+
 @pytest.mark.slow
 def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
     from dask.distributed import Client, LocalCluster

@@ -8,14 +8,16 @@ matches.
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Sequence
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from twin.errors import InputError
 from twin.io.atomic import write_json
 from twin.loop.folders import folder_lock, remove_orphans
-from twin.loop.overlap import ForkedTask
+from twin.loop.overlap import ForkedTask, held_interrupts
 from twin.loop.runfiles import (
     check_distinct_names,
     is_done,
@@ -129,11 +131,17 @@ def replay_batch(
         todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
                               assimilate_drift, fields))
 
-    for outcome in _execute(todo, jobs, dask_address, progress, plotter):
-        if "ok" in outcome:
-            result.accuracies.append(outcome["ok"])
-        else:
-            result.failed.append(outcome)
+    try:
+        # closed on leaving: a Ctrl-C here ends the worker processes before they go on
+        with closing(_execute(todo, jobs, dask_address, progress, plotter)) as outcomes:
+            for outcome in outcomes:
+                if "ok" in outcome:
+                    result.accuracies.append(outcome["ok"])
+                else:
+                    result.failed.append(outcome)
+    except KeyboardInterrupt:
+        remove_orphans(out_root)  # the staging folders of the runs the workers were on
+        raise
     order = {n: i for i, n in enumerate(names)}
     result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
     write_summary(out_root, result.failed, attempted=names)
@@ -199,12 +207,30 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed  # --jobs only
 
-    with ProcessPoolExecutor(max_workers=min(jobs, len(todo))) as pool:
-        futures = [pool.submit(run_job, job) for job in todo]
-        for fut in as_completed(futures):
-            outcome = fut.result()
-            _tell(progress, outcome)
-            yield outcome
+    # the workers leave Ctrl-C (sent to the whole process group) to this process, which
+    # ends them: interrupted on their own, a worker between runs died with a traceback, and
+    # the others went on with the queued runs while the pool's shutdown waited for them
+    with ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
+                             initializer=_ignore_interrupts) as pool:
+        try:
+            with held_interrupts():  # the workers are forked here
+                futures = [pool.submit(run_job, job) for job in todo]
+            for fut in as_completed(futures):
+                outcome = fut.result()
+                _tell(progress, outcome)
+                yield outcome
+        except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
+            # ProcessPoolExecutor has no public way to end its workers before Python 3.14
+            for worker in list(pool._processes.values()):
+                worker.terminate()
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+
+
+def _ignore_interrupts() -> None:
+    """A --jobs worker's start: Ctrl-C is the batch's to handle (see `_execute`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def _tell(progress, outcome: dict) -> None:  # noqa: ANN001
