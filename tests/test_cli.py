@@ -679,19 +679,24 @@ def test_ctrl_c_while_twin_loads_its_commands_exits_130(tmp_path):
 def test_ctrl_c_while_the_options_are_read_is_told(capsys, monkeypatch):
     # typer turns a KeyboardInterrupt while it reads the options into exit code 130 without
     # a word (a Ctrl-C some 0.1 s into `twin replay` ended so)
-    from twin.errors import run_console_script
-
     def interrupted(value: int) -> int:
         raise KeyboardInterrupt
 
+    assert _console_exit(lambda x=typer.Option(0, callback=interrupted): None, monkeypatch) == 130
+    assert capsys.readouterr().err == "interrupted\n"
+
+
+def _console_exit(command, monkeypatch) -> int:  # noqa: ANN001
+    """The exit code of `command` run as a console script's subcommand (`probe go`)."""
+    from twin.errors import run_console_script
+
     probe = typer.Typer()
-    probe.command("go")(report_errors(lambda x=typer.Option(0, callback=interrupted): None))
+    probe.command("go")(report_errors(command))
     probe.command("other")(lambda: None)
     monkeypatch.setattr(sys, "argv", ["probe", "go"])
     with pytest.raises(SystemExit) as exit_:
         run_console_script(probe, "probe")
-    assert exit_.value.code == 130
-    assert capsys.readouterr().err == "interrupted\n"
+    return exit_.value.code
 
 
 def _ctrl_c_swallowed() -> None:
@@ -726,14 +731,6 @@ def _ctrl_c_unraisable() -> None:
 def test_a_ctrl_c_a_library_swallows_or_wraps_is_still_told(command, capsys, monkeypatch):
     # a Ctrl-C early in `twin replay --jobs 2` was lost (the whole batch ran, exit 0), or
     # was 'internal error: SchemaError: ...' with exit code 1
-    from twin.errors import run_console_script
-
-    probe = typer.Typer()
-    probe.command("go")(report_errors(command))
-    probe.command("other")(lambda: None)
-    monkeypatch.setattr(sys, "argv", ["probe", "go"])
-    with pytest.raises(SystemExit) as exit_:
-        run_console_script(probe, "probe")
-    assert exit_.value.code == 130
+    assert _console_exit(command, monkeypatch) == 130
     assert capsys.readouterr().err == "interrupted\n"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
