@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from twin.io.atomic import write_text
-from twin.io.vtk import write_vtu
+from twin.io.vtk import read_vtu, write_vtu
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -91,19 +91,9 @@ def write_state_vtu(path: str | Path, points_rz: np.ndarray, triangles: np.ndarr
 def read_state_vtu(path: str | Path) -> tuple[np.ndarray, np.ndarray, float]:
     """(points (n, 2) m, TEMP (n,) °C, TIME s) of a state or result file; InputError naming
     the file if it is not one."""
-    import contextlib
-    import io
-
-    from meshio import vtu
-
     from twin.errors import InputError
 
-    try:  # the format's reader itself: meshio.read prints and exits on a bad file
-        with contextlib.redirect_stdout(io.StringIO()):
-            mesh = vtu.read(str(path))
-    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds on a bad file
-        why = f" ({exc})" if str(exc).strip() else ""
-        raise InputError(f"not a readable .vtu file{why}", file=str(path)) from None
+    mesh = read_vtu(path)
     temp = mesh.point_data.get("TEMP")
     if temp is None or np.ndim(temp) != 1:
         raise InputError("no nodal TEMP array (a state file or an apdl-like result_NNN.vtu "

@@ -233,6 +233,61 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
 
 
 
+
+def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path):
+    # `--resume --snapshots every` after a `--snapshots none` batch skipped every run and
+    # left it without a single picture
+    from twin.loop.batch import replay_batch
+
+    run = runs_dir / "hot_9000.csv"
+    fresh = replay_batch([run], tmp_path / "fresh", ["open_loop"], None, snapshots="every")
+    out = tmp_path / "out"
+    replay_batch([run], out, ["open_loop"], None, snapshots="none")
+    assert not (out / "hot_9000" / "snapshots").exists()
+    stamp = (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns
+    resumed = replay_batch([run], out, ["open_loop"], None, snapshots="every", resume=True)
+    assert resumed.skipped == ["hot_9000"]
+    assert (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns == stamp  # not solved
+    pictures = sorted(p.name for p in (out / "hot_9000" / "snapshots").iterdir())
+    assert pictures == [f"open_loop_t{60 * k:05d}s.png" for k in range(1, MINUTES + 1)]
+    for name in pictures:  # drawn from the field files: the pictures a replay draws
+        assert ((out / "hot_9000" / "snapshots" / name).read_bytes()
+                == (tmp_path / "fresh" / "hot_9000" / "snapshots" / name).read_bytes())
+    assert fresh.accuracies == resumed.accuracies
+
+
+@pytest.mark.parametrize("fields", ["every", "end"])
+def test_resume_replays_a_run_whose_fields_cannot_give_the_snapshots(runs_dir, tmp_path,
+                                                                     fields):
+    # a damaged field file, or one `--fields end` never wrote
+    from twin.loop.batch import replay_batch
+
+    run = runs_dir / "hot_9000.csv"
+    out = tmp_path / "out"
+    replay_batch([run], out, ["open_loop"], None, snapshots="none", fields=fields)
+    if fields == "every":
+        (out / "hot_9000" / "fields" / "open_loop_t00300s.vtu").write_text("damaged")
+    snapshots = "end" if fields == "every" else "every"
+    resumed = replay_batch([run], out, ["open_loop"], None, snapshots=snapshots,
+                           fields=fields, resume=True)
+    assert resumed.skipped == [] and not resumed.failed
+    pictures = sorted(p.name for p in (out / "hot_9000" / "snapshots").iterdir())
+    assert pictures == [f"open_loop_t{60 * k:05d}s.png"
+                        for k in range(1 if snapshots == "every" else MINUTES, MINUTES + 1)]
+
+
+def test_resume_keeps_a_run_that_has_the_snapshots_asked_for_without_fields(runs_dir,
+                                                                            tmp_path):
+    from twin.loop.batch import replay_batch
+
+    run = runs_dir / "hot_9000.csv"
+    out = tmp_path / "out"
+    replay_batch([run], out, ["open_loop"], None, snapshots="end", fields="none")
+    resumed = replay_batch([run], out, ["open_loop"], None, snapshots="end", fields="none",
+                           resume=True)
+    assert resumed.skipped == ["hot_9000"]
+
+
 @pytest.mark.parametrize("when", ["after a run", "as the workers start"])
 def test_ctrl_c_stops_the_worker_processes_and_their_queued_runs(runs_dir, tmp_path, when,
                                                                  monkeypatch):

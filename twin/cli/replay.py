@@ -42,7 +42,9 @@ def replay(
         help="field files (fields/*.vtu + fields.pvd): every window end, the last one only "
         "(end), or none; about 220 kB a window of the default spindle",
     ),
-    resume: bool = typer.Option(False, "--resume", help="skip runs already finished"),
+    resume: bool = typer.Option(
+        False, "--resume", help="skip runs already finished (same input, methods, model, "
+        "--fields); a skipped run gets the --snapshots it lacks, drawn from its field files"),
     quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
     drift_assimilation: bool = typer.Option(
         True, "--drift-assimilation/--no-drift-assimilation",

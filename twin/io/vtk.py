@@ -175,6 +175,24 @@ def _appended_block(data: bytes, compress: bool) -> bytes:
     return header.tobytes() + b"".join(chunks)
 
 
+def read_vtu(path: str | os.PathLike[str]) -> Any:
+    """A .vtu file as a meshio.Mesh (its FieldData in `field_data`); InputError naming the
+    file if it is not a readable one."""
+    import contextlib
+    import io
+
+    from meshio import vtu
+
+    from twin.errors import InputError
+
+    try:  # the format's reader itself: meshio.read prints and exits on a bad file
+        with contextlib.redirect_stdout(io.StringIO()):
+            return vtu.read(str(path))
+    except Exception as exc:  # noqa: BLE001 - meshio raises many kinds on a bad file
+        why = f" ({exc})" if str(exc).strip() else ""
+        raise InputError(f"not a readable .vtu file{why}", file=str(path)) from None
+
+
 def write_pvd(path: str | os.PathLike[str], entries: Sequence[tuple[float, str]]) -> Path:
     """ParaView collection, atomically: (time s, .vtu path relative to the .pvd) per entry."""
     # here, not at the top: xml.sax.saxutils imports urllib.request, http and ssl (about

@@ -19,6 +19,7 @@ from twin.io.atomic import write_json
 from twin.loop.folders import folder_lock, remove_orphans
 from twin.loop.overlap import ForkedTask, held_interrupts
 from twin.loop.runfiles import (
+    add_snapshots,
     check_distinct_names,
     is_done,
     replay_run_to_dir,
@@ -121,7 +122,7 @@ def replay_batch(
     for path, name in named:
         if resume:
             finished = _finished(out_root / name, path, methods, model_path, assimilate_drift,
-                                 fields)
+                                 fields, snapshots)
             if finished is not None:
                 result.accuracies.append(finished)
                 result.skipped.append(name)
@@ -163,16 +164,25 @@ def _refused_folder(folder: Path, path: str, result: BatchResult) -> bool:
 
 def _finished(out_dir: Path, path: str, methods: Sequence[str],
               model_path: str | None, assimilate_drift: bool = True,
-              fields: str = "every") -> dict | None:
+              fields: str = "every", snapshots: str = "none") -> dict | None:
     """The accuracy of a run folder --resume may keep, or None: replay it (again) when its
-    token does not match or its accuracy.json is missing or unreadable."""
+    token does not match or its accuracy.json is missing or unreadable.  A run kept gets
+    the snapshots `snapshots` asks for that it lacks, drawn from its field files; it is
+    replayed if they cannot be (a field file missing or damaged)."""
     try:
         if not is_done(out_dir, resume_token(path, methods, model_path, assimilate_drift,
                                              fields)):
             return None
     except OSError:
         return None
-    return read_accuracy(out_dir / "accuracy.json")
+    accuracy = read_accuracy(out_dir / "accuracy.json")
+    if accuracy is None:
+        return None
+    try:
+        add_snapshots(path, out_dir, methods, snapshots, accuracy["duration_s"])
+    except (InputError, OSError):
+        return None
+    return accuracy
 
 
 def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202

@@ -235,7 +235,13 @@ def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # no
 
 def n_windows(run: RecordedRun) -> int:
     """Whole 60 s windows the run covers."""
-    return int(np.floor(run.duration_s / WINDOW_S + 1e-9))
+    return windows_in(run.duration_s)
+
+
+def windows_in(duration_s: float) -> int:
+    """Whole 60 s windows in a run of `duration_s`: a replay keeps a field at each one's
+    end, `WINDOW_S` · k for k = 1 … windows_in."""
+    return int(np.floor(duration_s / WINDOW_S + 1e-9))
 
 
 def check_field_time(run: RecordedRun, time_s: float) -> None:

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.contract import SENSOR_NAMES
+from twin.contract import SENSOR_NAMES, WINDOW_S
 from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.folders import replaced_folder
@@ -253,8 +253,50 @@ def _write_snapshots(out_dir: Path, model, r: MethodReplay, snapshots: str,  # n
     from twin.loop.snapshot import render_snapshot
 
     for t in _window_ends(r.fields, snapshots):
-        render_snapshot(model, r.fields[t], out_dir / "snapshots" / f"{r.method}_t{t:05.0f}s.png",
+        render_snapshot(model, r.fields[t], out_dir / _snapshot_name(r.method, t),
                         title=f"{title} · {r.method} · t = {t:.0f} s", T_initial_C=r.T_initial_C)
+
+
+def _snapshot_name(method: str, t: float) -> str:
+    return f"snapshots/{method}_t{t:05.0f}s.png"
+
+
+def _field_name(method: str, t: float) -> str:
+    return f"fields/{method}_t{t:05.0f}s.vtu"
+
+
+def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
+                  snapshots: str, duration_s: float) -> int:
+    """Draw the snapshots `snapshots` asks for that the finished run folder `out_dir` lacks,
+    from its field files, without solving again (--resume on a run it skips); pictures it
+    has are kept.  `duration_s`: the run's (accuracy.json), which sets its window ends.
+    Returns how many were drawn.  InputError: a field file it needs is missing (`--fields
+    end` or `none`) or damaged (the caller replays the run)."""
+    from twin.io.vtk import read_vtu
+    from twin.loop.replay import initial_temperature_C, windows_in
+    from twin.loop.snapshot import render_snapshot
+    from twin.runs import read_run
+    from twin.spindle.model import SpindleModel
+
+    primary = primary_method(methods)
+    ends = dict.fromkeys(WINDOW_S * k for k in range(1, windows_in(duration_s) + 1))
+    wanted = [t for t in _window_ends(ends, snapshots)
+              if not (out_dir / _snapshot_name(primary, t)).is_file()]
+    if not wanted:
+        return 0
+    model = SpindleModel.load()
+    run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
+    for t in wanted:
+        path = out_dir / _field_name(primary, t)
+        if not path.is_file():
+            raise InputError("no field file to draw the snapshot from", file=str(path))
+        T = read_vtu(path).point_data.get("temperature_C")
+        if T is None or np.shape(T) != (model.n_dofs,) or not np.all(np.isfinite(T)):
+            raise InputError("no temperature_C array of the spindle's vertices", file=str(path))
+        render_snapshot(model, np.asarray(T, float), out_dir / _snapshot_name(primary, t),
+                        title=f"{run_name(run_path)} · {primary} · t = {t:.0f} s",
+                        T_initial_C=initial_temperature_C(run))
+    return len(wanted)
 
 
 def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
@@ -437,6 +479,6 @@ def _write_fields(out_dir: Path, model, fields: str, r: MethodReplay) -> None:  
     times = _window_ends(r.fields, fields)
     if not times:
         return
-    write_field_series(out_dir, ((t, f"fields/{r.method}_t{t:05.0f}s.vtu",
+    write_field_series(out_dir, ((t, _field_name(r.method, t),
                                   field_mesh(model, r.fields[t], r.T_initial_C))
                                  for t in times))
