@@ -430,6 +430,35 @@ def test_report_names_an_unreadable_run_folder_and_exits_2(replayed, tmp_path):
     assert [f["run"] for f in summary["failed"]] == ["hot_9000"]
 
 
+
+@pytest.mark.parametrize(("file", "text", "message"), [
+    ("keypoints.csv", "time_s,method,T1_twin_C\n0,ratio,20\nabc,ratio,21\n",
+     "keypoints.csv, line 3, column 'time_s': 'abc' is not a number"),
+    ("keypoints.csv", "a,b\n1,2\n", "keypoints.csv, column 'method': column missing"),
+    ("keypoints.csv", b"\xfa\xfb,\xfc\n", "keypoints.csv: cannot be read"),
+    ("corrections.csv", "window,method\nx,ratio\n",
+     "corrections.csv, line 2, column 'window': 'x' is not a number"),
+    ("corrections.csv", None, "corrections.csv: cannot be read (replay the run again): No such"),
+])
+def test_report_names_a_damaged_run_file_it_draws_from(replayed, tmp_path, file, text,
+                                                       message):
+    # a run folder whose figures the report draws again (plots/ gone) with a damaged
+    # keypoints.csv or corrections.csv was an internal error (ValueError, KeyError, ...)
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    run_dir = folder / "hot_9000"
+    shutil.rmtree(run_dir / "plots")
+    if text is None:
+        (run_dir / file).unlink()
+    elif isinstance(text, bytes):
+        (run_dir / file).write_bytes(text)
+    else:
+        (run_dir / file).write_text(text)
+    result = invoke("report", str(folder))
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {run_dir}/{message}"), lines
+
+
 def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
     # quality.json (and the snapshots' titles) took the run's `# name:` line while
     # accuracy.json, summary.json and the folder took the file name

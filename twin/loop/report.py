@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
+from twin.errors import InputError
 from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.figures import load_matplotlib, new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
@@ -30,14 +31,48 @@ METHOD_COLORS = {
 }
 
 
-def _read_csv(path: Path) -> dict[str, list[str]]:
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    return {k: [r[k] for r in rows] for k in (rows[0].keys() if rows else [])}
+class _Columns(dict[str, list[str]]):
+    """A run's CSV (keypoints.csv, corrections.csv) as its columns of text by name; a
+    column it lacks or a cell that is no number is an InputError naming the file, line
+    and column: a damaged file was an internal error of the report."""
+
+    def __init__(self, path: Path, columns: dict[str, list[str]]) -> None:
+        super().__init__(columns)
+        self.path = path
+
+    def __missing__(self, column: str) -> list[str]:
+        raise InputError("column missing (replay the run again)", file=str(self.path),
+                         column=column)
+
+    def numbers(self, column: str) -> np.ndarray:
+        """The column as floats, NaN where a cell is empty."""
+        cells = self[column]
+        try:
+            return np.array([float(v) if v not in ("", None) else np.nan for v in cells])
+        except ValueError:
+            row = next(i for i, v in enumerate(cells) if not _is_number(v))
+            raise InputError(f"{cells[row]!r} is not a number (replay the run again)",
+                             file=str(self.path), row=row + 2, column=column,
+                             row_unit="line") from None
 
 
-def _floats(values: list[str]) -> np.ndarray:
-    return np.array([float(v) if v not in ("", None) else np.nan for v in values])
+def _is_number(cell: str | None) -> bool:
+    try:
+        float(cell or "nan")
+    except ValueError:
+        return False
+    return True
+
+
+def _read_csv(path: Path) -> _Columns:
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise InputError(f"cannot be read (replay the run again): {why}",
+                         file=str(path)) from None
+    return _Columns(path, {k: [r[k] for r in rows] for k in (rows[0].keys() if rows else [])})
 
 
 PLOTS = ("temperatures.png", "drift_corrections.png")
@@ -49,12 +84,12 @@ def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
     return png_bytes(fig, dpi=80)
 
 
-def _shade_band(ax, kp: dict, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,  # noqa: ANN001
+def _shade_band(ax, kp: _Columns, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,  # noqa: ANN001
                 method: str) -> None:
     """The method's 90 % band, shaded, where keypoints.csv has one."""
-    if lo not in kp:
+    if lo not in kp and hi not in kp:
         return
-    low, high = _floats(kp[lo])[sel], _floats(kp[hi])[sel]
+    low, high = kp.numbers(lo)[sel], kp.numbers(hi)[sel]
     if np.isfinite(low).any():
         ax.fill_between(t_min[sel], low, high, color=METHOD_COLORS.get(method), alpha=0.2,
                         lw=0, label=f"{method} 90 % band")
@@ -83,22 +118,22 @@ def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
     return paths
 
 
-def _temperature_figure(kp: dict[str, list[str]]) -> bytes:
+def _temperature_figure(kp: _Columns) -> bytes:
     """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11)."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
-    t_min = _floats(kp["time_s"]) / 60.0
+    t_min = kp.numbers("time_s") / 60.0
     fig = new_figure(figsize=(17, 3.2))
     axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
         first = method_col == methods[0]
-        ax.plot(t_min[first], _floats(kp[f"{s}_meas_C"])[first], "k.", ms=2, label="measured")
+        ax.plot(t_min[first], kp.numbers(f"{s}_meas_C")[first], "k.", ms=2, label="measured")
         for m in methods:
             sel = method_col == m
             ax.plot(
                 t_min[sel],
-                _floats(kp[f"{s}_twin_C"])[sel],
+                kp.numbers(f"{s}_twin_C")[sel],
                 color=METHOD_COLORS.get(m),
                 lw=1.3,
                 label=m,
@@ -115,21 +150,21 @@ def _temperature_figure(kp: dict[str, list[str]]) -> bytes:
     return _png(fig)
 
 
-def _drift_figure(kp: dict[str, list[str]], corr: dict[str, list[str]]) -> bytes:
+def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
     """The axial nose drift measured and per method, and the correction factors per window."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
-    t_min = _floats(kp["time_s"]) / 60.0
+    t_min = kp.numbers("time_s") / 60.0
     fig = new_figure(figsize=(13, 3.2))
     ax1, ax2 = fig.subplots(1, 2)
     first = method_col == methods[0]
-    meas = _floats(kp["disp_z_meas_um"])[first]
+    meas = kp.numbers("disp_z_meas_um")[first]
     if np.isfinite(meas).any():
         ax1.plot(t_min[first], meas, "k.", ms=2, label="measured")
     for m in methods:
         sel = method_col == m
         ax1.plot(
-            t_min[sel], _floats(kp["disp_z_twin_um"])[sel], color=METHOD_COLORS.get(m), label=m
+            t_min[sel], kp.numbers("disp_z_twin_um")[sel], color=METHOD_COLORS.get(m), label=m
         )
         _shade_band(ax1, kp, sel, t_min, "disp_z_twin_lo_um", "disp_z_twin_hi_um", m)
     ax1.set_title("axial nose drift", y=1.0)
@@ -143,7 +178,7 @@ def _drift_figure(kp: dict[str, list[str]], corr: dict[str, list[str]]) -> bytes
             sel = cm == m
             if m == "open_loop":
                 continue
-            w = _floats(corr["window"])[sel]
+            w = corr.numbers("window")[sel]
             for key, style in (
                 ("C_H_front", "-"),
                 ("C_H_rear", "--"),
@@ -152,7 +187,7 @@ def _drift_figure(kp: dict[str, list[str]], corr: dict[str, list[str]]) -> bytes
             ):
                 ax2.plot(
                     w,
-                    _floats(corr[key])[sel],
+                    corr.numbers(key)[sel],
                     style,
                     color=METHOD_COLORS.get(m),
                     label=f"{m} {key}",
