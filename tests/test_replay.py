@@ -459,6 +459,16 @@ def test_report_names_a_damaged_run_file_it_draws_from(replayed, tmp_path, file,
     assert len(lines) == 1 and lines[0].startswith(f"error: {run_dir}/{message}"), lines
 
 
+@pytest.mark.parametrize("quality", ['"stuck sensor T2"', "42"])
+def test_report_shows_a_hand_edited_quality_file_as_it_is(replayed, tmp_path, quality):
+    # a quality.json holding a text or a number: internal error (AttributeError)
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    (folder / "hot_9000" / "quality.json").write_text(quality)
+    result = invoke("report", str(folder))
+    assert result.exit_code == 0, result.output
+    assert quality.strip('"') in (folder / "report.html").read_text()
+
+
 def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
     # quality.json (and the snapshots' titles) took the run's `# name:` line while
     # accuracy.json, summary.json and the folder took the file name

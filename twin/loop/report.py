@@ -284,8 +284,10 @@ def _findings(run_dir: Path) -> list[dict[str, str]] | None:
         findings = json.loads((run_dir / "quality.json").read_text())
     except (OSError, ValueError):
         return None
-    items = findings if isinstance(findings, list) else findings.get("findings", findings)
-    items = items if isinstance(items, list) else [items] if items else []
+    if isinstance(findings, dict):
+        findings = findings.get("findings", findings)
+    # anything else a hand-edited file holds (a text, a number) is a row shown as it is
+    items = findings if isinstance(findings, list) else [findings] if findings else []
     return [_finding_row(f) for f in items]
 
 
