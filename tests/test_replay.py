@@ -469,6 +469,14 @@ def test_report_shows_a_hand_edited_quality_file_as_it_is(replayed, tmp_path, qu
     assert quality.strip('"') in (folder / "report.html").read_text()
 
 
+def test_report_passes_over_a_folder_among_the_snapshots(replayed, tmp_path):
+    # snapshots/old.png being a folder: internal error (IsADirectoryError)
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    (folder / "hot_9000" / "snapshots" / "zz.png").mkdir()
+    result = invoke("report", str(folder))
+    assert result.exit_code == 0, result.output
+    assert 'alt="ratio_t00300s.png"' in (folder / "report.html").read_text()
+
 def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
     # quality.json (and the snapshots' titles) took the run's `# name:` line while
     # accuracy.json, summary.json and the folder took the file name

@@ -338,7 +338,7 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
         run_dir = run_folder(out_root, r["run"])
         if run_dir is None:  # a name, never a path: nothing is read or drawn outside DIR
             continue
-        snapshots = sorted((run_dir / "snapshots").glob("*.png"))[-2:]
+        snapshots = sorted(p for p in (run_dir / "snapshots").glob("*.png") if p.is_file())[-2:]
         page_runs.append({
             "name": r["run"],
             "caption": f"{r['speed_rpm']:.0f} rpm, ambient {r['ambient_C']:.2f} °C, "
