@@ -118,6 +118,25 @@ def test_simulate_cli_rejects_bad_speed(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+
+def test_simulate_refuses_a_replay_output_folder(tmp_path):
+    # `--out` given a replay's folder: the simulation's summary.json replaced the replay's
+    # (every run's accuracy), its keypoints.csv and fields/ landed beside the run folders
+    from twin.cli import app
+
+    out = tmp_path / "replay"
+    (out / "run1").mkdir(parents=True)
+    (out / "run1" / "accuracy.json").write_text("{}")
+    (out / "summary.json").write_text('{"runs": []}')
+    result = CliRunner().invoke(app, ["simulate", "--speed", "9000", "--minutes", "1",
+                                      "--ambient", "24", "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (f"error: {out}, option '--out': is a twin replay output "
+                                     "folder, whose summary.json this would replace: choose "
+                                     "another --out")
+    assert (out / "summary.json").read_text() == '{"runs": []}'
+    assert sorted(p.name for p in out.iterdir()) == ["run1", "summary.json"]
+
 def test_p2_elements_agree_with_the_default_p1_run(spindle_model):
     # discretisation check: quadratic elements on the same mesh change the 10 min key
     # points by well under the sensors' accuracy

@@ -14,13 +14,14 @@ def report(out: Path = typer.Argument(..., help="a replay output folder")) -> No
     """Rebuild DIR/report.html and DIR/summary.json from a replay folder."""
     from twin.io.destinations import check_out_dir
     from twin.loop.report import build_report
+    from twin.loop.summary import is_replay_folder
 
     if not out.exists():
         raise InputError("no such folder", file=str(out))
     if not out.is_dir():
         raise InputError("is a file; a replay folder (twin replay --out DIR) is expected",
                          file=str(out))
-    if not any(out.glob("*/accuracy.json")):
+    if not is_replay_folder(out):
         raise InputError("not a replay folder (no <run>/accuracy.json inside)", file=str(out))
     # the folder is the command's argument, no option: the writer's checks named '--out'
     check_out_dir(out, option=None, files=["summary.json", "report.html"])

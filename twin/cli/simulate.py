@@ -43,6 +43,7 @@ def simulate_command(
     """
     from twin.errors import InputError
     from twin.io.destinations import check_out_dir
+    from twin.loop.summary import is_replay_folder
     from twin.runs.schema import MAX_DURATION_S
     from twin.spindle import SpindleModel, simulate, write_simulation
     from twin.spindle.spec import load_spec
@@ -52,6 +53,9 @@ def simulate_command(
                          f"{minutes:g}", column="--minutes")
     check_out_dir(out, inputs=[spec],
                   owned=["fields"], files=["keypoints.csv", "fields.pvd", "summary.json"])
+    if is_replay_folder(out):  # whose summary.json (and report's table) this one replaced
+        raise InputError("is a twin replay output folder, whose summary.json this would "
+                         "replace: choose another --out", file=str(out), column="--out")
     # validate the operating point before the (slower) model build
     check_operating_options(load_spec(spec, option="--spec"), speed, ambient, coolant)
     model = SpindleModel.load(spec, size_factor=size_factor)

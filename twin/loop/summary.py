@@ -47,6 +47,11 @@ def _is_metric(value: object) -> bool:
     return value is None or _is_number(value)
 
 
+def is_replay_folder(folder: Path) -> bool:
+    """True for a `twin replay` output folder: one holding a <run>/accuracy.json."""
+    return any(Path(folder).glob("*/accuracy.json"))
+
+
 def run_folder(out_root: Path, name: object) -> Path | None:
     """DIR/<name> when `name` is one plain folder name of a run folder in DIR, else None."""
     if not isinstance(name, str) or not name or name.startswith(".") or name != Path(name).name:
