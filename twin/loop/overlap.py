@@ -13,8 +13,10 @@ wrote before `start` and from the text `start` passes on (a path, say, decided a
 fork).  What it returns (text or None) comes back from `join`, as text
 through a pipe (UTF-8: again no pickling).  Its failure comes back as a `ForkedTaskError`
 from `join` (the message of the child's exception; the child writes nothing to stdout or
-stderr).  Leaving the `with` block without `start` (the parent failed) kills the child,
-which has written nothing by then; a started child is always waited for.
+stderr); a Ctrl-C that ended it (it reaches the whole process group) comes back as
+KeyboardInterrupt, as it would have ended the task run here.  Leaving the `with` block
+without `start` (the parent failed) kills the child, which has written nothing by then; a
+started child is always waited for.
 
 Where fork is unavailable or unsafe (anywhere but Linux, see `fork_is_safe`; or other
 threads are running: a lock one of them holds at the fork would stay locked in the child
@@ -36,7 +38,8 @@ from contextlib import contextmanager
 from types import TracebackType
 
 _GO = b"g"
-_DONE, _FAILED = b"0", b"1"  # the first byte the child sends back: its result or its error
+# the first byte the child sends back: its result, its error, or that Ctrl-C ended it
+_DONE, _FAILED, _INTERRUPTED = b"0", b"1", b"2"
 _NONE, _TEXT = b"N", b"T"  # then: the task returned None, or text (which follows)
 _MAX_MESSAGE = 4000
 
@@ -138,6 +141,8 @@ class ForkedTask:
         code = os.waitstatus_to_exitcode(status)
         if not self._started:
             return None
+        if reply[:1] == _INTERRUPTED:  # the Ctrl-C this process may not have taken yet
+            raise KeyboardInterrupt
         if code != 0 or reply[:1] != _DONE:
             message = reply[1:].decode(errors="replace") if reply[:1] == _FAILED else ""
             raise ForkedTaskError(message or f"the forked task ended with exit code {code}")
@@ -163,7 +168,7 @@ def _child(prepare: Callable[[], object] | None, task: Callable[[str], str | Non
     """The forked child's whole life; ends the process with os._exit (no cleanup of the
     parent's state: its buffers, atexit handlers and `finally` blocks are the parent's).
     Ctrl-C, held since before the fork, is let in here (`mask`, the parent's signal mask
-    before `held_interrupts`): it fails the task, as any error does."""
+    before `held_interrupts`); it ends the task, and `join` raises KeyboardInterrupt."""
     code = 1
     try:
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
@@ -184,8 +189,9 @@ def _child(prepare: Callable[[], object] | None, task: Callable[[str], str | Non
         code = 0
     except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
         message = f"{type(exc).__name__}: {exc}".encode(errors="replace")[:_MAX_MESSAGE]
+        kind = _INTERRUPTED if isinstance(exc, KeyboardInterrupt) else _FAILED
         try:
-            _write_all(result, _FAILED + message)
+            _write_all(result, kind + message)
         except OSError:
             pass
     finally:
