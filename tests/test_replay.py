@@ -181,6 +181,31 @@ def test_snapshot_png_is_not_blank_and_has_the_size(replayed, runs_dir, tmp_path
     assert np.asarray(Image.open(out).convert("RGB"), dtype=float).std() > 10.0
 
 
+
+def test_a_ctrl_c_while_a_snapshot_renders_is_taken_when_it_is_done(spindle_model, tmp_path,
+                                                                    monkeypatch):
+    # a KeyboardInterrupt raised while VTK renders (in a call VTK makes back into Python)
+    # crashed the replay in VTK's Python wrapping (SIGSEGV); the picture now finishes first
+    import signal
+    import time
+
+    import twin.spindle.fields
+    from twin.loop.snapshot import render_snapshot
+
+    real = twin.spindle.fields.field_arrays
+
+    def ctrl_c_meanwhile(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.2)  # Python code runs on meanwhile, as pyvista's does
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(twin.spindle.fields, "field_arrays", ctrl_c_meanwhile)
+    out = tmp_path / "t.png"
+    with pytest.raises(KeyboardInterrupt):
+        render_snapshot(spindle_model, np.full(spindle_model.n_dofs, 25.0), out)
+    assert out.is_file() and out.stat().st_size > 10_000
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
 def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C\n0,9000,25,25,25,25,25\n")

@@ -10,7 +10,12 @@ drift are stated.  `twin replay --snapshots` and `twin snapshot` both use `rende
 from __future__ import annotations
 
 import os
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from types import FrameType
 
 import numpy as np
 
@@ -31,7 +36,34 @@ def render_snapshot(
     section: bool = False,
     window_size: tuple[int, int] = (1200, 800),
 ) -> Path:
-    """Render one field state to a PNG (written atomically); returns the path."""
+    """Render one field state to a PNG (written atomically); returns the path.  A Ctrl-C
+    meanwhile is taken once the picture is done (`ctrl_c_after`)."""
+    with ctrl_c_after():
+        return _render(model, T, out_png, field, title, T_initial_C, section, window_size)
+
+
+@contextmanager
+def ctrl_c_after() -> Iterator[None]:
+    """Take a Ctrl-C only when the block is done: VTK calls back into Python while it
+    renders (pyvista's error observer), and a KeyboardInterrupt raised in such a call
+    crashed the process in VTK's Python wrapping (SIGSEGV, a Ctrl-C 7 s into a replay).
+    In the main thread, and while Ctrl-C raises at all; else the block runs as it is."""
+    handler = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or not callable(handler):
+        yield
+        return
+    pressed: list[tuple[int, FrameType | None]] = []
+    signal.signal(signal.SIGINT, lambda signum, frame: pressed.append((signum, frame)))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+        if pressed:
+            handler(*pressed[0])  # the handler's own KeyboardInterrupt, now
+
+
+def _render(model, T: np.ndarray, out_png: str | Path, field: str, title: str,  # noqa: ANN001
+            T_initial_C: float | None, section: bool, window_size: tuple[int, int]) -> Path:
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
 
