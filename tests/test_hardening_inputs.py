@@ -121,6 +121,19 @@ def test_defect15_warnings_go_to_the_log_not_the_terminal(tmp_path):
     assert "Mean of empty slice" in log and "bad X server connection" in log
 
 
+
+def test_vtk_errors_pyvista_logs_go_to_the_log_not_the_terminal(tmp_path):
+    # pyvista sends VTK's errors to the root logger, which printed them on the terminal
+    # ('ERROR:root:Algorithm vtkPythonAlgorithm ... returned failure' and the request's
+    # eight lines, after a Ctrl-C during a snapshot)
+    code = ("from twin.log import send_warnings_to_log\n"
+            "send_warnings_to_log()\n"
+            "import pyvista\n"
+            "from vtkmodules.vtkCommonCore import vtkOutputWindow\n"
+            "vtkOutputWindow.GetInstance().DisplayErrorText('Algorithm returned failure')\n")
+    _runs_silently(code, log_dir=tmp_path)
+    assert "Algorithm returned failure" in (tmp_path / "twin.log").read_text()
+
 def test_a_log_file_that_cannot_be_opened_drops_the_warnings(tmp_path):
     # the log folder was there but twin.log could not be opened (a read-only home in CI;
     # here a folder of that name): the first warning ended the command with exit 1

@@ -54,7 +54,9 @@ def _handler() -> logging.Handler:
 
 
 def send_warnings_to_log() -> None:
-    """Route Python warnings (and the `twin` logger) to the log file, once per process."""
+    """Route Python warnings (and the `twin` logger) to the log file, once per process;
+    and the root logger, where pyvista sends VTK's errors and warnings (with no handler
+    of its own, a record there printed itself on the terminal)."""
     logging.captureWarnings(True)
     for name in ("py.warnings", LOGGER):
         logger = logging.getLogger(name)
@@ -62,6 +64,9 @@ def send_warnings_to_log() -> None:
             logger.addHandler(_handler())
             logger.propagate = False
             logger.setLevel(logging.INFO)
+    root = logging.getLogger()
+    if not root.handlers:
+        root.addHandler(_handler())
 
 
 def send_vtk_messages_to_log() -> None:
