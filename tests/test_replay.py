@@ -206,6 +206,27 @@ def test_a_ctrl_c_while_a_snapshot_renders_is_taken_when_it_is_done(spindle_mode
     assert out.is_file() and out.stat().st_size > 10_000
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
+
+def test_figures_drawn_without_fork_fork_nothing(replayed, tmp_path, monkeypatch):
+    # a --jobs worker (no forked helpers: the workers fill the cores) still drew a run's
+    # second figure in a forked child; a Ctrl-C ends the workers, and that child, left
+    # running, wrote into the run's staging folder after the batch had removed it
+    import twin.loop.overlap
+    from twin.loop.report import run_plotter
+
+    run_dir = shutil.copytree(replayed / "hot_9000", tmp_path / "hot_9000")
+    shutil.rmtree(run_dir / "plots")
+
+    def no_fork() -> int:
+        raise AssertionError("forked")
+
+    monkeypatch.setattr(twin.loop.overlap.os, "fork", no_fork)
+    with run_plotter(fork=False) as plots:
+        plots.start(str(run_dir))
+        plots.join()
+    assert sorted(p.name for p in (run_dir / "plots").iterdir()) == [
+        "drift_corrections.png", "temperatures.png"]
+
 def test_bad_run_in_a_batch_is_reported_and_the_others_finish(runs_dir, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C\n0,9000,25,25,25,25,25\n")

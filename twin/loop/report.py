@@ -203,9 +203,11 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
 def run_plotter(fork: bool = True) -> ForkedTask:
     """A forked child that imports matplotlib now and draws one run's figures once started
     with the run folder (`start(str(run_dir))`, when keypoints.csv and corrections.csv are
-    written); without fork (`fork=False`, or where it is unsafe) `start` draws them here."""
+    written); without fork (`fork=False`, or where it is unsafe) `start` draws them here,
+    forking nothing either: a --jobs worker, which the batch ends on Ctrl-C, left the
+    child drawing its second figure running, to write into the run's removed folder."""
     def draw(run_dir: str) -> None:
-        render_run_plots(Path(run_dir), split=True)
+        render_run_plots(Path(run_dir), split=fork)
 
     return ForkedTask(draw, prepare=load_matplotlib, fork=fork)
 
