@@ -142,6 +142,10 @@ def replay_batch(
                     result.failed.append(outcome)
     except KeyboardInterrupt:
         remove_orphans(out_root)  # the staging folders of the runs the workers were on
+        # A worker ended inside its turn of the folder lock left the lock's file (the lock
+        # itself ended with it); the next turn removes it, so take one now.
+        with folder_lock(out_root):
+            pass
         raise
     order = {n: i for i, n in enumerate(names)}
     result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
