@@ -137,6 +137,24 @@ def test_simulate_refuses_a_replay_output_folder(tmp_path):
     assert (out / "summary.json").read_text() == '{"runs": []}'
     assert sorted(p.name for p in out.iterdir()) == ["run1", "summary.json"]
 
+def test_replay_refuses_a_simulate_output_folder(tmp_path):
+    # the reverse: `twin replay --out` given a simulation's folder replaced its summary.json
+    # and put run folders and a report beside its keypoints.csv
+    from twin.cli import app
+
+    out = tmp_path / "sim"
+    out.mkdir()
+    (out / "keypoints.csv").write_text("time_s\n")
+    (out / "summary.json").write_text('{"speed_rpm": 9000}')
+    result = CliRunner().invoke(app, ["replay", "--out", str(out), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip() == (f"error: {out}, option '--out': is a twin simulate output "
+                                     "folder, whose summary.json this would replace: choose "
+                                     "another --out")
+    assert sorted(p.name for p in out.iterdir()) == ["keypoints.csv", "summary.json"]
+    assert (out / "summary.json").read_text() == '{"speed_rpm": 9000}'
+
+
 def test_p2_elements_agree_with_the_default_p1_run(spindle_model):
     # discretisation check: quadratic elements on the same mesh change the 10 min key
     # points by well under the sensors' accuracy

@@ -64,6 +64,11 @@ def replay(
         raise InputError("no recorded runs (CSV/Parquet) found", file=", ".join(where))
     check_out_dir(out, inputs=[*paths, model], owned=[Path(p).stem for p in paths],
                   files=["summary.json", "report.html"])
+    from twin.spindle.output import is_simulation_folder
+
+    if is_simulation_folder(out):  # whose summary.json this one would replace
+        raise InputError("is a twin simulate output folder, whose summary.json this would "
+                         "replace: choose another --out", file=str(out), column="--out")
     model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
     console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")

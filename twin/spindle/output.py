@@ -90,6 +90,13 @@ def write_fields(model: SpindleModel, result: SimulationResult, out_dir: Path) -
         for t, T in result.fields))
 
 
+def is_simulation_folder(folder: str | Path) -> bool:
+    """True for a `twin simulate` output folder: keypoints.csv and summary.json at its top
+    (a replay keeps them in its run folders and writes a summary.json of its own)."""
+    folder = Path(folder)
+    return (folder / "keypoints.csv").is_file() and (folder / "summary.json").is_file()
+
+
 def write_simulation(model: SpindleModel, result: SimulationResult, out_dir: str | Path,
                      fields: bool = True) -> dict:
     """Write keypoints.csv, fields (if kept and `fields`) and summary.json; return summary."""
