@@ -9,6 +9,7 @@ mesh size is ESIZE, or a tenth of the largest area extent when ESIZE is not set.
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,6 +17,7 @@ from scipy.spatial import cKDTree
 
 from apdl_like.errors import ApdlError
 from apdl_like.model import Line
+from twin.signal_guard import signals_kept
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -90,8 +92,16 @@ def _triangulate(boundaries: list[tuple[np.ndarray, np.ndarray]],
     import gmsh
 
     owner = not gmsh.isInitialized()
-    if owner:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
+    # gmsh changes signal handlers process-wide: restored after finalize (twin.signal_guard)
+    with signals_kept() if owner else nullcontext():
+        if owner:
+            gmsh.initialize(readConfigFiles=False, interruptible=False)
+        return _mesh_areas(gmsh, boundaries, size, owner)
+
+
+def _mesh_areas(gmsh, boundaries: list[tuple[np.ndarray, np.ndarray]],  # noqa: ANN001
+                size: float, owner: bool) -> tuple[np.ndarray, np.ndarray]:
+    """`_triangulate` in an initialized gmsh, which it finalizes if it is the `owner`."""
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("amesh")

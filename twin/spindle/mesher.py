@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.io.atomic import atomic_target
+from twin.signal_guard import signals_kept
 from twin.spindle.spec import BOUNDARY_NAMES, SpindleSpec
 
 MM = 1e-3
@@ -58,7 +59,7 @@ def build_mesh(spec: SpindleSpec, size_factor: float = 1.0) -> SpindleMesh:
     import gmsh
     import pygmsh
 
-    with pygmsh.occ.Geometry() as geom:
+    with signals_kept(), pygmsh.occ.Geometry() as geom:
         gmsh.option.setNumber("General.Terminal", 0)
         def rectangle(box):  # noqa: ANN001, ANN202 - a spec part or channel (r/z in mm)
             return geom.add_rectangle(
