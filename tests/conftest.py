@@ -6,7 +6,18 @@ tests only read from it, so one instance serves them all.
 
 from __future__ import annotations
 
+import signal
+
 import pytest
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Make Ctrl-C deliverable, as in a terminal: a test run started in the background by a
+    non-interactive shell, or under nohup, begins with SIGINT ignored, and Python then
+    installs no KeyboardInterrupt handler, so every test of what Ctrl-C does failed there
+    (the code leaves an ignored SIGINT alone, as it should for a background job)."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")
