@@ -9,7 +9,6 @@ mesh size is ESIZE, or a tenth of the largest area extent when ESIZE is not set.
 
 from __future__ import annotations
 
-from contextlib import nullcontext
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -93,51 +92,45 @@ def _triangulate(boundaries: list[tuple[np.ndarray, np.ndarray]],
 
     owner = not gmsh.isInitialized()
     # gmsh changes signal handlers process-wide: restored after finalize (twin.signal_guard)
-    with signals_kept() if owner else nullcontext():
+    with signals_kept():
         if owner:
             gmsh.initialize(readConfigFiles=False, interruptible=False)
-        return _mesh_areas(gmsh, boundaries, size, owner)
-
-
-def _mesh_areas(gmsh, boundaries: list[tuple[np.ndarray, np.ndarray]],  # noqa: ANN001
-                size: float, owner: bool) -> tuple[np.ndarray, np.ndarray]:
-    """`_triangulate` in an initialized gmsh, which it finalizes if it is the `owner`."""
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("amesh")
-        occ = gmsh.model.occ
-        surfaces = []
-        tags = [np.zeros(len(poly), int) for poly, _ in boundaries]
-        for first in (True, False):
-            for (poly, corner), tag in zip(boundaries, tags, strict=True):
-                seg = np.hypot(*(np.roll(poly, -1, axis=0) - poly).T)
-                local = 0.5 * (seg + np.roll(seg, 1))  # a point's size: its two segments
-                for i in np.nonzero(corner == first)[0]:
-                    tag[i] = occ.addPoint(poly[i, 0], poly[i, 1], 0.0, float(local[i]))
-        for tag in tags:
-            lines = [occ.addLine(int(tag[i]), int(tag[(i + 1) % tag.size]))
-                     for i in range(tag.size)]
-            surfaces.append((2, occ.addPlaneSurface([occ.addCurveLoop(lines)])))
-        if len(surfaces) > 1:
-            occ.fragment(surfaces[:1], surfaces[1:])
-        occ.synchronize()
-        for _, curve in gmsh.model.getEntities(1):
-            gmsh.model.mesh.setTransfiniteCurve(curve, 2)  # a boundary segment stays whole
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: regular triangles
-        gmsh.model.mesh.generate(2)
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        _, elem_nodes = gmsh.model.mesh.getElementsByType(2)
-    except Exception as exc:  # noqa: BLE001 - gmsh raises plain Exception
-        raise ApdlError(f"gmsh could not mesh the areas: {exc}") from None
-    finally:
-        if owner:
-            gmsh.finalize()
-        elif gmsh.isInitialized():
-            gmsh.model.remove()
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.add("amesh")
+            occ = gmsh.model.occ
+            surfaces = []
+            tags = [np.zeros(len(poly), int) for poly, _ in boundaries]
+            for first in (True, False):
+                for (poly, corner), tag in zip(boundaries, tags, strict=True):
+                    seg = np.hypot(*(np.roll(poly, -1, axis=0) - poly).T)
+                    local = 0.5 * (seg + np.roll(seg, 1))  # a point's size: its two segments
+                    for i in np.nonzero(corner == first)[0]:
+                        tag[i] = occ.addPoint(poly[i, 0], poly[i, 1], 0.0, float(local[i]))
+            for tag in tags:
+                lines = [occ.addLine(int(tag[i]), int(tag[(i + 1) % tag.size]))
+                         for i in range(tag.size)]
+                surfaces.append((2, occ.addPlaneSurface([occ.addCurveLoop(lines)])))
+            if len(surfaces) > 1:
+                occ.fragment(surfaces[:1], surfaces[1:])
+            occ.synchronize()
+            for _, curve in gmsh.model.getEntities(1):
+                gmsh.model.mesh.setTransfiniteCurve(curve, 2)  # a boundary segment stays whole
+            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 1)
+            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
+            gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: regular triangles
+            gmsh.model.mesh.generate(2)
+            tags, coords, _ = gmsh.model.mesh.getNodes()
+            _, elem_nodes = gmsh.model.mesh.getElementsByType(2)
+        except Exception as exc:  # noqa: BLE001 - gmsh raises plain Exception
+            raise ApdlError(f"gmsh could not mesh the areas: {exc}") from None
+        finally:
+            if owner:
+                gmsh.finalize()
+            elif gmsh.isInitialized():
+                gmsh.model.remove()
     xy = np.asarray(coords).reshape(-1, 3)[:, :2]
     tags = np.asarray(tags, np.int64)
     lookup = np.full(tags.max() + 1 if tags.size else 1, -1, np.int64)

@@ -88,11 +88,12 @@ def noise_sigma(values: np.ndarray, keep: np.ndarray | None = None) -> float:
     With `keep` (bool per sample), only second differences of three consecutive kept
     samples count: the noise of the running or the stopped stretches of a run, say.
     """
-    ok = ~np.isnan(values) if keep is None else ~np.isnan(values) & keep
+    ok = ~np.isnan(values)
     if keep is None:
         x = values[ok]
         d2 = x[2:] - 2.0 * x[1:-1] + x[:-2]
     else:
+        ok &= keep
         d2 = (values[2:] - 2.0 * values[1:-1] + values[:-2])[ok[2:] & ok[1:-1] & ok[:-2]]
     if d2.size < 3:
         return 0.0

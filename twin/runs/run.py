@@ -19,7 +19,7 @@ from twin.runs.quality import QualityConfig, drop_repeated_rows, finding, repair
 from twin.runs.schema import AMBIENT, COOLANT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
 from twin.runs.validate import (
-    check_operating_range,
+    check_operating_temperatures,
     check_speed_limit,
     check_structure,
     check_values,
@@ -190,8 +190,8 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
     check_speed_limit(table.file, table.rows, table.columns[SPEED], max_speed_rpm,
                       row_unit=table.row_unit)
     fixed = repair(table, config)
-    check_operating_range(table.file, fixed.rows, fixed.columns, max_speed_rpm,
-                          row_unit=table.row_unit)
+    check_operating_temperatures(table.file, fixed.rows, fixed.columns,
+                                 row_unit=table.row_unit)
     quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
                        detail="unknown column name") for n in table.ignored_columns]
     quality += repeats + fixed.findings

@@ -169,15 +169,15 @@ def _check_celsius(table: RawTable, name: str) -> None:
                 f"= {1.8 * a0 + 32:.1f} °F); the column must be in °C", row, name)
 
 
-def check_operating_range(file: str, rows: np.ndarray, columns: dict[str, np.ndarray],
-                          max_speed_rpm: float, *, row_unit: str) -> None:
-    """Speed within the spindle's limit, ambient and coolant within the twin's envelope.
+def check_operating_temperatures(file: str, rows: np.ndarray, columns: dict[str, np.ndarray],
+                                 *, row_unit: str) -> None:
+    """Ambient and coolant within the twin's envelope (`check_operating_temperature`).
 
     Checked on the repaired values (a spike the repair removes is no error) so that a
     replay never meets a value it cannot simulate; the error names the file's line or row
-    (`row_unit`, as `RawTable.row_unit`).
+    (`row_unit`, as `RawTable.row_unit`).  The speed's limit is checked on the speeds as
+    written (`check_speed_limit`): its repairs only put a neighbour's speed in a sample.
     """
-    check_speed_limit(file, rows, columns[SPEED], max_speed_rpm, row_unit=row_unit)
     for name in (AMBIENT, COOLANT):
         if name in columns:
             check_operating_temperature(file, rows, name, columns[name], row_unit=row_unit)
