@@ -734,3 +734,15 @@ def test_a_ctrl_c_a_library_swallows_or_wraps_is_still_told(command, capsys, mon
     assert _console_exit(command, monkeypatch) == 130
     assert capsys.readouterr().err == "interrupted\n"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_ctrl_c_does_not_outlive_the_console_script_that_saw_it(capsys, monkeypatch):
+    # what a run saw of Ctrl-C is its own: a second run in the same process (a test, an
+    # embedding tool) neither stops at raise_if_interrupted nor stays silent on its own Ctrl-C
+    from twin.errors import raise_if_interrupted
+
+    assert _console_exit(_ctrl_c_swallowed, monkeypatch) == 130
+    raise_if_interrupted()  # outside any run: nothing pressed
+    assert _console_exit(raise_if_interrupted, monkeypatch) == 0
+    assert _console_exit(_ctrl_c_wrapped, monkeypatch) == 130
+    assert capsys.readouterr().err == "interrupted\ninterrupted\n"

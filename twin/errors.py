@@ -15,6 +15,8 @@ import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 from typing import Any, NoReturn, Self
 
 EXIT_INPUT_ERROR = 2
@@ -156,9 +158,10 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     from typer import Exit
 
     def interrupted() -> Exit:
-        _ctrl_c.clear()
         print(INTERRUPTED, file=sys.stderr)
-        _interrupt_told.append(True)
+        watch = _CTRL_C.get()
+        if watch is not None:
+            watch.pressed, watch.told = False, True
         return Exit(EXIT_INTERRUPTED)
 
     @functools.wraps(func)
@@ -180,7 +183,7 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
             raise Exit(EXIT_BROKEN_PIPE) from None
         except Exception as exc:  # noqa: BLE001 - the last line of defence of a CLI
-            if _ctrl_c:  # a library made Ctrl-C its own error (pydantic's SchemaError)
+            if _pressed():  # a library made Ctrl-C its own error (pydantic's SchemaError)
                 raise interrupted() from None
             print(f"internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
             raise Exit(EXIT_INTERNAL_ERROR) from None
@@ -188,21 +191,37 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
-_ctrl_c: list[bool] = []
-"""Not empty once Ctrl-C was pressed in a `run_console_script` and until a command told it."""
+@dataclass
+class _CtrlCWatch:
+    """What one console script saw of Ctrl-C: `pressed` once SIGINT came and until a command
+    told it, `told` once `report_errors` printed it (so that `exit_interrupted` does not
+    print it again).  One per `run_console_script`, reached through `_CTRL_C`."""
+
+    pressed: bool = False
+    told: bool = False
+
+    def note(self, signum: int, frame: object) -> None:
+        """The SIGINT handler while the script runs: note, then interrupt as Python does."""
+        self.pressed = True
+        raise KeyboardInterrupt
+
+
+_CTRL_C: ContextVar[_CtrlCWatch | None] = ContextVar("ctrl_c_watch", default=None)
+"""The running console script's watch; `run_console_script` sets it and resets it, so no
+state outlives a run (a test calling it twice starts clean)."""
+
+
+def _pressed() -> bool:
+    watch = _CTRL_C.get()
+    return watch is not None and watch.pressed
 
 
 def raise_if_interrupted() -> None:
     """Raise KeyboardInterrupt if Ctrl-C was pressed and no command has told it yet: a
     library swallowed it (a `try: ... except:` around an import, a weakref callback), and a
     long command asks here between its steps.  (Only under `run_console_script`.)"""
-    if _ctrl_c:
+    if _pressed():
         raise KeyboardInterrupt
-
-
-def _note_ctrl_c(signum: int, frame: object) -> None:
-    _ctrl_c.append(True)
-    raise KeyboardInterrupt
 
 
 def _unraisable(unraisable: Any) -> None:
@@ -213,20 +232,26 @@ def _unraisable(unraisable: Any) -> None:
 
 
 @contextmanager
-def _ctrl_c_noted() -> Iterator[None]:
-    """Note every Ctrl-C while a console script runs (see `raise_if_interrupted`); a SIGINT
-    that is ignored (`nohup`, a background job) or someone else's is left alone."""
+def _ctrl_c_noted(watch: _CtrlCWatch) -> Iterator[None]:
+    """Note every Ctrl-C in `watch` while a console script runs (see
+    `raise_if_interrupted`); a SIGINT that is ignored (`nohup`, a background job) or someone
+    else's is left alone, and only the told/not-told bookkeeping applies then."""
+    token = _CTRL_C.set(watch)
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        yield
+        try:
+            yield
+        finally:
+            _CTRL_C.reset(token)
         return
     hook = sys.unraisablehook
-    signal.signal(signal.SIGINT, _note_ctrl_c)
+    signal.signal(signal.SIGINT, watch.note)
     sys.unraisablehook = _unraisable
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, signal.default_int_handler)
         sys.unraisablehook = hook
+        _CTRL_C.reset(token)
 
 
 def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
@@ -236,13 +261,12 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
     a usage block and a box that wraps the message over several lines."""
     from typer import Abort
 
-    _interrupt_told.clear()
-    _ctrl_c.clear()
+    watch = _CtrlCWatch()
     try:
-        with _ctrl_c_noted():
+        with _ctrl_c_noted(watch):
             code = app(prog_name=prog_name, standalone_mode=False)
     except KeyboardInterrupt:  # while typer builds the command line from the functions
-        exit_interrupted()
+        exit_interrupted(told=watch.told)
     except Abort:
         print("aborted", file=sys.stderr)
         sys.exit(EXIT_INTERNAL_ERROR)
@@ -269,18 +293,14 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
         sys.exit(getattr(exc, "exit_code", EXIT_INPUT_ERROR))
     if code == EXIT_INTERRUPTED:
         # typer turns a Ctrl-C while it reads the options into this code without a word
-        exit_interrupted()
+        exit_interrupted(told=watch.told)
     sys.exit(code if isinstance(code, int) else 0)
 
 
-_interrupt_told: list[bool] = []
-"""Not empty once `report_errors` has told a Ctrl-C (`run_console_script` empties it): a
-Ctrl-C typer or the loading caught is told by `exit_interrupted`, and none twice."""
-
-
-def exit_interrupted() -> NoReturn:
-    """End the process after a Ctrl-C: one line (`interrupted`), exit code 130."""
-    if not _interrupt_told:
+def exit_interrupted(*, told: bool = False) -> NoReturn:
+    """End the process after a Ctrl-C: one line (`interrupted`; none if a command `told`
+    it already), exit code 130.  A Ctrl-C typer or the loading caught is told here."""
+    if not told:
         print(INTERRUPTED, file=sys.stderr)
     forget_keyboard_interrupt()
     sys.exit(EXIT_INTERRUPTED)
