@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import time
 
 import numpy as np
 import pytest
@@ -395,6 +396,44 @@ def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
     assert not seq.failed and not par.failed and not dsk.failed
     # deterministic: the same inputs give the same numbers whichever way they ran
     assert seq.accuracies == par.accuracies == dsk.accuracies
+
+
+@pytest.mark.slow
+def test_ctrl_c_of_a_dask_batch_ends_the_runs_the_cluster_had_started(runs_dir, spindle_model,
+                                                                       tmp_path):
+    # a cluster runs a started task to its end whatever its client does: after a Ctrl-C of
+    # `twin replay --dask`, the runs the workers were on appeared in --out seconds later,
+    # missing from the summary the stopped batch had written
+    from dask.distributed import Client, LocalCluster
+
+    from twin.loop.batch import replay_batch
+
+    short = tmp_path / "short.csv"
+    make_recorded_run(short, spindle_model, minutes=2)
+    runs = [short] + [tmp_path / f"long{k}.csv" for k in range(2)]
+    for run in runs[1:]:
+        make_recorded_run(run, spindle_model, minutes=30)
+    out = tmp_path / "out"
+
+    def ctrl_c(name: str, status: str) -> None:
+        assert name == "short"  # the long one next to it is still running
+        raise KeyboardInterrupt
+
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                     dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
+        with pytest.raises(KeyboardInterrupt):
+            replay_batch(runs, out, ["open_loop", "ratio"], None, fields="none",
+                         dask_address=cluster.scheduler_address, progress=ctrl_c)
+        deadline = time.monotonic() + 60
+        while any(client.processing().values()) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert not any(client.processing().values())
+    time.sleep(0.5)  # the stopped task's staging folder is removed as it unwinds
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["short"]
+    assert [p.name for p in out.iterdir() if p.name.startswith(".")] == []
 
 
 def test_report_rebuilds_from_a_folder(replayed):

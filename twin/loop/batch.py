@@ -9,9 +9,10 @@ matches.
 from __future__ import annotations
 
 import signal
-from collections.abc import Sequence
+import uuid
+from collections.abc import Callable, Sequence
 from contextlib import closing
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from twin.errors import InputError
@@ -38,6 +39,29 @@ class ReplayJob:
     snapshots: str
     assimilate_drift: bool = True  # the estimator's (twin.estimation.method.EstimatorConfig)
     fields: str = "every"  # the window ends written as field files
+    stop_event: str | None = None  # a dask batch's `Event`, set when the batch is stopped
+
+
+class BatchStopped(Exception):  # noqa: N818 - a state, as KeyboardInterrupt
+    """The batch this run belonged to was stopped (Ctrl-C) while a dask worker replayed it."""
+
+
+def _stop_check(event_name: str | None) -> Callable[[], None] | None:
+    """`replay_run_to_dir`'s stop: it ends the run (its staging folder removed, no earlier
+    result left, as for a local Ctrl-C) once the batch's dask `Event` is set.  A cluster
+    runs a started task to its end whatever its client does: the run folders appeared after
+    the stopped batch had written its summary without them."""
+    if event_name is None:
+        return None
+    from dask.distributed import Event
+
+    event = Event(event_name)
+
+    def check() -> None:
+        if event.is_set():
+            raise BatchStopped("the batch was stopped")
+
+    return check
 
 
 @dataclass
@@ -62,7 +86,7 @@ def run_job(job: ReplayJob, spindle=None, overlap: bool = False,  # noqa: ANN001
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
             spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
-            plotter=plotter, fields=job.fields,
+            plotter=plotter, fields=job.fields, stop=_stop_check(job.stop_event),
         )
         return {"ok": acc}
     except InputError as exc:
@@ -192,7 +216,7 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
 def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202
              plotter: ForkedTask | None):
     if dask_address:
-        from dask.distributed import Client
+        from dask.distributed import Client, Event
         from dask.distributed import as_completed as dask_completed
 
         try:
@@ -201,11 +225,18 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
             raise InputError(f"cannot reach the dask scheduler at {dask_address} ({exc})",
                              column="--dask") from None
         with client:
-            futures = client.map(run_job, todo, pure=False)
-            for fut in dask_completed(futures):
-                outcome = fut.result()
-                _tell(progress, outcome)
-                yield outcome
+            stop = Event(f"twin-replay-stop-{uuid.uuid4().hex}", client=client)
+            futures = client.map(run_job, [replace(j, stop_event=stop.name) for j in todo],
+                                 pure=False)
+            try:
+                for fut in dask_completed(futures):
+                    outcome = fut.result()
+                    _tell(progress, outcome)
+                    yield outcome
+            except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
+                client.cancel(futures)  # the queued runs; the started ones ask `stop`
+                stop.set()
+                raise
         return
     # a worker process or a dask task builds its own spindle per run (about 0.5 s of a
     # run's replay); in this process one model serves every run, and the run's forked

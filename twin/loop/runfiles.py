@@ -122,6 +122,7 @@ def replay_run_to_dir(
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
     fields: str = "every",
+    stop: Callable[[], None] | None = None,
 ) -> dict:
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
     `assimilate_drift`: the estimator's option (twin.estimation.method.EstimatorConfig).
@@ -133,6 +134,8 @@ def replay_run_to_dir(
     overlap: use a second core through forked children (`twin.loop.overlap`) for part of
     the methods and for the figures; the outputs are the same either way.  A batch whose
     workers already fill the cores turns it off.
+    stop: called between windows and once more before the folder is swapped in; what it
+    raises ends the run as a failure does (a stopped batch's run leaves no folder).
     plotter: a `twin.loop.report.run_plotter` forked earlier (by the CLI, before its heavy
     imports, so that matplotlib loads on the idle core); used if still fresh, else this
     run forks its own.
@@ -140,9 +143,18 @@ def replay_run_to_dir(
     for option, value in (("snapshots", snapshots), ("fields", fields)):
         if value not in WINDOW_END_CHOICES:
             raise ValueError(f"{option} must be one of {WINDOW_END_CHOICES}, got {value!r}")
+    window_hook = on_window
+    if stop is not None:
+        def window_hook(method: str, window: int, windows: int) -> None:
+            stop()
+            if on_window is not None:
+                on_window(method, window, windows)
     with replaced_folder(Path(out_root) / run_name(run_path)) as out_dir:
-        return _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
-                            on_window, overlap, assimilate_drift, plotter, fields)
+        accuracy = _replay_into(run_path, out_dir, methods, model_path, snapshots, spindle,
+                                window_hook, overlap, assimilate_drift, plotter, fields)
+        if stop is not None:
+            stop()
+        return accuracy
 
 
 def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
