@@ -135,3 +135,22 @@ def test_spec_errors_name_the_line(tmp_path, old, new, field):
     with pytest.raises(InputError) as info:
         load_spec(path)
     assert info.value.row == line and field in str(info.value)
+
+
+@pytest.mark.parametrize("new, says", [
+    ("conductivity_W_per_mK = inf", "finite"),  # passed `gt=0`: a field of inf and nan
+    ("conductivity_W_per_mK = nan", "finite"),
+    ('conductivity_W_per_mK = "49.8"', "number"),  # a quoted number, read as 49.8
+    ("conductivity_W_per_mK = true", "number"),  # read as 1.0 W/mK
+])
+def test_a_spec_value_must_be_a_finite_number_as_written(tmp_path, new, says):
+    # a spec's values were parsed leniently (a scenario's strictly): a slip in the TOML
+    # became a number the user never wrote
+    text = DEFAULT_SPEC_PATH.read_text()
+    old = "conductivity_W_per_mK = 49.8"
+    path = tmp_path / "spec.toml"
+    path.write_text(text.replace(old, new, 1))
+    with pytest.raises(InputError) as info:
+        load_spec(path)
+    assert info.value.row == text[:text.index(old)].count("\n") + 1
+    assert "conductivity_W_per_mK" in str(info.value) and says in str(info.value)

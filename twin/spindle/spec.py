@@ -54,7 +54,10 @@ _TOL_MM = 1e-9
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # as a scenario's (twin.plant.scenario): TOML has typed values, so `true` or "1.2"
+    # where a number belongs is a slip lax parsing would read as 1.0 and 1.2, and `inf` or
+    # `nan` is no dimension, property or coefficient (inf passed every `gt=0`)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 class SpindleInfo(_Strict):
