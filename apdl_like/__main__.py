@@ -1,5 +1,5 @@
 """`python -m apdl_like` is the `apdl-like` console script."""
 
-from apdl_like.cli import main
+from twin.console import apdl_like_main
 
-main()
+apdl_like_main()

@@ -656,24 +656,30 @@ def test_ctrl_c_ending_a_string_exec_still_exits_130_under_python_m(tmp_path):
     assert proc.stderr == "interrupted\n"
 
 
-def test_ctrl_c_while_twin_loads_its_commands_exits_130(tmp_path):
-    # `python -m twin` interrupted while importing the commands: a traceback, then death
-    # by SIGINT
-    source = (
-        "import builtins, runpy, sys\n"
-        "real_import = builtins.__import__\n"
-        "def interrupting(name, *args, **kwargs):\n"
-        "    if name == 'twin.cli':\n"
-        "        exec('raise KeyboardInterrupt')\n"
-        "    return real_import(name, *args, **kwargs)\n"
-        "builtins.__import__ = interrupting\n"
-        "sys.argv = ['twin', '--help']\n"
-        "runpy.run_module('twin', run_name='__main__')\n"
-    )
+_INTERRUPTING_LOADER = (
+    "import sys\n"
+    "class Interrupting:  # a Ctrl-C as the module loads\n"
+    "    def find_spec(self, name, path=None, target=None):\n"
+    "        if name == {module!r}:\n"
+    "            exec('raise KeyboardInterrupt')\n"
+    "sys.meta_path.insert(0, Interrupting())\n"
+    "sys.argv = ['prog', '--help']\n"
+)
+
+
+@pytest.mark.parametrize("entry, module", [
+    ("import runpy; runpy.run_module('twin', run_name='__main__')", "twin.cli"),  # python -m
+    ("from twin.console import twin_main; twin_main()", "twin.cli"),  # the `twin` script
+    ("from twin.console import apdl_like_main; apdl_like_main()", "apdl_like.cli"),
+    ("from twin.console import twin_main; twin_main()", "platformdirs"),  # as main() starts
+])
+def test_ctrl_c_while_a_console_script_loads_its_commands_exits_130(tmp_path, entry, module):
+    # a console script interrupted while importing its commands (their first 40-100 ms),
+    # or as its main() set up the warning log: a traceback, then death by SIGINT
+    source = _INTERRUPTING_LOADER.format(module=module) + entry + "\n"
     proc = _run_module(tmp_path, "load_probe", source)
     assert proc.returncode == 130, proc.stderr
     assert proc.stderr == "interrupted\n"
-
 
 
 def test_ctrl_c_while_the_options_are_read_is_told(capsys, monkeypatch):

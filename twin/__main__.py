@@ -1,8 +1,5 @@
-try:
-    from twin.cli import main
-except KeyboardInterrupt:  # Ctrl-C while the commands load: nothing has run yet
-    from twin.errors import exit_interrupted
+"""`python -m twin` is the `twin` console script."""
 
-    exit_interrupted()
+from twin.console import twin_main
 
-main()
+twin_main()
