@@ -528,8 +528,11 @@ def test_report_names_an_unreadable_run_folder_and_exits_2(replayed, tmp_path):
 def test_report_names_a_damaged_run_file_it_draws_from(replayed, tmp_path, file, text,
                                                        message):
     # a run folder whose figures the report draws again (plots/ gone) with a damaged
-    # keypoints.csv or corrections.csv was an internal error (ValueError, KeyError, ...)
+    # keypoints.csv or corrections.csv was an internal error (ValueError, KeyError, ...);
+    # then it stopped with summary.json rewritten and the old report.html beside it
     folder = shutil.copytree(replayed, tmp_path / "replay")
+    (folder / "summary.json").write_text('{"runs": [], "failed": []}')
+    (folder / "report.html").write_text("the earlier report")
     run_dir = folder / "hot_9000"
     shutil.rmtree(run_dir / "plots")
     if text is None:
@@ -542,6 +545,35 @@ def test_report_names_a_damaged_run_file_it_draws_from(replayed, tmp_path, file,
     assert result.exit_code == 2, result.output
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"error: {run_dir}/{message}"), lines
+    assert (folder / "summary.json").read_text() == '{"runs": [], "failed": []}'
+    assert (folder / "report.html").read_text() == "the earlier report"
+
+
+def test_report_draws_again_a_run_a_batch_swapped_in_meanwhile(replayed, tmp_path,
+                                                               monkeypatch):
+    # the page is drawn outside the folder's lock (it takes seconds); a run another batch
+    # put in meanwhile must be in both files, which are written together under the lock
+    import twin.loop.report
+
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    shutil.move(folder / "hot_9000", tmp_path / "hot_9000")
+    (folder / "other").mkdir()  # keeps it a replay folder with a run in it
+    shutil.copy(replayed / "hot_9000" / "accuracy.json", folder / "other")
+    drawn = []
+    page = twin.loop.report._page
+
+    def draw(out_root, summary):  # noqa: ANN001, ANN202
+        drawn.append([r["run"] for r in summary["runs"]])
+        if len(drawn) == 1:
+            shutil.move(tmp_path / "hot_9000", folder / "hot_9000")
+        return page(out_root, summary)
+
+    monkeypatch.setattr(twin.loop.report, "_page", draw)
+    twin.loop.report.build_report(folder)
+    assert len(drawn) == 2 and "hot_9000" not in drawn[0] and "hot_9000" in drawn[1]
+    summary = json.loads((folder / "summary.json").read_text())
+    assert "hot_9000" in [r["run"] for r in summary["runs"]]
+    assert "hot_9000" in (folder / "report.html").read_text()
 
 
 @pytest.mark.parametrize("quality", ['"stuck sensor T2"', "42"])

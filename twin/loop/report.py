@@ -324,14 +324,41 @@ def _distribution(summary: dict, runs: list[dict], methods: list[str]) -> dict |
             "plot": png_data_uri(distribution_plot(runs, methods))}
 
 
+REDRAWS = 3
+"""How often `build_report` draws the page again for runs a batch swapped in meanwhile
+(then it writes the page it has: batches that never stop would keep it drawing)."""
+
+
 def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
-    """Write DIR/report.html (and DIR/summary.json when rebuilding) from a replay folder."""
+    """Write DIR/report.html (and DIR/summary.json when rebuilding) from a replay folder.
+
+    A rebuilt summary.json is written with the page, once that is drawn: a run file the
+    page cannot read (a damaged keypoints.csv) stops the command before either file is
+    replaced.  Both are written under the folder's lock from the run folders as they are
+    then; a batch that swapped a run in while the page was drawn gets it drawn again."""
     out_root = Path(out_root)
+    path = out_root / "report.html"
     summary = None if rebuild_summary else _summary_of_batch(out_root)
-    if summary is None:
+    if summary is not None:
+        write_text(path, _page(out_root, summary))
+        return path
+    with folder_lock(out_root):
+        summary = collect_summary(out_root)
+    redraws = REDRAWS
+    while True:
+        page = _page(out_root, summary)
         with folder_lock(out_root):
-            summary = collect_summary(out_root)
-            write_json(out_root / "summary.json", summary)
+            latest = collect_summary(out_root)
+            # as JSON: a NaN in an accuracy equals itself there, never as a float
+            if redraws == 0 or json.dumps(latest) == json.dumps(summary):
+                write_json(out_root / "summary.json", latest)
+                write_text(path, page)
+                return path
+        summary, redraws = latest, redraws - 1
+
+
+def _page(out_root: Path, summary: dict) -> str:
+    """report.html's text for `summary` (summary.json's form) of the folder `out_root`."""
     runs = summary.get("runs", [])
     methods = list(dict.fromkeys(m for r in runs for m in r["methods"]))
     mean = summary.get("mean", {})
@@ -350,7 +377,7 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
             "snapshots": [{"alt": p.name, "src": png_data_uri(p.read_bytes())}
                           for p in snapshots],
         })
-    page = render_page(
+    return render_page(
         "replay_report.html.j2",
         step_s=STEP_S, window_s=WINDOW_S, methods=methods,
         rows=[[r["run"], f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
@@ -362,6 +389,3 @@ def build_report(out_root: str | Path, rebuild_summary: bool = True) -> Path:
         runs=page_runs,
         distribution=_distribution(summary, runs, methods),
     )
-    path = out_root / "report.html"
-    write_text(path, page)
-    return path
