@@ -7,7 +7,7 @@ A typer sub-app; `twin/cli/__init__.py` adds it under the name `drift`.  Heavy i
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -52,7 +52,7 @@ def _check_inputs(paths: Sequence[Path]) -> None:
         check_input_file(path)
 
 
-def _progress(quiet: bool):
+def _progress(quiet: bool) -> Callable[[str], None]:
     start = time.perf_counter()
 
     def tell(message: str) -> None:

@@ -96,7 +96,8 @@ def fit_bayesian(X: np.ndarray, Y: np.ndarray, seed: int, hidden: int | None = N
         beta_t = torch.from_numpy(beta.copy())
         a = alpha
 
-        def loss_of(residual, w, beta_t=beta_t, a=a):
+        def loss_of(residual: torch.Tensor, w: Sequence[torch.Tensor],
+                    beta_t: torch.Tensor = beta_t, a: float = a) -> torch.Tensor:
             # F/n: the same minimum, better conditioned for L-BFGS
             data = 0.5 * ((residual**2).sum(dim=0) * beta_t).sum()
             prior = 0.5 * a * sum((t**2).sum() for t in w)

@@ -54,7 +54,8 @@ def _thinned(rows: FitRows) -> tuple[np.ndarray, np.ndarray]:
     return rows.X[keep], rows.Y[keep]
 
 
-def _deterministic(predict: Callable[[Params, np.ndarray], np.ndarray]):
+def _deterministic(predict: Callable[[Params, np.ndarray], np.ndarray],
+                   ) -> Callable[[Params, np.ndarray], tuple[np.ndarray, None]]:
     def wrapped(params: Params, X: np.ndarray) -> tuple[np.ndarray, None]:
         return predict(params, X), None
 

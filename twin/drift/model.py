@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from twin.drift.methods import METHODS, FitRows, method_named
 from twin.drift.ranking import SensorRanking, rank_sensors
 from twin.drift.validation import MethodValidation, choose_default, validate_method
 from twin.errors import InputError
+
+if TYPE_CHECKING:
+    from threadpoolctl import threadpool_limits
 
 Progress = Callable[[str], None] | None
 
@@ -158,7 +162,7 @@ def _methods_without_speed(names: list[str], method: str | None, data: DriftData
     return usable
 
 
-def one_blas_thread():
+def one_blas_thread() -> threadpool_limits:
     """Run numpy/scipy/scikit-learn linear algebra on one thread.
 
     Bit-for-bit repeatable results (threaded BLAS reductions may sum in another order)

@@ -17,11 +17,15 @@ MacKay's evidence framework.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin.drift.scaling import fit_standard, standardize
+
+if TYPE_CHECKING:
+    import torch
 
 BP_HIDDEN = 12
 BP_WEIGHT_DECAY = 1e-3
@@ -137,7 +141,7 @@ def fit_bp(X: np.ndarray, Y: np.ndarray, seed: int, hidden: int = BP_HIDDEN,
     scaling, Z, Ys = scaled_problem(X, Y)
     start = initial_weights(Z.shape[1], hidden, Ys.shape[1], seed)
 
-    def loss_of(residual, w):
+    def loss_of(residual: torch.Tensor, w: Sequence[torch.Tensor]) -> torch.Tensor:
         return (residual**2).mean() + 0.5 * weight_decay * sum((t**2).sum() for t in w)
 
     return {**scaling, **minimise_weights(Z, Ys, start, loss_of, max_iter, seed)}

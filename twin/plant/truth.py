@@ -55,7 +55,7 @@ import numpy as np
 
 from twin.contract import OPERATING_TEMPERATURE_C
 from twin.lag import first_order_lag
-from twin.plant.scenario import Scenario
+from twin.plant.scenario import AmbientTable, CoolantTable, FactorTable, Scenario
 from twin.plant.timetable import TimeTable
 from twin.spindle.conditions import FILM_GROUPS, film_group
 
@@ -225,7 +225,8 @@ def sensor_offsets_mm(rng: np.random.Generator, placement_mm: float,
 
 def truth_tables(scenario: Scenario, defaults: TruthTables) -> TruthTables:
     """The scenario's tables where given, the defaults elsewhere."""
-    def pick(table, default: TimeTable) -> TimeTable:
+    def pick(table: FactorTable | CoolantTable | AmbientTable | None,
+             default: TimeTable) -> TimeTable:
         return default if table is None else table.table()
 
     xy = scenario.xy_drift

@@ -135,7 +135,8 @@ class RecordedRun(Samples):
 
         return self._build(self.time_s[idx], pick, ok)
 
-    def _build(self, t: np.ndarray, get, ok) -> Samples:
+    def _build(self, t: np.ndarray, get: Callable[[np.ndarray], np.ndarray],
+               ok: Callable[[str], np.ndarray]) -> Samples:
         disp = None
         if self.disp_um is not None:
             disp = np.stack([get(self.disp_um[:, j]) for j in range(3)], axis=1)

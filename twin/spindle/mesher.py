@@ -25,7 +25,7 @@ import numpy as np
 
 from twin.io.atomic import atomic_target
 from twin.signal_guard import signals_kept
-from twin.spindle.spec import BOUNDARY_NAMES, SpindleSpec
+from twin.spindle.spec import BOUNDARY_NAMES, PartSpec, SpindleSpec
 
 MM = 1e-3
 _TRIANGLE = 2  # gmsh element type: 3-node triangle
@@ -46,7 +46,7 @@ class SpindleMesh:
 
 
 # ------------------------------------------------------------------------- meshing
-def _part_size_m(part, spec: SpindleSpec, size_factor: float) -> float:
+def _part_size_m(part: PartSpec, spec: SpindleSpec, size_factor: float) -> float:
     thin = min(part.r_outer_mm - part.r_inner_mm, part.z_end_mm - part.z_start_mm)
     local = min(spec.mesh.element_size_mm, thin / spec.mesh.min_elements_across)
     return local * size_factor * MM
