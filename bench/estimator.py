@@ -1,8 +1,9 @@
 """Estimator benchmarks (issue 13): ensemble size against accuracy and time; the default
 estimator's time per 30 min run and its peak memory.
 
-- per ensemble size (the default: recorded drift assimilated), and the default size on
-  T1..T5 alone (`assimilate_drift=False`): the estimator
+- per ensemble size (the default: recorded drift assimilated), the default size on
+  T1..T5 alone (`assimilate_drift=False`), and the default on the runs without their
+  coolant_C column (the inlet then estimated too): the estimator
   replayed through its window decks (what `twin replay` does for the method) on every
   bundled run, warm process: best-of-two wall time and CPU time per run, mean temperature /
   deformation accuracy and band coverage;
@@ -30,8 +31,11 @@ def bundled_runs() -> list[Path]:
 
 
 def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
-    """One row per ensemble size (the default: the recorded drift assimilated), and the
-    default size on T1..T5 alone (`assimilate_drift=False`)."""
+    """One row per ensemble size (the default: the recorded drift assimilated), the
+    default size on T1..T5 alone (`assimilate_drift=False`), and the default on the runs
+    with their coolant inlet left out (`coolant_recorded` false: the inlet estimated)."""
+    import dataclasses
+
     from twin.estimation.method import EnsembleEstimator, EstimatorConfig
     from twin.loop.replay import deck_window_solver, replay_method
     from twin.loop.runfiles import measured_reference, method_accuracy
@@ -40,13 +44,15 @@ def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
 
     model = SpindleModel.load()
     runs = [read_run(p) for p in bundled_runs()]
+    unrecorded = [dataclasses.replace(r, coolant_C=None) for r in runs]
     rows = []
-    configs = [EstimatorConfig(members=n) for n in members]
-    configs.append(EstimatorConfig(assimilate_drift=False))
-    for cfg in configs:
+    configs = [(EstimatorConfig(members=n), runs) for n in members]
+    configs.append((EstimatorConfig(assimilate_drift=False), runs))
+    configs.append((EstimatorConfig(), unrecorded))
+    for cfg, replayed in configs:
         est = EnsembleEstimator(model, cfg)
         wall, cpu, metrics = [], [], []
-        for run in runs:
+        for run in replayed:
             best_wall = best_cpu = float("inf")
             for _ in range(2):
                 t, c = time.perf_counter(), time.process_time()
@@ -66,6 +72,7 @@ def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
         rows.append({
             "members": cfg.members,
             "assimilate_drift": cfg.assimilate_drift,
+            "coolant_recorded": replayed is runs,
             "wall_s_per_30min_run": float(np.mean(wall)),
             "cpu_s_per_30min_run": float(np.mean(cpu)),
             "temperature_accuracy_pct": mean("temperature_accuracy_pct"),

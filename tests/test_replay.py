@@ -28,9 +28,11 @@ MINUTES = 5
 
 def make_recorded_run(
     path, model, speed_rpm=9000.0, minutes=MINUTES, ambient_C=25.0, heat=1.15, resistance=0.7,
-    seed=0, factors=None, noise_C=0.02, edit=None, load_update_steps=1,
+    seed=0, factors=None, noise_C=0.02, edit=None, load_update_steps=1, record_coolant=False,
 ):
     """`factors` (twin.estimation.parameters names → multiplier) replaces heat/resistance;
+    the coolant inlet is at the ambient, as the nominal model assumes (`record_coolant`:
+    and the run records it in a coolant_C column);
     `edit(time_s, temps)` may change the measured temperatures in place before writing;
     `model` is the SpindleModel that plays the spindle; its bearing heat and contact
     resistance are taken at its ring and sleeve temperatures every `load_update_steps`
@@ -63,6 +65,8 @@ def make_recorded_run(
         **{f"T{i + 1}_C": temps[:, i] for i in range(5)},
         "disp_z_um": np.array(drift) + 0.05 * rng.standard_normal(t.size),
     }
+    if record_coolant:
+        cols["coolant_C"] = np.full(t.size, ambient_C)
     write_run(path, cols, {"source": "test: spindle model with +15 % heat, -30 % R_front"})
     return path
 

@@ -190,6 +190,9 @@ class WindowFeatures:
     """Per value, the factor value / nominal of the last window in which the value was not
     0 (a stopped bearing keeps the factor it had before the stop).  None: derived from
     `previous` and `previous_nominal`, 1 where those are 0."""
+    coolant_recorded: bool = True
+    """Whether the run records its coolant inlet (`coolant_C`); False: the conditions
+    assume the inlet at the ambient, and an estimator may estimate it."""
 
     def __post_init__(self) -> None:
         pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))

@@ -54,6 +54,10 @@ class Correction:
     start field, re-applied to the nominal values at each piece's start (every method's
     default, `twin.loop.replay`).  False: the values held for the whole window, the paper's
     literal per-window boundary conditions (one load step per deck)."""
+    coolant_C: float | None = None
+    """The coolant inlet temperature the method estimated for the window, °C (the
+    estimator, on a run that records none): the loop runs the window's deck with it.
+    None: the recorded inlet, or the ambient where the run records none."""
 
     @property
     def values(self) -> BoundaryValues:
@@ -69,7 +73,7 @@ class Correction:
         cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
     ) -> Correction:
         """These values with C_H, C_C on `previous` (1 where that was 0: a stop);
-        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s."""
+        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s, coolant_C."""
         v = [float(x) for x in values]
         c = [float(x) for x in correction_factors(v, previous)]
         return cls(*v, C_H=(c[0], c[1]), C_C=(c[2], c[3]), **extra)

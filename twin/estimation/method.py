@@ -9,7 +9,9 @@ What it estimates
     temperature, so only the recorded drift updates it), and the thermocouples' common time
     constant (a factor on the assumed 10 s, seen only through T1..T5's readings; see
     "Thermocouples").  The housing and air-gap film factors are available
-    (`EstimatorConfig.parameters`) but not estimated by default.
+    (`EstimatorConfig.parameters`) but not estimated by default.  On a run that records no
+    coolant inlet (no `coolant_C` column), also the inlet's offset from the ambient, in K
+    (`coolant_offset`; "Coolant inlet").
 
 Why these (sensitivity and observability study, `python -m twin.estimation.sensitivity`,
 run with the twin model itself: 30 min from a cold start, T1..T5 and the axial drift every
@@ -199,6 +201,51 @@ Thermocouples (T1..T5 as reported)
     a 16.5 s sensor and 14 s for 4.5–6.5 s ones; in the filter, against the other factors'
     covariance, the tests' emulated runs find 5.1 s for 5 s and 17.5 s for 18 s.
 
+Coolant inlet (runs without a `coolant_C` column)
+    The nominal conditions then take the inlet at the ambient; a chiller usually holds the
+    jacket 1–3 K off the room air, and the whole housing follows the jacket (T5 moves by
+    0.99 K per K of inlet, T1/T2 by 0.8/0.9, the rear ring and sleeve by 0.5; the drift by
+    0.25–0.35 µm per K).  So where the run does not record it the filter estimates the
+    inlet as an offset from the ambient (`coolant_offset`, K, additive: `parameters`):
+    prior N(0, 2.5 K), a random walk of 0.1 K per window (the suite's inlet and ambient
+    drift independently by up to 2 and 2.5 K over a run), bounds ±8 K, analysed from
+    T1..T5 (and the drift) like the log-factors; its tangent column is the jacket's
+    Σ h ∫ v dA.  Runs that record the inlet are filtered exactly as before (the parameter
+    is not in their ensemble), and `EstimatorConfig(estimate_coolant=False)` keeps the
+    ambient everywhere.  The estimated inlet goes with the correction
+    (`Correction.coolant_C`): the window's deck runs the jacket's films at it, and
+    corrections.csv lists it (`coolant_C`).
+    Observability (`python -m twin.estimation.sensitivity --names …,coolant_offset`, per
+    K; 30 min from a cold start at one speed): the offset is nearly collinear with the
+    jacket's film factor — a colder inlet looks like a stronger jacket:
+    cos(J_offset, J_film_coolant) = −0.97 at 9000 rpm (−0.99 at 4000, −0.94 at 14 000),
+    and of its 0.71 K per K of signature (RMS over T1..T5 and 30 samples) 0.16 K is left
+    after the film factor alone and 0.05 K after all nine other factors; with it the ten
+    singular values of J/σ gain one at 4.0 (offset against motor loss and jacket film).
+    That is within the model-form error: a steady run at one speed cannot tell the two
+    apart.  Two things do.  The film's effect is the jacket's wall-to-inlet difference,
+    which follows the heat load, the offset's is not: over a profile (the same forward
+    differences, loads following the rings) of 10 min each at 6000, 9000 and 12 000 rpm
+    0.18 K per K is left after all others (cos with the film −0.93), over 15 min at
+    14 000 rpm, a 10-min stop and 15 min at 4000 rpm 0.34 K (cos −0.83).  And the start:
+    the spindle at rest is at the ambient, and an offset inlet pulls T5 by 0.75 K per K
+    within the first minute, where the film's effect (no wall-to-inlet difference yet) is
+    0.17 per unit log-factor.
+    The linear-Gaussian posterior of the offset (σ 0.1–0.3 K per sample, the default
+    priors) is 0.12–0.18 K for the one-speed run, 0.02–0.06 K with the stop, correlated
+    0.7–0.8 with the film factor.  Consequence: the offset is estimated (it matters: 1 K
+    of inlet moves the housing by 1 K, the film's ±25 % by 0.2–0.7 K), and on one-speed
+    runs the pair is pinned only together; the factor recovery test therefore records the
+    inlet.
+    Measured (own seeds, not the fresh suite; temperature / deformation accuracy median,
+    worst of 12 runs without the column: suite 97531 as drawn and with the inlet held
+    ±1–3 K off the ambient): assumed at the ambient 98.78 / 95.64 and 95.46 / 68.57 % →
+    estimated 99.83 / 99.46 and 97.71 / 95.33 %, band coverage 90.4–91.6 %; the inlet found
+    within 0.3 K of the truth at the run's end on all 12.  The bundled runs without their
+    column (inlet within 0.9 K of the ambient): 99.80 / 99.79 → 99.84 / 99.83 and 99.07 /
+    98.87 → 99.11 / 98.96 %.  Walk 0.03–0.15 K and prior 2–3 K measured within 0.02
+    points; 0.1 tracks a drifting inlet within 0.3 K where 0.05 lagged it by up to 1.1 K.
+
 Band
     Per solver step, ±1.645 σ around the mean: σ² = member variance of the sensor value +
     a model-plus-noise variance; for the drift, the member variance (field and expansion
@@ -250,8 +297,10 @@ from twin.estimation.parameters import (
     DEFAULT_PARAMETERS,
     DRIFT_ONLY,
     OBSERVATION_ONLY,
+    OFFSETS,
     TangentOperators,
     apply_factors,
+    coolant_offset_of,
     factors_of,
     parameters,
 )
@@ -340,6 +389,10 @@ class EstimatorConfig:
     """Gauss–Newton iterations of the analysis of a run's first `iterated_windows` windows
     (1: the plain ETKF everywhere; module doc, "Iterated first analysis")."""
     iterated_windows: int = 1
+    estimate_coolant: bool = True
+    """On a run that records no coolant inlet (`WindowFeatures.coolant_recorded`), also
+    estimate the inlet's offset from the ambient (`coolant_offset`; module doc, "Coolant
+    inlet"); False: assume the inlet at the ambient, as the paper's methods do."""
     """How many of a run's first analyses are iterated (each costs one more window forecast
     per extra iteration)."""
 
@@ -423,24 +476,38 @@ class EnsembleEstimator:
     """What the window being forecast started from."""
 
     def __post_init__(self) -> None:
-        self._params = parameters(self.config.parameters)
+        self._sensors = self.model.sensor_matrix
+        self._drift_um = 1e6 * np.asarray(self.model.probe_vectors[0])
+        self._estimate(self.config.parameters)
+
+    def _estimate(self, names: tuple[str, ...]) -> None:
+        """Estimate `names` in the run to come (the configured parameters, and the coolant
+        inlet's offset where the run records no inlet)."""
+        self._names = names
+        self._params = parameters(names)
         self._prior_sd = np.array([p.prior_sd for p in self._params])
         self._walk_sd = np.array([p.walk_sd for p in self._params])
-        self._bounds = np.array([p.log_bounds for p in self._params])
-        S = self.model.sensor_matrix
-        self._sensors = S
-        names = self.config.parameters
+        self._bounds = np.array([p.state_bounds for p in self._params])
         self._expansion = names.index("expansion") if "expansion" in names else None
         self._lag = names.index("sensor_lag") if "sensor_lag" in names else None
-        self._drift_um = 1e6 * np.asarray(self.model.probe_vectors[0])
+        self._coolant = names.index("coolant_offset") if "coolant_offset" in names else None
 
     @property
     def log_factors(self) -> dict[str, float]:
-        """Current mean log-factors by name (after the last analysis)."""
+        """Current mean log-factors by name (after the last analysis; the coolant inlet's
+        offset is `coolant_offset_K`)."""
         if self._ensemble is None:
             return {}
-        return dict(zip(self.config.parameters, self._ensemble.log_factor_mean.tolist(),
-                        strict=True))
+        return {n: v for n, v in zip(self._names, self._ensemble.log_factor_mean.tolist(),
+                                     strict=True) if n not in OFFSETS}
+
+    @property
+    def coolant_offset_K(self) -> float | None:
+        """Current mean offset of the coolant inlet from the ambient, K (None: the run
+        records its inlet, or nothing has been estimated yet)."""
+        if self._ensemble is None or self._coolant is None:
+            return None
+        return float(self._ensemble.log_factor_mean[self._coolant])
 
     def correct(self, features: WindowFeatures) -> Correction:
         f = features
@@ -448,6 +515,11 @@ class EnsembleEstimator:
         if f.twin_state is None:
             raise ValueError("the estimator needs the twin's state (run it through the loop)")
         if f.window == 0 or self._ensemble is None:
+            names = cfg.parameters
+            if (cfg.estimate_coolant and not f.coolant_recorded
+                    and "coolant_offset" not in names):
+                names = names + ("coolant_offset",)
+            self._estimate(names)
             self._rng = np.random.default_rng(cfg.seed)
             self._drift_start_um = float(self._drift_um @ f.twin_state.field_C)
             # one channel per thermocouple and one for the drift (`_adapt_band`)
@@ -472,7 +544,7 @@ class EnsembleEstimator:
         )
         ens.log_factor_mean = np.clip(ens.log_factor_mean, self._bounds[:, 0], self._bounds[:, 1])
 
-        factors = factors_of(cfg.parameters, ens.log_factor_mean)
+        factors = factors_of(self._names, ens.log_factor_mean)
         self._forecast_speed_rpm = f.speed_rpm
         # the window's start: its readings, its re-run and a re-forecast need it
         self._start = WindowStart(ens, f.twin_state.conditions, self._readings_C.copy(),
@@ -487,6 +559,7 @@ class EnsembleEstimator:
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
             readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
             sensor_lag_s=self._lag_of(self._start), loads_follow_rings=cfg.loads_follow_rings,
+            coolant_C=bc.coolant_C if self._coolant is not None else None,
         )
 
     # ------------------------------------------------------------------ steps
@@ -532,8 +605,8 @@ class EnsembleEstimator:
             # With the history, one on a window boundary held every factor too, so a run
             # whose speed changed every minute on the minute never updated one (the
             # suites' changes sit on a 10 s grid: one in six of them).
-            held |= set(cfg.parameters)
-        rows = [i for i, name in enumerate(cfg.parameters) if name in held]
+            held |= set(self._names)
+        rows = [i for i, name in enumerate(self._names) if name in held]
 
         w, W = etkf_weights(obs.mean, obs.anomalies, obs.observed, obs.sd, cfg.inflation)
         w_forecast = np.zeros_like(w)  # the weights of the start `fc` was forecast from
@@ -632,10 +705,11 @@ class EnsembleEstimator:
         where configured; the members tangent-linear) and the mean's conditions at the
         window start."""
         cfg = self.config
-        factors = factors_of(cfg.parameters, start.ensemble.log_factor_mean)
+        factors = factors_of(self._names, start.ensemble.log_factor_mean)
+        offset = coolant_offset_of(self._names, start.ensemble.log_factor_mean)
 
         def conditions_at(T: np.ndarray) -> BoundaryConditions:
-            return apply_factors(self._conditions_at(start.conditions, T), factors)
+            return apply_factors(self._conditions_at(start.conditions, T), factors, offset)
 
         bc = conditions_at(start.field_C)
         loads = bc.to_thermal_loads()
@@ -645,7 +719,7 @@ class EnsembleEstimator:
             thermal.transient(loads, cfg.step_s),
             thermal.transient(loads, cfg.step_s * substeps),
             substeps,
-            TangentOperators(thermal, bc, cfg.parameters),
+            TangentOperators(thermal, bc, self._names),
             start.ensemble, self._sensors, self._drift_um, cfg.steps_per_window,
             stepper_at=(lambda T: thermal.transient(conditions_at(T).to_thermal_loads(),
                                                     cfg.step_s))
@@ -667,7 +741,7 @@ class EnsembleEstimator:
     def _lag_of(self, start: WindowStart) -> float:
         """The thermocouples' time constant a window from `start` is read with, s."""
         cfg = self.config
-        factors = factors_of(cfg.parameters, start.ensemble.log_factor_mean)
+        factors = factors_of(self._names, start.ensemble.log_factor_mean)
         return cfg.sensor_lag_s * factors.get("sensor_lag", 1.0)
 
     def _window_readings(self, time_s: np.ndarray, sensors_C: np.ndarray,
@@ -708,7 +782,8 @@ class EnsembleEstimator:
 
         cfg = self.config
         T0 = start.field_C
-        factors = factors_of(cfg.parameters, start.ensemble.log_factor_mean)
+        factors = factors_of(self._names, start.ensemble.log_factor_mean)
+        offset = coolant_offset_of(self._names, start.ensemble.log_factor_mean)
         current = f.twin_state.conditions
         steps = cfg.steps_per_window
 
@@ -717,7 +792,7 @@ class EnsembleEstimator:
             if abs(speed - current.speed_rpm) > 0.5:
                 base = nominal_conditions(self.model, speed, current.ambient_C,
                                           current.coolant_C)
-            bc = apply_factors(self._conditions_at(base, T), factors)
+            bc = apply_factors(self._conditions_at(base, T), factors, offset)
             stepper = self.model.thermal.transient(bc.to_thermal_loads(), cfg.step_s)
             return np.array(list(stepper.march(T, n)))
 

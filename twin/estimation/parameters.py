@@ -12,6 +12,12 @@ The tangent operators here give, for a mean temperature T̄ after a backward-Eul
 ∂(right-hand side − A(φ)·T̄)/∂φ_i: the heat a unit log-change of each parameter adds at
 every node, which is what the ensemble's perturbations are driven by (`twin.estimation.
 forecast`).
+
+One parameter is no factor: `coolant_offset`, the coolant inlet's offset from the inlet
+the conditions assume (K, additive: an inlet 2 K below is as likely as 2 K above, and 0 K
+is no boundary value to take a logarithm of).  It is estimated only on a run that records
+no inlet temperature, where the conditions assume the inlet at the ambient
+(`twin.estimation.method`, "Coolant inlet").
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from twin.contract import OPERATING_TEMPERATURE_C
 from twin.spindle.conditions import FILM_GROUPS, SIDES, BoundaryConditions
 
 
@@ -33,10 +40,11 @@ class Parameter:
     name       H_front, H_rear (bearing heat), R_front, R_rear (ring/sleeve contact
                resistance), motor (motor loss), film_<group> (FILM_GROUPS film coefficients),
                expansion (every thermal expansion coefficient: the drift's scale),
-               sensor_lag (the thermocouples' time constant: what T1..T5 read of the metal)
-    prior_sd   spread of the prior in log space (0.2 ≈ ±20 %)
-    walk_sd    random-walk spread added per 60 s window, log space
-    bounds     (lowest, highest) factor on the nominal value
+               sensor_lag (the thermocouples' time constant: what T1..T5 read of the metal),
+               coolant_offset (the coolant inlet's offset, K; `OFFSETS`)
+    prior_sd   spread of the prior in log space (0.2 ≈ ±20 %); an offset's in K
+    walk_sd    random-walk spread added per 60 s window, log space; an offset's in K
+    bounds     (lowest, highest) factor on the nominal value; an offset's in K
     """
 
     name: str
@@ -45,8 +53,16 @@ class Parameter:
     bounds: tuple[float, float]
 
     @property
-    def log_bounds(self) -> tuple[float, float]:
+    def state_bounds(self) -> tuple[float, float]:
+        """The bounds as the filter's state holds the parameter: log-factors, or K."""
+        if self.name in OFFSETS:
+            return self.bounds
         return math.log(self.bounds[0]), math.log(self.bounds[1])
+
+
+OFFSETS: frozenset[str] = frozenset({"coolant_offset"})
+"""Additive parameters (K), not log-factors: the coolant inlet's offset from the inlet the
+conditions assume.  `factors_of` leaves them out; `apply_factors` takes the offset apart."""
 
 
 ALL_PARAMETERS: dict[str, Parameter] = {
@@ -63,11 +79,13 @@ ALL_PARAMETERS: dict[str, Parameter] = {
         Parameter("film_rotor", 0.25, 0.005, (0.3, 3.0)),
         Parameter("expansion", 0.05, 0.002, (0.7, 1.4)),
         Parameter("sensor_lag", 0.45, 0.01, (0.2, 4.0)),
+        Parameter("coolant_offset", 2.5, 0.10, (-8.0, 8.0)),
     )
 }
 """Every candidate.  Prior spreads follow REFERENCE.md §7 (motor ±20–30 %, films ±20–40 %)
 and the paper's corrections (bearing heat and contact resistance moving by tens of %);
-sensor_lag's spread spans the 4–20 s of sheathed thermocouples around the assumed 10 s."""
+sensor_lag's spread spans the 4–20 s of sheathed thermocouples around the assumed 10 s;
+coolant_offset's 2.5 K a chiller holding the jacket 1–3 K off the room air, either way."""
 
 DEFAULT_PARAMETERS: tuple[str, ...] = (
     "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor", "film_coolant", "expansion",
@@ -102,20 +120,32 @@ def parameters(names: Sequence[str]) -> tuple[Parameter, ...]:
 
 
 def factors_of(names: Sequence[str], log_factors: np.ndarray) -> dict[str, float]:
-    """{name: e^φ} for every name (names not estimated are absent)."""
-    return {n: float(math.exp(v)) for n, v in zip(names, np.asarray(log_factors), strict=True)}
+    """{name: e^φ} for every name but the offsets (names not estimated are absent)."""
+    return {n: float(math.exp(v)) for n, v in zip(names, np.asarray(log_factors), strict=True)
+            if n not in OFFSETS}
+
+
+def coolant_offset_of(names: Sequence[str], values: np.ndarray) -> float:
+    """The estimated coolant inlet offset, K (0 where it is not estimated)."""
+    names = tuple(names)
+    return float(values[names.index("coolant_offset")]) if "coolant_offset" in names else 0.0
 
 
 BOUNDARY_VALUES = ("H_front", "H_rear", "R_front", "R_rear")
 
 
-def apply_factors(bc: BoundaryConditions, factors: dict[str, float]) -> BoundaryConditions:
+def apply_factors(bc: BoundaryConditions, factors: dict[str, float],
+                  coolant_offset_K: float = 0.0) -> BoundaryConditions:
     """The conditions with every thermal factor applied (bearing heat, contact, motor,
     films; the expansion and sensor-lag factors are no boundary condition and are left
-    out)."""
+    out), and the coolant inlet moved by `coolant_offset_K` (kept inside the operating
+    range every reader accepts, `twin.contract.OPERATING_TEMPERATURE_C`)."""
     values = {v: getattr(bc, v) * factors[v] for v in BOUNDARY_VALUES if v in factors}
     out = bc.scaled({k: v for k, v in factors.items()
                      if k not in BOUNDARY_VALUES and k not in NOT_THERMAL})
+    if coolant_offset_K:
+        lo, hi = OPERATING_TEMPERATURE_C
+        out = out.with_coolant(min(max(bc.coolant_C + coolant_offset_K, lo), hi))
     return out.with_values(**values) if values else out
 
 
@@ -129,6 +159,7 @@ class TangentOperators:
         motor      Σ q ∫ v dV over rotor and stator
         R_side     (1/R) K_side T⁺                                  (K_side: unit interface)
         film_g     Σ_b∈g h_b (∫ v T∞ dA − M_b T⁺)                   (M_b: unit film matrix)
+        coolant_offset  Σ_b h_b ∫ v dA over the coolant boundaries    (per K of the inlet)
         expansion, sensor_lag  0                                    (move no temperature)
 
     Built once per window from the applied conditions; `columns(T)` is cheap (one sparse
@@ -167,6 +198,10 @@ class TangentOperators:
                     op = term if op is None else op + term
                 if op is not None:
                     self.linear.append((i, op))
+            elif name == "coolant_offset":
+                for b in bc.coolant_boundaries:
+                    if b in bc.convection:
+                        self.constant[:, i] += bc.convection[b][0] * problem.facet_load(b)
             elif name in NOT_THERMAL:
                 pass  # no heat: its column stays zero
             else:

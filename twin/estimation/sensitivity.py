@@ -8,7 +8,13 @@ data pin down (a singular value below 1 is a direction the data cannot tell from
 the singular vectors which parameters are confounded.  The axial nose drift's sensitivity
 says which parameters matter for the deformation the twin must predict.
 
+The coolant inlet's offset (`coolant_offset`, additive) is differenced by δ K instead: its
+sensitivities are per K.  For it the report also gives the cosine of its column with every
+other and the RMS of its column left after a least-squares fit by all the others: what no
+combination of them can stand in for (`twin.estimation.method`, "Coolant inlet").
+
     python -m twin.estimation.sensitivity [--speed 9000] [--minutes 30] [--sigma 0.1]
+                                          [--names H_front,…,coolant_offset]
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.contract import STEP_S
-from twin.estimation.parameters import ALL_PARAMETERS, apply_factors
+from twin.estimation.parameters import ALL_PARAMETERS, OFFSETS, apply_factors
 
 
 @dataclass(frozen=True)
@@ -76,8 +82,10 @@ def trajectory_sensitivity(
     J = np.empty(base_T.shape + (len(names),))
     Jd = np.empty(base_d.shape + (len(names),))
     for i, name in enumerate(names):
-        T, d = sensor_trajectories(model, apply_factors(bc, {name: np.exp(delta)}), steps, dt_s,
-                                   every)
+        # an offset (K) moves by `delta` K: its sensitivity is per K
+        moved = (apply_factors(bc, {}, coolant_offset_K=delta) if name in OFFSETS
+                 else apply_factors(bc, {name: np.exp(delta)}))
+        T, d = sensor_trajectories(model, moved, steps, dt_s, every)
         J[..., i] = (T - base_T) / delta
         Jd[..., i] = (d - base_d) / delta
     time_s = 60.0 * np.arange(1, len(base_d) + 1)
@@ -87,7 +95,8 @@ def trajectory_sensitivity(
 def report(sens: Sensitivity, sigma_C: float) -> str:
     """A plain-text table: per-parameter sensitivities, singular values and vectors."""
     lines = [f"{'parameter':14s}" + "".join(f"{f'T{i}':>8s}" for i in range(1, 6))
-             + f"{'drift':>9s}   (max over the run, K resp. µm per unit log-factor)"]
+             + f"{'drift':>9s}   (max over the run, K resp. µm per unit log-factor; an "
+             "offset's per K)"]
     for i, name in enumerate(sens.names):
         peak = np.max(np.abs(sens.sensors_K[..., i]), axis=0)
         lines.append(f"{name:14s}" + "".join(f"{v:8.2f}" for v in peak)
@@ -99,6 +108,19 @@ def report(sens: Sensitivity, sigma_C: float) -> str:
         top = np.argsort(-np.abs(vt[k]))[:3]
         lines.append(f"  v{k + 1} ({s[k]:.3g}): " + ", ".join(
             f"{vt[k, j]:+.2f} {sens.names[j]}" for j in top))
+    J = sens.scaled_jacobian(1.0)
+    for i, name in enumerate(sens.names):
+        if name not in OFFSETS or len(sens.names) < 2:
+            continue
+        col = J[:, i]
+        norms = np.linalg.norm(J, axis=0)
+        cos = (J.T @ col) / np.where(norms > 0, norms * np.linalg.norm(col), 1.0)
+        others = np.delete(J, i, axis=1)
+        left = col - others @ np.linalg.lstsq(others, col, rcond=None)[0]
+        lines.append(f"{name}: cos with " + ", ".join(
+            f"{n} {c:+.2f}" for n, c in zip(sens.names, cos, strict=True) if n != name))
+        lines.append(f"  RMS {np.sqrt(np.mean(col**2)):.3f} K per K, left after all others "
+                     f"{np.sqrt(np.mean(left**2)):.3f}")
     return "\n".join(lines)
 
 
@@ -109,8 +131,11 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--speed", type=float, default=9000.0)
     parser.add_argument("--minutes", type=float, default=30.0)
     parser.add_argument("--sigma", type=float, default=0.1)
+    parser.add_argument("--names", default=",".join(ALL_PARAMETERS),
+                        help="comma-separated parameters (default: every candidate)")
     args = parser.parse_args(argv)
-    sens = trajectory_sensitivity(SpindleModel.load(), args.speed, minutes=args.minutes)
+    sens = trajectory_sensitivity(SpindleModel.load(), args.speed, minutes=args.minutes,
+                                  names=tuple(args.names.split(",")))
     print(report(sens, args.sigma))
 
 

@@ -369,6 +369,7 @@ def replay_method(
             measured_drift_um=None if measured_drift is None else measured_drift[upto],
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
+            coolant_recorded=state.coolant_C is not None,
         )
         previous_end = T
         if reruns and last is not None and (
@@ -392,6 +393,9 @@ def replay_method(
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
             T = np.asarray(corr.state_C, dtype=float)
+        if corr.coolant_C is not None:  # an estimated inlet (the run records none)
+            coolant = corr.coolant_C
+            bc = bc.with_coolant(coolant)
         thermal_factors = {k: v for k, v in corr.factors.items() if k != "expansion"}
         if thermal_factors:  # model-form factors (motor, film groups) go into the deck's loads
             bc = bc.scaled(thermal_factors)
@@ -496,6 +500,9 @@ def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
     decks: list[str] = []
     n_pieces = len(speed_stretches(speeds, max_steps=LOAD_UPDATE_STEPS))
     model_form = ", ".join(f"{k} {v:.4g}" for k, v in sorted(window.thermal_factors.items()))
+    estimated_coolant = (() if window.correction.coolant_C is None else (
+        f"  coolant inlet {coolant:.4f} C estimated (the run records none; ambient "
+        f"{ambient:.4f} C)",))
 
     def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
         # the nominal loads at this piece's own temperatures (they follow the rings every
@@ -514,7 +521,7 @@ def _follow_rings(model: SpindleModel, solver: WindowSolver, window: _WindowRun,
             f"  H front/rear {factors[0]:.4g} {factors[1]:.4g}, R front/rear "
             f"{factors[2]:.4g} {factors[3]:.4g}" + (f"; model-form: {model_form}"
                                                     if model_form else ""),
-        )
+        ) + estimated_coolant
         steps, deck = solver(bc, corr, T, start_s, window.window, n_steps=n,
                              load_step=(len(decks) + 1, n_pieces), notes=notes)
         if deck is not None:
@@ -551,7 +558,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
                 "band_sd": _array(c.band_sd), "sensor_lag_s": c.sensor_lag_s,
                 "readings_start_C": _array(c.readings_start_C),
-                "loads_follow_rings": c.loads_follow_rings,
+                "loads_follow_rings": c.loads_follow_rings, "coolant_C": c.coolant_C,
             },
         }
 
@@ -574,7 +581,8 @@ def method_replay_from_json(text: str) -> MethodReplay:
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
             state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]),
             readings_start_C=_from_array(c["readings_start_C"]),
-            sensor_lag_s=c["sensor_lag_s"], loads_follow_rings=c["loads_follow_rings"])
+            sensor_lag_s=c["sensor_lag_s"], loads_follow_rings=c["loads_follow_rings"],
+            coolant_C=c.get("coolant_C"))
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
                             correction, BoundaryValues(*w["nominal"]), w["deck"],
                             w["rerun_deck"], _from_array(w["start_C"]))

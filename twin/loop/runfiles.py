@@ -4,7 +4,8 @@ Layout under DIR/<run-name>/ (shared DESIGN.md):
     keypoints.csv      time_s, method, T1..T5 twin and measured, nose drift twin/measured,
                        and the 90 % band (…_twin_lo/_hi) when a method has one (estimator)
     corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C, and
-                       <name>_factor for further estimated values (motor, film groups)
+                       <name>_factor for further estimated values (motor, film groups),
+                       sensor_lag_s and coolant_C where a method estimates them
     accuracy.json      per-method metrics (twin.loop.metrics)
     quality.json       data-quality findings of the recorded run
     decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/),
@@ -460,6 +461,9 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
     # the thermocouples' time constant, where a method estimates it (the estimator)
     lagged = any(w.correction.sensor_lag_s > 0 for r in results.values() for w in r.windows)
     header += ["sensor_lag_s"] if lagged else []
+    # the coolant inlet, where a method estimates it (the estimator, on a run without one)
+    cooled = any(w.correction.coolant_C is not None for r in results.values() for w in r.windows)
+    header += ["coolant_C"] if cooled else []
     rows = []
     for name, r in results.items():
         for w in r.windows:
@@ -478,6 +482,7 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
                     *c.C_C,
                     *(c.factors.get(k, float("nan")) for k in extra),
                     *([c.sensor_lag_s if c.sensor_lag_s > 0 else float("nan")] if lagged else []),
+                    *([float("nan") if c.coolant_C is None else c.coolant_C] if cooled else []),
                 ]
             )
     write_csv(path, header, rows)

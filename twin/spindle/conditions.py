@@ -87,6 +87,9 @@ class BoundaryConditions:
     interfaces: dict[str, str]  # side → interface name
     bearing_volume_m3: dict[str, float] = field(default_factory=dict)
     motor_volume_m3: dict[str, float] = field(default_factory=dict)
+    coolant_boundaries: tuple[str, ...] = ()
+    """The convection boundaries whose bulk temperature is the coolant inlet (the spec's
+    `fluid = "coolant"`)."""
 
     def heat_W(self) -> dict[str, float]:
         """Heat generated per source, W (front/rear bearing, rotor, stator)."""
@@ -114,6 +117,16 @@ class BoundaryConditions:
                       for b, (h, t_inf) in self.convection.items()}
         return replace(self, motor_heat={r: q * motor for r, q in self.motor_heat.items()},
                        convection=convection)
+
+    def with_coolant(self, coolant_C: float) -> BoundaryConditions:
+        """A copy with the coolant inlet at `coolant_C` (°C): the bulk temperature of every
+        coolant boundary (film coefficients stay)."""
+        coolant = float(coolant_C)
+        if not math.isfinite(coolant):
+            raise ValueError(f"coolant_C must be a finite temperature, got {coolant_C!r}")
+        convection = {b: ((h, coolant) if b in self.coolant_boundaries else (h, t_inf))
+                      for b, (h, t_inf) in self.convection.items()}
+        return replace(self, coolant_C=coolant, convection=convection)
 
     def with_values(self, **values: float) -> BoundaryConditions:
         """A copy with some of H_front, H_rear, R_front, R_rear replaced."""
@@ -386,4 +399,6 @@ def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN00
         interfaces={s: spec.bearings[s].interface for s in SIDES},
         bearing_volume_m3={s: constants.bearings[s].volume_m3 for s in SIDES},
         motor_volume_m3=volumes,
+        coolant_boundaries=tuple(name for name, conv in spec.convection.items()
+                                 if conv.fluid == "coolant"),
     )
