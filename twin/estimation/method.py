@@ -389,12 +389,12 @@ class EstimatorConfig:
     """Gauss–Newton iterations of the analysis of a run's first `iterated_windows` windows
     (1: the plain ETKF everywhere; module doc, "Iterated first analysis")."""
     iterated_windows: int = 1
+    """How many of a run's first analyses are iterated (each costs one more window forecast
+    per extra iteration)."""
     estimate_coolant: bool = True
     """On a run that records no coolant inlet (`WindowFeatures.coolant_recorded`), also
     estimate the inlet's offset from the ambient (`coolant_offset`; module doc, "Coolant
     inlet"); False: assume the inlet at the ambient, as the paper's methods do."""
-    """How many of a run's first analyses are iterated (each costs one more window forecast
-    per extra iteration)."""
 
     def __post_init__(self) -> None:
         if self.analysis_iterations < 1:
