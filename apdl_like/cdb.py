@@ -16,11 +16,15 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from apdl_like.errors import ApdlError
 from apdl_like.writer import DeckLayout, component_name
+
+if TYPE_CHECKING:
+    from twin.fem import AxiMesh
 
 _NFORMAT = re.compile(
     r"\(\s*(\d+)\s*i\s*(\d+)\s*,\s*(\d+)\s*e\s*(\d+)\s*\.\s*\d+(?:\s*e\s*\d+)?\s*\)",
@@ -126,7 +130,8 @@ def _cmblock(name: str, entity: str, numbers: np.ndarray) -> list[str]:
     return out
 
 
-def cdb_text(mesh, materials: Mapping[str, object] | None = None, title: str = "") -> str:  # noqa: ANN001
+def cdb_text(mesh: AxiMesh, materials: Mapping[str, object] | None = None,
+             title: str = "") -> str:
     """The archive text of an AxiMesh (see the module docstring)."""
     thermal = mesh.thermal
     n = thermal.p.shape[1]
@@ -172,7 +177,7 @@ def cdb_text(mesh, materials: Mapping[str, object] | None = None, title: str = "
     return "\n".join(out)
 
 
-def write_cdb(mesh, path: str | Path, materials: Mapping[str, object] | None = None,  # noqa: ANN001
+def write_cdb(mesh: AxiMesh, path: str | Path, materials: Mapping[str, object] | None = None,
               title: str = "") -> Path:
     """Write the archive atomically."""
     from twin.io.atomic import write_bytes

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -25,6 +26,9 @@ from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
 from twin.paths import check_input_file, regular_file_info
 from twin.version import version_option
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
 
 app = typer.Typer(
     name="apdl-like",
@@ -108,7 +112,7 @@ def run(
                    f"{len(written)} files to {out}")
 
 
-def _spindle_session(base_dir: Path, strict: bool):  # noqa: ANN202 - a Session
+def _spindle_session(base_dir: Path, strict: bool) -> Session:
     """A session holding the reference spindle as the twin's loop builds it
     (`twin.loop.replay.spindle_session`)."""
     from twin.loop.replay import spindle_session

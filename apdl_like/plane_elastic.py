@@ -13,13 +13,18 @@ share the node, as MAPDL's nodal solution (PRNSOL, *GET,,NODE,,S) averages them.
 from __future__ import annotations
 
 from functools import cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 from skfem import Basis, BilinearForm, LinearForm
 
 from apdl_like.errors import ApdlError
-from apdl_like.plane_thermal import PlaneMesh, coupling_map, solve_constrained
+from apdl_like.plane_thermal import Part, PlaneMesh, coupling_map, solve_constrained
+
+if TYPE_CHECKING:
+    from skfem import DiscreteField
+    from skfem.assembly.form.form import FormExtraParams
 
 MODES = ("axisymmetric", "plane_stress", "plane_strain")
 
@@ -41,7 +46,7 @@ def elasticity_matrix(E: np.ndarray, nu: np.ndarray, mode: str) -> np.ndarray:
     return D
 
 
-def _strain(phi, component: int, mode: str, x: np.ndarray) -> list:  # noqa: ANN001
+def _strain(phi: DiscreteField, component: int, mode: str, x: np.ndarray) -> list:
     """(ε1, ε2, ε3, γ12) of the test/trial function phi in displacement `component`."""
     zero = 0.0 * np.asarray(phi)
     hoop = np.asarray(phi) / x if mode == "axisymmetric" else zero
@@ -58,7 +63,7 @@ def _weight(mode: str, x: np.ndarray) -> np.ndarray:
 def stiffness_form(mode: str, a: int, b: int) -> BilinearForm:
     """∫ ε(v; b)ᵀ D ε(u; a) dV for displacement components a (trial) and b (test)."""
 
-    def form(u, v, w):  # noqa: ANN001, ANN202 - a scikit-fem form
+    def form(u: DiscreteField, v: DiscreteField, w: FormExtraParams) -> np.ndarray:
         x = w.x[0]
         eu, ev = _strain(u, a, mode, x), _strain(v, b, mode, x)
         D = elasticity_matrix(w.E, w.nu, mode)
@@ -76,7 +81,7 @@ def thermal_load_form(mode: str, b: int) -> LinearForm:
     """∫ ε(v; b)ᵀ D ε_th dV, ε_th = α ΔT (1, 1, 1, 0) (plane stress: (1, 1, 0, 0))."""
     normal = 2 if mode == "plane_stress" else 3
 
-    def form(v, w):  # noqa: ANN001, ANN202
+    def form(v: DiscreteField, w: FormExtraParams) -> np.ndarray:
         x = w.x[0]
         ev = _strain(v, b, mode, x)
         D = elasticity_matrix(w.E, w.nu, mode)
@@ -90,7 +95,7 @@ def thermal_load_form(mode: str, b: int) -> LinearForm:
     return LinearForm(form)
 
 
-def _corner_dofs(part) -> np.ndarray:  # noqa: ANN001 - plane_thermal.Part
+def _corner_dofs(part: Part) -> np.ndarray:
     """(cells, corners) global scalar dofs of the corners of each cell."""
     return part.local_dofs[part.basis.nodal_dofs[0]][part.basis.mesh.t].T
 

@@ -31,6 +31,7 @@ from apdl_like.state import StepResult
 from apdl_like.tabular_loads import TabularLoads, tabular_loads
 
 if TYPE_CHECKING:
+    from apdl_like.model import SolutionSettings
     from apdl_like.state import SessionState
 
 THERMAL_PLANES = ("PLANE35", "PLANE55", "PLANE77")
@@ -493,7 +494,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
                       nodal_temperature=mesh.nodal(sol.temperature))
 
 
-def _substeps(settings, span: float) -> tuple[float, bool, float, float]:  # noqa: ANN001
+def _substeps(settings: SolutionSettings, span: float) -> tuple[float, bool, float, float]:
     """(first substep, adaptive?, DTMIN, DTMAX) from DELTIM/NSUBST and AUTOTS: the first
     substep is span / `SolutionSettings.substeps` with or without AUTOTS; the bounds are
     DELTIM's DTMIN, DTMAX or span / NSBMX, span / NSBMN, and where not given

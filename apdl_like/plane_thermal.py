@@ -34,6 +34,7 @@ import functools
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -62,6 +63,10 @@ from twin.fem.stepper import (
     picard,
     theta_step,
 )
+
+if TYPE_CHECKING:
+    from skfem import DiscreteField
+    from skfem.assembly.form.form import FormExtraParams
 
 STEP_TOLERANCE = 1e-5
 
@@ -233,24 +238,24 @@ def _refuse_zero_length(part: Part, facets: np.ndarray) -> None:
 
 
 # ----------------------------------------------------------------- the forms
-def _radius(w) -> np.ndarray:  # noqa: ANN001 - skfem FormExtraParams
+def _radius(w: FormExtraParams) -> np.ndarray:
     return 2.0 * np.pi * w.x[0] if w.axisymmetric else np.ones_like(w.x[0])
 
 
 @BilinearForm
-def conduction(u, v, w):  # noqa: ANN001, ANN201 - a scikit-fem form
+def conduction(u: DiscreteField, v: DiscreteField, w: FormExtraParams) -> np.ndarray:
     """∫ (kxx ∂u/∂x ∂v/∂x + kyy ∂u/∂y ∂v/∂y) dV."""
     return (w.kxx * u.grad[0] * v.grad[0] + w.kyy * u.grad[1] * v.grad[1]) * _radius(w)
 
 
 @BilinearForm
-def mass(u, v, w):  # noqa: ANN001, ANN201
+def mass(u: DiscreteField, v: DiscreteField, w: FormExtraParams) -> np.ndarray:
     """∫ c u v dV: the capacity on cells (c = ρc, J/(m³·K)), a film on faces (c = h)."""
     return w.c * u * v * _radius(w)
 
 
 @LinearForm
-def load(v, w):  # noqa: ANN001, ANN201
+def load(v: DiscreteField, w: FormExtraParams) -> np.ndarray:
     """∫ g v dV: a source on cells (g = HGEN, W/m³), on faces h·T_bulk or a heat flux."""
     return w.g * v * _radius(w)
 

@@ -37,7 +37,7 @@ from apdl_like.errors import ApdlError
 from apdl_like.fem_bridge import FemModel
 from apdl_like.interpreter import execute
 from apdl_like.loadset import LoadSet, load_set_from_record
-from apdl_like.model import Component, ElementType
+from apdl_like.model import Component, Database, ElementType
 from apdl_like.model import Material as MpTable
 from apdl_like.parser import Program, parse_deck, read_deck
 from apdl_like.solve import adopt_thermal_problem
@@ -57,7 +57,7 @@ class Session:
 
     # read-only views the callers use most
     @property
-    def db(self):  # noqa: ANN201 - apdl_like.model.Database
+    def db(self) -> Database:
         return self.state.db
 
     @property

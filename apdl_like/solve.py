@@ -29,6 +29,7 @@ from apdl_like.tabular_loads import in_use
 from twin.fem import ElasticProblem, Material, ThermalLoads, ThermalProblem
 
 if TYPE_CHECKING:
+    from apdl_like.plane_solve import FaceTable
     from apdl_like.state import SessionState
 _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants positive values
 
@@ -296,7 +297,7 @@ def initial_temperature(session: SessionState, fem: FemModel, n_dofs: int) -> np
     return fem.nodal_to_thermal(session.db.nodes.arrays["ic_temp"], base)
 
 
-def face_table(session: SessionState):  # noqa: ANN201 - FemModel | plane_solve.FaceTable
+def face_table(session: SessionState) -> FemModel | FaceTable:
     """The exterior faces SF/SFE load: the AxiMesh's (a twin session) or the deck mesh's."""
     if session.fem.external_mesh:
         return fem_model(session)

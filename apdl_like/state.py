@@ -26,7 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -35,9 +35,18 @@ from apdl_like.fem_bridge import FemModel, nearest_node
 from apdl_like.model import Database, RecordPartition
 
 if TYPE_CHECKING:
+    from apdl_like.parser import Statement
     from twin.fem import ElasticProblem, ThermalProblem
 
 TCC_LOCATION = 14  # real-constant position of TCC (thermal contact conductance) on CONTA17x
+
+
+class LocatedCall(Protocol):
+    """What `SessionState.note_load` reads of an apdl_like.call.Call (which imports this
+    module, so it is not named here): the statement it was made from."""
+
+    @property
+    def statement(self) -> Statement: ...
 
 
 @dataclass
@@ -209,7 +218,7 @@ class SessionState:
         self.listing.warnings.append(text)
         self.listing.log.append(text)
 
-    def note_load(self, call) -> None:  # noqa: ANN001 - an apdl_like.call.Call
+    def note_load(self, call: LocatedCall) -> None:
         """Remember the first load after the last SOLVE (a deck must not end there)."""
         if self.budget.unsolved is None:
             st = call.statement

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -32,9 +32,14 @@ from apdl_like.errors import ApdlError
 from apdl_like.table_array import TableArray, table_values
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from apdl_like.call import Call
     from apdl_like.model import Database
     from apdl_like.state import SessionState
+
+State = TypeVar("State", bound="DataclassInstance")
+"""A load state: a dataclass of load arrays (`TabularLoads.at` returns a copy of it)."""
 
 LOAD_VARIABLES = ("TIME", "X", "Y", "Z")
 _AXES = ("Var1 (rows)", "Var2 (columns)", "Var3 (planes)")
@@ -109,7 +114,7 @@ class TabularLoads:
     entries: tuple[_Entries, ...]
     tables: dict[int, tuple[str, TableArray]]  # slot -> (name, table)
 
-    def at(self, state: Any, time: float) -> Any:  # noqa: ANN401 - any load-state dataclass
+    def at(self, state: State, time: float) -> State:
         """A copy of `state` with every tabular entry looked up at `time`."""
         changes = {}
         for e in self.entries:
@@ -120,7 +125,7 @@ class TabularLoads:
             changes[e.name] = values
         return replace(state, **changes)
 
-    def cleared(self, state: Any) -> Any:  # noqa: ANN401
+    def cleared(self, state: State) -> State:
         """A copy of `state` without its tabular entries (NaN: no load), as the start of the
         next load step's ramps sees them."""
         changes = {}

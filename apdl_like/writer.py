@@ -23,9 +23,13 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from apdl_like.loadset import LoadSet
 from twin.io.atomic import write_text
+
+if TYPE_CHECKING:
+    from twin.fem import AxiMesh
 
 
 def component_name(name: str) -> str:
@@ -69,7 +73,7 @@ class DeckLayout:
         return cls(reg, bnd, ifc)
 
     @classmethod
-    def for_mesh(cls, mesh) -> DeckLayout:  # noqa: ANN001 - twin.fem.AxiMesh
+    def for_mesh(cls, mesh: AxiMesh) -> DeckLayout:
         return cls.from_names(mesh.regions, mesh.boundaries, mesh.interfaces)
 
 

@@ -15,11 +15,15 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from twin.correction.samples import SampleSet
 
-def _samples(n_runs: int = 20):
+
+def _samples(n_runs: int = 20) -> SampleSet:
     from twin.correction.samples import SampleSet, build_samples, open_loop_curves
     from twin.correction.toy_plant import ToyPlant
 

@@ -9,7 +9,9 @@ work the wall time includes waiting for a core.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -18,7 +20,10 @@ TARGETS = [f"ch{i}_um" for i in range(1, 6)]
 PREDICT_ROWS = 11_000
 
 
-def _timed(func):
+Result = TypeVar("Result")
+
+
+def _timed(func: Callable[[], Result]) -> tuple[Result, float, float]:
     wall, cpu = time.perf_counter(), time.process_time()
     out = func()
     return out, time.perf_counter() - wall, time.process_time() - cpu

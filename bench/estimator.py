@@ -65,7 +65,7 @@ def ensemble_table(members: tuple[int, ...] = MEMBERS) -> list[dict]:
             cpu.append(best_cpu * 30.0 / minutes)
             metrics.append(method_accuracy(r, *measured_reference(run, r.time_s)))
 
-        def mean(key: str, rows=metrics) -> float | None:
+        def mean(key: str, rows: list[dict] = metrics) -> float | None:
             v = [m[key] for m in rows if m[key] is not None]
             return float(np.mean(v)) if v else None
 

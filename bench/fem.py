@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import resource
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -30,10 +31,10 @@ def window_mesh(n_nodes: int) -> AxiMesh:
     nz = int(round(np.sqrt(n_nodes * 3.0)))
     nr = max(4, int(round(n_nodes / nz)))
 
-    def band(z0: float):
+    def band(z0: float) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
         return lambda r, z: (r > 0.05) & (z > z0) & (z < z0 + 0.025)
 
-    def seat(z0: float):
+    def seat(z0: float) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
         return lambda r, z: np.isclose(r, 0.05) & (z > z0) & (z < z0 + 0.025)
 
     return AxiMesh.structured(

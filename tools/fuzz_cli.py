@@ -24,12 +24,18 @@ import sys
 import tempfile
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 from tests.test_apdl_language import VALID_DECK
 from tests.test_fuzz_inputs import BUNDLED_MODEL, model_with_metadata
+
+if TYPE_CHECKING:
+    import numpy as np
+    import pyarrow as pa
 
 BIN = Path(sys.executable).parent
 TWIN = [str(BIN / "twin")]
@@ -51,10 +57,14 @@ class Case:
 
 
 CASES: list[Case] = []
+Setup = Callable[[Path], list[str]]
+"""A case's command line, built in its scratch folder."""
 
 
-def case(name, category, expect, outs=(), names=None, check=None):  # noqa: ANN001, ANN201
-    def wrap(fn):  # noqa: ANN001, ANN202
+def case(name: str, category: str, expect: str, outs: Sequence[str] = (),
+         names: str | None = None,
+         check: Callable[[Path], str | None] | None = None) -> Callable[[Setup], Setup]:
+    def wrap(fn: Setup) -> Setup:
         CASES.append(Case(name, category, expect, fn, tuple(outs), names, check))
         return fn
     return wrap
@@ -97,7 +107,7 @@ def edit_cell(row: int, column: str, value: str) -> str:
     return "\n".join(ls) + "\n"
 
 
-def edit_column(column: str, fn) -> str:  # noqa: ANN001
+def edit_column(column: str, fn: Callable[[int, str], str]) -> str:
     ls = lines()
     h = header_index()
     j = columns().index(column)
@@ -122,7 +132,7 @@ def replay(d: Path, *runs: str, out: str = "out", extra: tuple[str, ...] = ()) -
     return [*TWIN, "replay", *runs, "--out", str(d / out), *REPLAY, *extra]
 
 
-def run_case(text: str | bytes, name: str = "run.csv"):  # noqa: ANN201
+def run_case(text: str | bytes, name: str = "run.csv") -> Setup:
     return lambda d: replay(d, put(d, name, text))
 
 
@@ -240,7 +250,9 @@ case("missing run file", R, "bad", outs=["out"], names="nope.csv")(
     lambda d: replay(d, str(d / "nope.csv")))
 
 
-def _parquet(d: Path, mutate) -> list[str]:  # noqa: ANN001
+def _parquet(
+    d: Path, mutate: Callable[[dict[str, pa.Array], np.ndarray, list[str]], None]
+) -> list[str]:
     import numpy as np
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -255,7 +267,7 @@ def _parquet(d: Path, mutate) -> list[str]:  # noqa: ANN001
     return replay(d, str(d / "run.parquet"))
 
 
-def _pa():  # noqa: ANN202
+def _pa() -> ModuleType:
     import pyarrow as pa
     return pa
 
@@ -407,7 +419,7 @@ for label, argv in [
 S = "synth"
 
 
-def synth_args(*args: str, name: str = "r.csv"):  # noqa: ANN201
+def synth_args(*args: str, name: str = "r.csv") -> Setup:
     def build(d: Path) -> list[str]:
         base = {"--speed": "9000", "--minutes": "3", "--ambient": "25", "--seed": "1"}
         argv = [*TWIN, "synth", "--out", str(d / name), "--quiet"]
@@ -448,7 +460,7 @@ for label, args, expect in [
 case("synth .txt output", S, "bad", names="r.txt")(synth_args(name="r.txt"))
 
 
-def _synth_then_replay(scenario: str, expect_note: str = ""):  # noqa: ANN201, ARG001
+def _synth_then_replay(scenario: str, expect_note: str = "") -> Setup:  # noqa: ARG001
     def build(d: Path) -> list[str]:
         put(d, "s.toml", scenario)
         return [*TWIN, "synth", "--speed", "9000", "--minutes", "3", "--ambient", "25",
@@ -514,7 +526,7 @@ for label, text, expect in [
 M = "model"
 
 
-def model_info(data: bytes):  # noqa: ANN201
+def model_info(data: bytes) -> Setup:
     return lambda d: [*TWIN, "model-info", put(d, "m.safetensors", data)]
 
 
@@ -544,7 +556,7 @@ case("replay --model corrupt", M, "bad", outs=["out"], names="m.safetensors")(
 DK = "deck"
 
 
-def deck(text: str):  # noqa: ANN201
+def deck(text: str) -> Setup:
     return lambda d: [*APDL, "run", put(d, "d.inp", text), "--out", str(d / "out")]
 
 

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import ANY, Call, CommandSpec, command, ignored, specs_of
+from apdl_like.call import ANY, Call, CommandSpec, Handler, command, ignored, specs_of
 from apdl_like.commands.post26 import get_variable, variable_at
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from apdl_like.state import SessionState
 
 
-def _enter(processor: str):  # noqa: ANN202
+def _enter(processor: str) -> Handler:
     def enter(s: SessionState, c: Call) -> None:
         if processor == "SOLU" and s.processor != "SOLU":
             s.solution.new_analysis = True  # unless ANTYPE,,REST says otherwise

@@ -18,6 +18,7 @@ from apdl_like.call import POST, POST26, Call, CommandSpec, command, ignored, sp
 from apdl_like.errors import ApdlError
 
 if TYPE_CHECKING:
+    from apdl_like.plane_thermal import PlaneThermal, ThermalInputs
     from apdl_like.state import SessionState
 
 MAX_VARIABLE = 200
@@ -46,7 +47,7 @@ def thermal_history(s: SessionState) -> tuple[np.ndarray, list[np.ndarray]]:
     return np.array(times), temps
 
 
-def plane_solution(s: SessionState):  # noqa: ANN201 - (PlaneThermal, ThermalInputs)
+def plane_solution(s: SessionState) -> tuple[PlaneThermal, ThermalInputs]:
     solver = s.fem.plane_solver
     if solver is None or s.fem.plane_inputs is None:
         raise ApdlError("element heat flows need a thermal solution of the deck's own mesh")

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import PREP7, Call, CommandSpec, command, specs_of
+from apdl_like.call import PREP7, Call, CommandSpec, Handler, command, specs_of
 from apdl_like.errors import ApdlError
 from apdl_like.model import ELEMENT_TYPES, THERMAL_TO_STRUCTURAL, ElementType, Material
 
@@ -79,7 +79,7 @@ def etchg(s: SessionState, c: Call) -> None:
             et_.name = table[et_.name]
 
 
-def _attribute(name: str):  # noqa: ANN202
+def _attribute(name: str) -> Handler:
     def set_attribute(s: SessionState, c: Call) -> None:
         setattr(s.db, f"active_{name}", c.entity(1, name.upper()))
 

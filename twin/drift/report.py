@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,8 +19,11 @@ from twin.io.atomic import write_text
 from twin.io.figures import new_figure, png_bytes
 from twin.io.html_pages import png_data_uri, render_page
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
-def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
+
+def _png(fig: Figure) -> bytes:
     return png_bytes(fig, dpi=90)
 
 

@@ -17,12 +17,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin.correction.rerun import LOAD_UPDATE_STEPS
 from twin.estimation.ensemble import Ensemble
 from twin.estimation.parameters import TangentOperators
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
+
+    from twin.fem import ThermalStepper
 
 
 @dataclass
@@ -63,15 +69,15 @@ class WindowForecast:
 
 
 def forecast_window(
-    mean_stepper,  # noqa: ANN001 - twin.fem.ThermalStepper of the mean's loads, solver Δt
-    member_stepper,  # noqa: ANN001 - the same loads with Δt × substeps
+    mean_stepper: ThermalStepper,  # the mean's loads, solver Δt
+    member_stepper: ThermalStepper,  # the same loads with Δt × substeps
     substeps: int,
     tangent: TangentOperators,
     ensemble: Ensemble,
-    sensor_matrix,  # noqa: ANN001 - (5, n) sparse
+    sensor_matrix: sp.csr_matrix,  # (5, n)
     drift_vector_um: np.ndarray,
     steps: int,
-    stepper_at: Callable[[np.ndarray], object] | None = None,
+    stepper_at: Callable[[np.ndarray], ThermalStepper] | None = None,
     update_steps: int = LOAD_UPDATE_STEPS,
 ) -> WindowForecast:
     """Advance the ensemble `steps` solver steps; log-factors are constant over the window.

@@ -25,12 +25,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 
 from twin.contract import OPERATING_TEMPERATURE_C
 from twin.spindle.conditions import FILM_GROUPS, SIDES, BoundaryConditions
+
+if TYPE_CHECKING:
+    from twin.fem import ThermalProblem
 
 
 @dataclass(frozen=True)
@@ -166,7 +170,8 @@ class TangentOperators:
     mat-vec per contact and film parameter).
     """
 
-    def __init__(self, problem, bc: BoundaryConditions, names: Sequence[str]) -> None:  # noqa: ANN001
+    def __init__(self, problem: ThermalProblem, bc: BoundaryConditions,
+                 names: Sequence[str]) -> None:
         n = problem.n_dofs
         self.names = tuple(names)
         self.constant = np.zeros((n, len(self.names)))

@@ -22,11 +22,16 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin.contract import STEP_S
 from twin.estimation.parameters import ALL_PARAMETERS, OFFSETS, apply_factors
+
+if TYPE_CHECKING:
+    from twin.spindle.conditions import BoundaryConditions
+    from twin.spindle.model import SpindleModel
 
 
 @dataclass(frozen=True)
@@ -48,7 +53,8 @@ class Sensitivity:
         return s, vt
 
 
-def sensor_trajectories(model, bc, steps: int, dt_s: float, every: int) -> tuple:  # noqa: ANN001
+def sensor_trajectories(model: SpindleModel, bc: BoundaryConditions, steps: int, dt_s: float,
+                        every: int) -> tuple[np.ndarray, np.ndarray]:
     """T1..T5 (k, 5) and the axial drift (k,) µm every `every` steps of a run at fixed loads,
     from a uniform field at the ambient."""
     stepper = model.thermal.transient(bc.to_thermal_loads(), dt_s)
@@ -64,7 +70,7 @@ def sensor_trajectories(model, bc, steps: int, dt_s: float, every: int) -> tuple
 
 
 def trajectory_sensitivity(
-    model,  # noqa: ANN001 - twin.spindle.SpindleModel
+    model: SpindleModel,
     speed_rpm: float = 9000.0,
     ambient_C: float = 25.0,
     minutes: float = 30.0,

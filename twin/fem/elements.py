@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from skfem import ElementTriP1, ElementTriP2
+from skfem import Element, ElementTriP1, ElementTriP2
 
 ELEMENTS = {1: ElementTriP1, 2: ElementTriP2}
 
 
-def element_for(order: int):  # noqa: ANN201 - skfem element instance
+def element_for(order: int) -> Element:
     """P1 (order 1) or P2 (order 2) scalar triangle element."""
     try:
         return ELEMENTS[order]()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -58,7 +59,9 @@ class ThermalLoads:
             _finite(t, "fixed temperature of boundary", name)
 
 
-def field_values(value, points: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
+def field_values(
+    value: float | Callable[[np.ndarray, np.ndarray], np.ndarray], points: np.ndarray, what: str
+) -> np.ndarray:
     """A constant or a field f(r, z) evaluated at points (2, ...), checked finite."""
     if callable(value):
         out = np.asarray(value(points[0], points[1]), dtype=float)

@@ -25,10 +25,13 @@ import logging
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 from skfem import MeshTri
+
+if TYPE_CHECKING:
+    import meshio
 
 T = TypeVar("T")
 
@@ -295,7 +298,7 @@ class AxiMesh:
         )
 
     @classmethod
-    def from_meshio(cls, mesh, interfaces: Iterable[str] = (),  # noqa: ANN001
+    def from_meshio(cls, mesh: meshio.Mesh, interfaces: Iterable[str] = (),
                     present_only: bool = False) -> AxiMesh:
         """Build from a meshio.Mesh with gmsh physical groups (2-D regions, 1-D lines);
         with `present_only`, the `interfaces` the mesh has no line group of are left out."""

@@ -90,7 +90,9 @@ class ElasticProblem:
         self._lu = factorize_symmetric(K_free.tocsc())
         self._stress_mass = None
 
-    def _cell_constants(self, materials: Mapping[str, Material]):  # noqa: ANN202
+    def _cell_constants(
+        self, materials: Mapping[str, Material]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         n = self.mesh.n_cells
         lam, mu, beta = np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
         for region, mat in materials.items():

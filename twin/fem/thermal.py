@@ -14,7 +14,7 @@ window costs one sparse factorization and the time steps cost one back-substitut
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import partial
 
 import numpy as np
@@ -235,7 +235,8 @@ class ThermalProblem:
         last = d.size - 1 - np.unique(d[::-1], return_index=True)[1]
         return d[last], v[last]
 
-    def _weighted_load(self, value, basis: Basis, unit: np.ndarray, what: str) -> np.ndarray:  # noqa: ANN001
+    def _weighted_load(self, value: float | Callable[[np.ndarray, np.ndarray], np.ndarray],
+                       basis: Basis | None, unit: np.ndarray, what: str) -> np.ndarray:
         """∫ value·v 2πr over a (facet) basis; `unit` is the cached load of value = 1."""
         if not callable(value):
             return float(value) * unit

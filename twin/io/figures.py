@@ -9,10 +9,13 @@ itself is imported here, when the first figure is made, not when a report module
 from __future__ import annotations
 
 import io
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
-def new_figure(**figure_kwargs: Any) -> Any:
+def new_figure(**figure_kwargs: Any) -> Figure:
     """A matplotlib `Figure` (figsize=(w, h) in inches, ...) attached to the Agg canvas;
     lay it out as usual (`fig.subplots`, `fig.subplots_adjust`)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -32,7 +35,7 @@ def load_matplotlib() -> None:
     png_bytes(fig, dpi=10)
 
 
-def png_bytes(fig: Any, dpi: float) -> bytes:
+def png_bytes(fig: Figure, dpi: float) -> bytes:
     """The figure drawn to PNG at `dpi` pixels per inch."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)

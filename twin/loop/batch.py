@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import signal
 import uuid
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from twin.errors import InputError
 from twin.io.atomic import write_json
@@ -28,6 +29,9 @@ from twin.loop.runfiles import (
     run_name,
 )
 from twin.loop.summary import collect_summary, read_accuracy
+
+if TYPE_CHECKING:
+    from twin.spindle.model import SpindleModel
 
 
 @dataclass(frozen=True)
@@ -77,7 +81,7 @@ class BatchResult:
         return 2 if self.failed else 0
 
 
-def run_job(job: ReplayJob, spindle=None, overlap: bool = False,  # noqa: ANN001
+def run_job(job: ReplayJob, spindle: SpindleModel | None = None, overlap: bool = False,
             plotter: ForkedTask | None = None) -> dict:
     """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
     spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`:
@@ -114,7 +118,7 @@ def replay_batch(
     dask_address: str | None = None,
     snapshots: str = "none",
     resume: bool = False,
-    progress=None,  # noqa: ANN001 - a callable(run_name, status) or None
+    progress: Callable[[str, str], None] | None = None,  # (run name, status)
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
     fields: str = "every",
@@ -213,8 +217,9 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
     return accuracy
 
 
-def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202
-             plotter: ForkedTask | None):
+def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None,
+             progress: Callable[[str, str], None] | None,
+             plotter: ForkedTask | None) -> Iterator[dict]:
     if dask_address:
         from dask.distributed import Client, Event
         from dask.distributed import as_completed as dask_completed
@@ -278,7 +283,7 @@ def _ignore_interrupts() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
-def _tell(progress, outcome: dict) -> None:  # noqa: ANN001
+def _tell(progress: Callable[[str, str], None] | None, outcome: dict) -> None:
     if progress is None:
         return
     if "ok" in outcome:

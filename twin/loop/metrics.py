@@ -27,6 +27,7 @@ relative to that temperature: finite for any valid run, and a run shifted to bel
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -130,7 +131,7 @@ def metric_values(runs: list[dict]) -> dict[str, dict[str, list[float]]]:
     return methods
 
 
-def _reduce(runs: list[dict], reduce) -> dict:  # noqa: ANN001 - (key, values) -> float
+def _reduce(runs: list[dict], reduce: Callable[[str, list[float]], float]) -> dict:
     return {m: {k: float(reduce(k, v)) for k, v in d.items()}
             for m, d in metric_values(runs).items()}
 

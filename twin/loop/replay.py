@@ -58,6 +58,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -81,6 +82,9 @@ from twin.lag import first_order_lag
 from twin.runs import RecordedRun
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
+
+if TYPE_CHECKING:
+    from apdl_like.session import Session
 
 FILM_AMBIENT_STEP_K = 0.5
 """The film coefficients see the ambient on this grid (the sink temperature stays exact).
@@ -159,7 +163,7 @@ def direct_window_solver(model: SpindleModel) -> WindowSolver:
     return solve
 
 
-def spindle_session(model: SpindleModel, base_dir: str | Path | None = None):  # noqa: ANN201
+def spindle_session(model: SpindleModel, base_dir: str | Path | None = None) -> Session:
     """An APDL-like session (`apdl_like.Session`) holding `model`'s mesh, materials and
     contact real sets: the database every window deck runs on (the loop's, and
     `apdl-like run --spindle`'s)."""
@@ -175,7 +179,7 @@ def spindle_session(model: SpindleModel, base_dir: str | Path | None = None):  #
     )
 
 
-def deck_window_solver(model: SpindleModel, session=None) -> WindowSolver:  # noqa: ANN001
+def deck_window_solver(model: SpindleModel, session: Session | None = None) -> WindowSolver:
     """Solve each window through its APDL-like deck in one persistent session.
 
     The deck (apdl_like.writer) carries the window's loads only; the session holds the

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,10 @@ from twin.loop.folders import folder_lock
 from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
 from twin.loop.overlap import ForkedTask
 from twin.loop.summary import collect_summary, run_folder
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 METHOD_COLORS = {
     "open_loop": "#7f7f7f", "ratio": "#1f77b4", "bpnn": "#d62728", "estimator": "#2ca02c"
@@ -78,13 +83,13 @@ def _read_csv(path: Path) -> _Columns:
 PLOTS = ("temperatures.png", "drift_corrections.png")
 
 
-def _png(fig) -> bytes:  # noqa: ANN001 - matplotlib Figure
+def _png(fig: Figure) -> bytes:
     # fixed margins: a "tight" bounding box draws the figure twice (a third of a replay)
     fig.subplots_adjust(left=0.05, right=0.99, bottom=0.17, top=0.9, wspace=0.25)
     return png_bytes(fig, dpi=80)
 
 
-def _shade_band(ax, kp: _Columns, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,  # noqa: ANN001
+def _shade_band(ax: Axes, kp: _Columns, sel: np.ndarray, t_min: np.ndarray, lo: str, hi: str,
                 method: str) -> None:
     """The method's 90 % band, shaded, where keypoints.csv has one."""
     if lo not in kp and hi not in kp:

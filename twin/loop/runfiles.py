@@ -28,6 +28,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,6 +45,12 @@ from twin.loop.replay import (
     method_replay_to_json,
     replay_method,
 )
+
+if TYPE_CHECKING:
+    from twin.correction.result import Corrector
+    from twin.loop.replay import WindowRecord, WindowSolver
+    from twin.runs import RecordedRun
+    from twin.spindle.model import SpindleModel
 
 DONE_FILE = ".done.json"
 WINDOW_END_CHOICES = ("none", "end", "every")
@@ -117,7 +124,7 @@ def replay_run_to_dir(
     methods: Sequence[str],
     model_path: str | None,
     snapshots: str = "none",
-    spindle=None,  # noqa: ANN001 - a loaded SpindleModel to reuse, or None
+    spindle: SpindleModel | None = None,  # a loaded spindle to reuse
     on_window: Callable[[str, int, int], None] | None = None,
     overlap: bool = True,
     assimilate_drift: bool = True,
@@ -158,9 +165,10 @@ def replay_run_to_dir(
         return accuracy
 
 
-def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                 on_window, overlap: bool, assimilate_drift: bool,
-                 plotter: ForkedTask | None, fields: str) -> dict:  # noqa: ANN001
+def _replay_into(run_path: str | Path, out_dir: Path, methods: Sequence[str],
+                 model_path: str | None, snapshots: str, spindle: SpindleModel | None,
+                 on_window: Callable[[str, int, int], None] | None, overlap: bool,
+                 assimilate_drift: bool, plotter: ForkedTask | None, fields: str) -> dict:
     from twin.io.figures import load_matplotlib
     from twin.loop.report import run_plotter
 
@@ -178,10 +186,11 @@ def _replay_into(run_path, out_dir: Path, methods, model_path, snapshots, spindl
     return accuracy
 
 
-def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spindle,  # noqa: ANN001
-                    on_window, plots: ForkedTask,
+def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
+                    model_path: str | None, snapshots: str, spindle: SpindleModel | None,
+                    on_window: Callable[[str, int, int], None] | None, plots: ForkedTask,
                     assimilate_drift: bool = True,
-                    fields: str = "every") -> tuple[dict, dict]:  # noqa: ANN001
+                    fields: str = "every") -> tuple[dict, dict]:
     """Replay and write every file but accuracy.json and the .done token; `plots` is
     started once keypoints.csv and corrections.csv (what the figures show) are written."""
     from twin.correction.methods import make_corrector
@@ -240,7 +249,7 @@ def _replay_outputs(run_path, out_dir: Path, methods, model_path, snapshots, spi
     return accuracy, token
 
 
-def _write_start_state(path: Path, model, w) -> None:  # noqa: ANN001
+def _write_start_state(path: Path, model: SpindleModel, w: WindowRecord) -> None:
     """The field window `w` starts from, on the deck session's nodes (node i+1 = vertex i,
     `apdl_like.session`), with the estimator's stated readings and lag: what `apdl-like run
     --spindle --start` runs its deck (or its re-run deck) from."""
@@ -261,7 +270,7 @@ def _window_ends(fields: dict[float, np.ndarray], choice: str) -> list[float]:
     return {"none": [], "end": times[-1:], "every": times}[choice]
 
 
-def _write_snapshots(out_dir: Path, model, r: MethodReplay, snapshots: str,  # noqa: ANN001
+def _write_snapshots(out_dir: Path, model: SpindleModel, r: MethodReplay, snapshots: str,
                      title: str) -> None:
     from twin.loop.snapshot import render_snapshot
 
@@ -312,7 +321,9 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     return len(wanted)
 
 
-def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # noqa: ANN001
+def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corrector],
+                    primary: str, solver: WindowSolver,
+                    on_window: Callable[[str, int, int], None] | None,
                     write_primary_fields: Callable[[MethodReplay], None], snapshots: str,
                     fork: bool, keep_fields: bool = True) -> dict[str, MethodReplay]:
     """Every method's replay, by name in the order given; the primary's field files are
@@ -330,7 +341,7 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
     child fail, the parent replays its methods itself: the error, if it is one, is then
     raised here with its own type.
     """
-    def replay(corrector) -> MethodReplay:  # noqa: ANN001
+    def replay(corrector: Corrector) -> MethodReplay:
         callback = None
         if on_window is not None:
             callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
@@ -366,7 +377,7 @@ def _replay_methods(run, model, correctors, primary: str, solver, on_window,  # 
 
 
 def measured_reference(
-    run, time_s: np.ndarray  # noqa: ANN001 - twin.runs.RecordedRun
+    run: RecordedRun, time_s: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """What a replay is compared with at `time_s`: T1..T5 (k, 5) and the axial drift (k,)
     (NaN where invalid; None if not recorded), and T1..T5 at the run start (5,)."""
@@ -488,7 +499,7 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
     write_csv(path, header, rows)
 
 
-def _write_fields(out_dir: Path, model, fields: str, r: MethodReplay) -> None:  # noqa: ANN001
+def _write_fields(out_dir: Path, model: SpindleModel, fields: str, r: MethodReplay) -> None:
     """fields/*.vtu and fields.pvd of the window ends `fields` chooses; none: neither."""
     from twin.io.vtk import write_field_series
     from twin.spindle.fields import field_mesh

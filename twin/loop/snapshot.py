@@ -16,8 +16,12 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from twin.spindle.model import SpindleModel
 
 FIELDS = {
     "temperature": ("temperature_C", "Temperature [°C]", "inferno"),
@@ -27,7 +31,7 @@ FIELDS = {
 
 
 def render_snapshot(
-    model,  # noqa: ANN001 - twin.spindle.model.SpindleModel
+    model: SpindleModel,
     T: np.ndarray,
     out_png: str | Path,
     field: str = "temperature",
@@ -62,7 +66,7 @@ def ctrl_c_after() -> Iterator[None]:
             handler(*pressed[0])  # the handler's own KeyboardInterrupt, now
 
 
-def _render(model, T: np.ndarray, out_png: str | Path, field: str, title: str,  # noqa: ANN001
+def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str, title: str,
             T_initial_C: float | None, section: bool, window_size: tuple[int, int]) -> Path:
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
@@ -170,7 +174,7 @@ def field_marker(field: str, values: np.ndarray) -> tuple[int, str]:
     return top, f"max {float(values[top]):.1f} {unit}"
 
 
-def _nose_vertex(model) -> int:  # noqa: ANN001
+def _nose_vertex(model: SpindleModel) -> int:
     """Thermal-mesh vertex nearest the axial nose probe."""
     probe = model.spec.probes["nose_axial"]
     p = model.mesh.thermal.p

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -30,11 +31,15 @@ from twin.loop.runfiles import measured_reference, method_accuracy
 from twin.loop.target_rules import TargetRule
 from twin.loop.windowfit import WindowFit
 
+if TYPE_CHECKING:
+    from twin.runs import RecordedRun
+    from twin.spindle.model import SpindleModel
+
 TRAINING_PASSES = (("anchor", 0.0), ("anchor", 0.05), ("fit", 0.05))
 """(drive, drive_spread) of the passes per run (seeds 0, 1, …): see `WindowFit`."""
 
 
-def simulate_for_training(run, model) -> list[SimulatedRun]:  # noqa: ANN001
+def simulate_for_training(run: RecordedRun, model: SpindleModel) -> list[SimulatedRun]:
     """The run (a `twin.runs.RecordedRun`) replayed on `model` (a `SpindleModel`) with the
     window fit, once per pass of `TRAINING_PASSES`."""
     out = []
@@ -48,14 +53,15 @@ def simulate_for_training(run, model) -> list[SimulatedRun]:  # noqa: ANN001
     return out
 
 
-def simulate_with_ratio(run, model) -> list[SimulatedRun]:  # noqa: ANN001
+def simulate_with_ratio(run: RecordedRun, model: SpindleModel) -> list[SimulatedRun]:
     """The run replayed on `model` with the online ratio correction (the paper's training
     simulation)."""
     result = replay_method(run, model, make_corrector("ratio"), keep_fields=False)
     return [_simulated(run, result, None)]
 
 
-def training_simulator(rule: TargetRule | str = TargetRule.FIT, spindle=None) -> Simulator:  # noqa: ANN001
+def training_simulator(rule: TargetRule | str = TargetRule.FIT,
+                       spindle: SpindleModel | None = None) -> Simulator:
     """The twin's simulation of a training run for a target rule, on `spindle` (a loaded
     `SpindleModel`; None: the bundled reference spindle, loaded here once for every run).
     The simulator keeps the name of the simulation it runs (the model file records it)."""
@@ -72,7 +78,7 @@ def training_simulator(rule: TargetRule | str = TargetRule.FIT, spindle=None) ->
     return functools.update_wrapper(functools.partial(simulate, model=spindle), simulate)
 
 
-def _simulated(run, result: MethodReplay, fitted: np.ndarray | None,  # noqa: ANN001
+def _simulated(run: RecordedRun, result: MethodReplay, fitted: np.ndarray | None,
                anchors: np.ndarray | None = None,
                anchored_inputs: np.ndarray | None = None) -> SimulatedRun:
     # the series starts at t = 0 with the uniform initial field the loop starts from
@@ -93,7 +99,8 @@ NETWORK_GROUPS = ((), ("resistance",), ("heat",), ("heat", "resistance"))
 """The network kinds an anchored model may keep, fewest first (a tie keeps fewer)."""
 
 
-def gate_networks(model: CorrectionModel, runs: list, spindle) -> tuple[CorrectionModel, dict]:  # noqa: ANN001
+def gate_networks(model: CorrectionModel, runs: list,
+                  spindle: SpindleModel) -> tuple[CorrectionModel, dict]:
     """Keep an anchored model's heat and resistance networks only as far as they help in
     closed loop on `runs` (the held-out runs of its training and any gate-only runs,
     `twin train --gate-runs`; `twin.runs.RecordedRun`s):

@@ -29,6 +29,7 @@ import math
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -50,6 +51,9 @@ from twin.plant.truth import (
 )
 from twin.runs.validate import check_speed_limit
 
+if TYPE_CHECKING:
+    from twin.spindle.model import SpindleModel
+
 DT_S = 2.0
 """Truth time step, s (the twin uses 4 s)."""
 UPDATE_S = 20.0
@@ -58,7 +62,7 @@ heat and contact resistance follow its rings every step (`run_truth`)."""
 
 
 
-def truth_model(nominal, form: ModelForm | None = None):  # noqa: ANN001, ANN201 - SpindleModel
+def truth_model(nominal: SpindleModel, form: ModelForm | None = None) -> SpindleModel:
     """The truth's spindle model: the nominal one (`nominal`, a SpindleModel) with the
     material factors and sensor offsets of `form` (None or all neutral: `nominal` itself).
 
@@ -113,7 +117,7 @@ class SynthRun:
         return int(self.columns["time_s"].size)
 
 
-def run_truth(model, duration_s: float, speed: StepTable, tables: TruthTables,  # noqa: ANN001
+def run_truth(model: SpindleModel, duration_s: float, speed: StepTable, tables: TruthTables,
               dt: float = DT_S, update_s: float = UPDATE_S) -> TruthRun:
     """Backward-Euler transient of the truth from a uniform start at the ambient.
 
@@ -199,7 +203,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
                profile: SpeedProfile | None = None, scenario: Scenario | None = None,
                rate_hz: float = 1.0, coolant_C: float | None = None,
                scenario_name: str | None = None, profile_name: str | None = None,
-               model=None) -> SynthRun:  # noqa: ANN001
+               model: SpindleModel | None = None) -> SynthRun:
     """An emulated recorded run (see the module doc).  Deterministic given the inputs.
 
     Exactly one of `speed_rpm` (constant) and `profile` is given.  `coolant_C` is the

@@ -46,12 +46,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin.contract import SENSOR_NAMES
 from twin.plant.scenario import Scenario, dump_scenario, parse_scenario
 from twin.plant.truth import FILM_GROUPS
+
+if TYPE_CHECKING:
+    from twin.plant.emulator import SynthRun
+    from twin.plant.profile import SpeedProfile
+    from twin.spindle.model import SpindleModel
 
 MIN_SPEED_RPM = 3000.0
 STOP_EVERY = 3
@@ -229,7 +235,7 @@ def scenario_text(case: SuiteCase) -> str:
     return dump_scenario(case.scenario, header)
 
 
-def speed_profile(case: SuiteCase):  # noqa: ANN201 - SpeedProfile
+def speed_profile(case: SuiteCase) -> SpeedProfile:
     """The case's speed profile, as `read_speed_profile` reads it from `profile_text`
     (times and speeds are whole numbers, so the CSV holds them exactly)."""
     from twin.plant.profile import SpeedProfile
@@ -239,7 +245,7 @@ def speed_profile(case: SuiteCase):  # noqa: ANN201 - SpeedProfile
     return SpeedProfile(StepTable(np.array(times), np.array(speeds)))
 
 
-def synthesize_case(case: SuiteCase, model=None):  # noqa: ANN001, ANN201 - SynthRun
+def synthesize_case(case: SuiteCase, model: SpindleModel | None = None) -> SynthRun:
     """The case's run, synthesized exactly as `twin synth` does from the case's files.
 
     `model`: the truth's nominal SpindleModel, loaded once for a whole suite (None: loaded
@@ -254,7 +260,8 @@ def synthesize_case(case: SuiteCase, model=None):  # noqa: ANN001, ANN201 - Synt
                       profile_name=f"{name}.profile.csv", model=model)
 
 
-def write_case(case: SuiteCase, out_dir: Path, model=None) -> dict[str, Path]:  # noqa: ANN001
+def write_case(case: SuiteCase, out_dir: Path,
+               model: SpindleModel | None = None) -> dict[str, Path]:
     """Write the case's profile and scenario, then its run and truth; paths by kind
     (`model` as in `synthesize_case`).  The run is emulated first: written before it, a
     profile and scenario stopped there (Ctrl-C, a failure) stood beside the run of an

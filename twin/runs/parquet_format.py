@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -16,6 +17,9 @@ from twin.io.atomic import atomic_target
 from twin.paths import check_input_file
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
 from twin.runs.table import RawTable, parse_cell
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 ROW = "row"
 """What an error calls a place in a Parquet file (`RawTable.row_unit`): its data row,
@@ -27,7 +31,7 @@ def _is_tool_metadata(key: str) -> bool:
     return key == "pandas" or key.startswith("ARROW:")
 
 
-def _column_values(column, file: str, name: str) -> np.ndarray:  # noqa: ANN001 - ChunkedArray
+def _column_values(column: pa.ChunkedArray, file: str, name: str) -> np.ndarray:
     """A Parquet column as float64; text cells are read as the CSV reader reads them."""
     import pyarrow as pa
 

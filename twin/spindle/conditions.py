@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 from twin.contract import OPERATING_TEMPERATURE_C
 from twin.errors import InputError
@@ -304,7 +305,20 @@ class SpecConstants:
                                     m.stator: spec.region_volume_m3(m.stator)})
 
 
-def _spec_and_constants(model) -> tuple[SpindleSpec, SpecConstants]:  # noqa: ANN001
+class SpecWithConstants(Protocol):
+    """What these functions read of a twin.spindle.model.SpindleModel (which imports this
+    module, so it is not named here): its spec and the SpecConstants computed with it."""
+
+    @property
+    def spec(self) -> SpindleSpec: ...
+
+    @property
+    def constants(self) -> SpecConstants: ...
+
+
+def _spec_and_constants(
+    model: SpecWithConstants | SpindleSpec,
+) -> tuple[SpindleSpec, SpecConstants]:
     """A SpindleModel's spec and its constants (computed once, with the model); a bare
     SpindleSpec's, computed now."""
     if isinstance(model, SpindleSpec):
@@ -324,7 +338,7 @@ def bearing_heat_density(spec: SpindleSpec, side: str, speed_rpm: float,
     return BearingConstants.of(spec, side).heat_density(speed_rpm, temperature_C)
 
 
-def bearing_values(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or SpindleSpec
+def bearing_values(model: SpecWithConstants | SpindleSpec, speed_rpm: float,
                    T_bearings_C: float | tuple[float, float],
                    T_sleeves_C: float | tuple[float, float] | None = None) -> dict[str, float]:
     """Nominal H_front, H_rear (Eq. 1, W/m³) and R_front, R_rear (Eq. 4/5, m²K/W) at the
@@ -346,7 +360,7 @@ def _bearing_values(constants: SpecConstants, speed_rpm: float,
     return out
 
 
-def bearing_values_at(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or SpindleSpec
+def bearing_values_at(model: SpecWithConstants | SpindleSpec, speed_rpm: float,
                       sensors_C: Sequence[float]) -> dict[str, float]:
     """`bearing_values` at a spindle's own readings T1..T4 (SENSOR_NAMES order: T1 front
     outer ring, T2 its sleeve, T3 rear outer ring, T4 its sleeve): the nominal bearing heat
@@ -356,7 +370,8 @@ def bearing_values_at(model, speed_rpm: float,  # noqa: ANN001 - SpindleModel or
                           (float(sensors_C[1]), float(sensors_C[3])))
 
 
-def nominal_conditions(model, speed_rpm: float, ambient_C: float,  # noqa: ANN001
+def nominal_conditions(model: SpecWithConstants | SpindleSpec, speed_rpm: float,
+                       ambient_C: float,
                        coolant_C: float | None = None,
                        T_bearings_C: float | tuple[float, float] | None = None,
                        T_sleeves_C: float | tuple[float, float] | None = None,

@@ -20,12 +20,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin.io.atomic import atomic_target
 from twin.signal_guard import signals_kept
-from twin.spindle.spec import BOUNDARY_NAMES, PartSpec, SpindleSpec
+from twin.spindle.spec import BOUNDARY_NAMES, PartSpec, Rectangle, SpindleSpec
+
+if TYPE_CHECKING:
+    from pygmsh.occ.rectangle import Rectangle as OccRectangle
 
 MM = 1e-3
 _TRIANGLE = 2  # gmsh element type: 3-node triangle
@@ -61,7 +65,7 @@ def build_mesh(spec: SpindleSpec, size_factor: float = 1.0) -> SpindleMesh:
 
     with signals_kept(), pygmsh.occ.Geometry() as geom:
         gmsh.option.setNumber("General.Terminal", 0)
-        def rectangle(box):  # noqa: ANN001, ANN202 - a spec part or channel (r/z in mm)
+        def rectangle(box: Rectangle) -> OccRectangle:  # a spec part or channel (r/z in mm)
             return geom.add_rectangle(
                 [box.r_inner_mm * MM, box.z_start_mm * MM, 0.0],
                 (box.r_outer_mm - box.r_inner_mm) * MM,
