@@ -222,10 +222,11 @@ def test_a_dead_rings_sleeve_below_ambient_moves_the_heat_towards_the_measuremen
     sim[:, 0] = AMBIENT
     held = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, t, sim, nominal, nominal)
     assert ratio_anchor(held, np.ones(4)) / np.array(nominal) == pytest.approx(np.ones(4))
-    # window 0 before the twin has a sample: nothing to read, the nominal values
+    # window 0 before the twin has a sample: nothing measured through a window yet (no
+    # sensor is read, none stands in for another), the nominal values
     first = WindowFeatures(0, 0.0, SPEED, AMBIENT, t[:1], T[:1], np.zeros(0), np.zeros((0, 5)),
                            nominal, nominal)
-    assert first.dead_rings() == ("front",)
+    assert first.dead_rings() == ()
     assert ratio_anchor(first, np.ones(4)) == pytest.approx(np.array(nominal))
 
 
@@ -322,16 +323,16 @@ def test_anchor_does_not_read_a_dead_sleeve_on_its_last_value():
     g = WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], absent, t[upto], sim[upto],
                        nominal, previous, previous_factors=factors)
     anchor = ratio_anchor(f, np.array(factors))
-    # the anchor's law reads T4 at 300 s as now: a ring-to-sleeve drop the twin's moving
-    # sleeve cannot match lands on the rear resistance in this one window (in the `ratio`
-    # method, the Eq. 5 pressure factor of the whole warm-up as well)
-    law = ANCHOR_LAW
-    stale = np.array(law.correct(f).values)
-    assert stale[3] / anchor[3] < 0.9
-    # the anchor holds what the dead sleeve would correct, as for a sensor never recorded;
-    # the front bearing and the rear heat are read as before
-    assert anchor == pytest.approx(np.array(law.correct(g).values), rel=1e-12)
-    assert anchor[[0, 1, 2]] == pytest.approx(stale[[0, 1, 2]], rel=1e-12)
+    # read on T4 at 300 s as now, a ring-to-sleeve drop the twin's moving sleeve cannot
+    # match landed on the rear resistance in this one window (in the `ratio` method, the
+    # Eq. 5 pressure factor of the whole warm-up as well); the anchor, its law and the
+    # `ratio` method hold what the dead sleeve would correct, as for a sensor never
+    # recorded, and read the front bearing and the rear heat as before
+    assert anchor[3] / nominal[3] == pytest.approx(1.05, rel=1e-12)
+    assert anchor == pytest.approx(np.array(ANCHOR_LAW.correct(g).values), rel=1e-12)
+    for law in (ANCHOR_LAW, RatioCorrection()):
+        assert law.correct(f).values == pytest.approx(law.correct(g).values, rel=1e-12)
+    assert anchor[[0, 1]] != pytest.approx(1.05 * np.array(nominal[:2]), rel=1e-3)
 
 
 def test_anchored_inputs_are_relative_to_the_twins_rise_and_drop():
@@ -506,3 +507,63 @@ def test_anchor_resistance_step_counts_the_metal_on_the_lumped_plant():
              for name, m in (("law", law), ("newton", newton))}
     assert np.all(swing["newton"] <= swing["law"] * 1.0001)
     assert np.all(swing["law"] < 0.02)
+
+
+def _gap_features(previous_factors=(1.07, 0.95, 1.2, 0.9)):
+    """Window 10 of the lumped plant whose logger recorded nothing over its last minute
+    (every T column NaN in (540, 600] s), the twin 0.3–0.6 K off the measurement."""
+    t, T = _measured()
+    upto = t <= 600
+    T, sim = T[upto].copy(), T[upto] + np.array([0.6, 0.3, -0.4, 0.2, 0.0])
+    T[t[upto] > 540] = np.nan
+    nominal = _nominal()
+    previous = BoundaryValues(*(np.array(nominal) * previous_factors))
+    return WindowFeatures(10, 600.0, SPEED, AMBIENT, t[upto], T, t[upto], sim, nominal,
+                          previous, previous_factors=previous_factors), nominal
+
+
+def test_ratio_holds_its_factors_through_a_logger_gap():
+    """Nothing measured in the window just ended: the law has nothing to compare the twin
+    with and holds every value.  Read on the last values before the gap, it compared a
+    ring a minute old with the twin's moving one, and the Eq. 5 pressure factor of the whole
+    warm-up (the previous level's being unknown) cut both resistances in one window."""
+    f, nominal = _gap_features()
+    factors = np.array(RatioCorrection().correct(f).values) / np.array(nominal)
+    assert factors == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)
+
+
+def test_paper_bpnn_holds_its_factors_through_a_logger_gap():
+    """A paper-configuration model's inputs are the measured key points at the window
+    start: without a valid sample in the last window there are none, and every value keeps
+    its previous factor instead of the networks reading the last values before the gap."""
+    f, nominal = _gap_features()
+    factors = np.array(make_corrector("bpnn", model=_ConstantNet()).correct(f).values)
+    assert factors / np.array(nominal) == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)
+
+
+def test_a_window_is_measured_through_only_with_two_samples_in_each_20_s_bin():
+    """The estimator's rule for an observation (a bin of 20 s with at least two valid
+    samples) over the whole window the ratio law's line reads."""
+    from twin.correction.features import window_observed
+
+    t = np.arange(0.0, 601.0, 1.0)
+    T = np.column_stack([t, t, t])
+    T[t > 541, 1] = np.nan  # a lone sample at the window's start: 59 s old
+    T[t > 570, 2] = np.nan  # the last 30 s lost: a line would extrapolate them
+    assert window_observed(t, T, 600.0).tolist() == [True, False, False]
+    slow = np.arange(0.0, 601.0, 10.0)  # the slowest rate a recorded run may have
+    assert window_observed(slow, slow, 600.0).tolist() == [True]
+
+
+def test_ratio_holds_what_a_sensor_lost_mid_window_corrects():
+    """The logger stops 30 s before the window start: the line through the first half
+    would stand for the second; the law holds instead, as for a whole window lost."""
+    f, nominal = _gap_features()
+    t, T = _measured()
+    T = T[t <= 600].copy()
+    t = t[t <= 600]
+    T[t > 570] = np.nan
+    g = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, f.simulated_time_s, f.simulated_C,
+                       nominal, f.previous, previous_factors=f.previous_factors)
+    factors = np.array(RatioCorrection().correct(g).values) / np.array(nominal)
+    assert factors == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)

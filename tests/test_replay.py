@@ -738,3 +738,38 @@ def test_a_snapshots_marker_names_the_shown_fields_largest_value():
     values = np.array([3.0, 96.42, 12.0])
     assert field_marker("displacement", values) == (1, "max 96.4 µm")
     assert field_marker("temperature", np.array([25.0, 50.83, 40.0])) == (1, "max 50.8 °C")
+
+
+def test_a_logger_gap_holds_ratio_and_bpnn_and_quality_json_says_which_windows(
+        tmp_path, spindle_model, replayed):
+    """Every thermocouple lost from 120 to 250 s (the quality check excludes the fill):
+    windows 3 and 4 read nothing measured, so ratio and bpnn keep window 2's factors and
+    quality.json names the windows per ring and sleeve sensor; a run without a gap has no
+    such finding."""
+    from twin.correction.methods import make_corrector
+    from twin.data import bundled_path
+    from twin.loop.replay import HELD_CORRECTION, replay_method
+    from twin.runs import read_run
+
+    def gap(t, temps):
+        temps[(t > 120) & (t < 250)] = np.nan
+
+    path = make_recorded_run(tmp_path / "gap.csv", spindle_model, minutes=6, edit=gap)
+    result = replay(path, out=tmp_path / "out", methods="open_loop,ratio")
+    assert result.exit_code == 0, result.output
+    findings = json.loads((tmp_path / "out" / "gap" / "quality.json").read_text())["findings"]
+    held = {f["column"]: f for f in findings if f["kind"] == HELD_CORRECTION}
+    assert sorted(held) == ["T1_C", "T2_C", "T3_C", "T4_C"]
+    assert all(f["spans_s"] == [[180.0, 300.0]] and f["count"] == 2 for f in held.values())
+    assert "window 3-4" in held["T1_C"]["detail"]
+    clean = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
+    assert not [f for f in clean if f["kind"] == HELD_CORRECTION]
+
+    run = read_run(path)
+    for method in ("ratio", "bpnn"):
+        model = bundled_path("correction_model.safetensors") if method == "bpnn" else None
+        r = replay_method(run, spindle_model, make_corrector(method, model), keep_fields=False)
+        factors = [np.array(w.correction.values) / np.array(w.nominal) for w in r.windows]
+        assert factors[3] == pytest.approx(factors[2], rel=1e-12), method
+        assert factors[4] == pytest.approx(factors[2], rel=1e-12), method
+        assert factors[5] != pytest.approx(factors[2], rel=1e-6), method  # read again

@@ -234,22 +234,24 @@ class WindowFeatures:
         return first_finite(self.measured_C)
 
     def seen_in_last_window(self) -> np.ndarray:
-        """(5,) True for each of T1..T5 with a valid sample in the last window (the span of
-        `window_line_fit`: a column with a finite sample there has a level)."""
-        time = self.measured_time_s
-        in_span = (time > self.start_s - self.window_s - 1e-9) & (time <= self.start_s + 1e-9)
-        return np.isfinite(self.measured_C[in_span]).any(axis=0)
+        """(5,) True for each of T1..T5 measured through the last window
+        (`window_observed`: valid samples in each of its bins, so a line through them gives
+        a level at the window start and a rise that are measurements)."""
+        return window_observed(self.measured_time_s, self.measured_C, self.start_s,
+                               self.window_s)
 
     def dead_rings(self) -> tuple[str, ...]:
-        """Bearings whose ring sensor has no valid sample in the last window while the
-        sleeve sensor has (a stuck or dropped-out ring thermocouple)."""
+        """Bearings whose ring sensor was not measured through the last window while the
+        sleeve sensor was (`seen_in_last_window`: a stuck or dropped-out ring
+        thermocouple)."""
         seen = self.seen_in_last_window()
         return tuple(b for b in BEARINGS if not seen[RING_SENSOR[b]] and seen[SLEEVE_SENSOR[b]])
 
     def without_dead_sensors(self) -> WindowFeatures:
-        """These features with the measured column of every sensor that has no valid
-        sample in the last window left out entirely (NaN): a correction then holds what
-        that sensor would correct instead of reading its last value before it died.
+        """These features with the measured column of every sensor not measured through
+        the last window (`seen_in_last_window`: a dropout, a logger gap, a stuck sensor)
+        left out entirely (NaN): a correction then holds what that sensor would correct
+        instead of reading its last value before it died.
 
         Why: `RatioCorrection` falls back on a sensor's last valid sample when the last
         window has none.  For a sleeve in a dropout that stale value entered the Eq. 5
@@ -412,6 +414,48 @@ def first_finite(values: ArrayLike) -> np.ndarray:
         if idx.size:
             out[j] = vals[idx[0], j]
     return out
+
+
+OBSERVATION_BINS = 3
+"""A window's measurements are read in this many equal bins (20 s): the estimator's
+observations are their means, and a correction reads a sensor only where every bin of the
+window just ended is observed (`window_observed`)."""
+
+MIN_BIN_SAMPLES = 2
+"""A bin is observed with at least this many valid samples: a lone sample is too noisy."""
+
+
+def bin_mean(time_s: np.ndarray, values: np.ndarray, lo_s: float,
+             hi_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per column, the mean of the finite values sampled in (lo_s, hi_s] and their count."""
+    rows = (time_s > lo_s + 1e-9) & (time_s <= hi_s + 1e-9)
+    v = values[rows]
+    ok = np.isfinite(v)
+    counts = ok.sum(axis=0)
+    total = np.where(ok, v, 0.0).sum(axis=0)
+    return np.where(counts > 0, total / np.maximum(counts, 1), np.nan), counts
+
+
+def window_observed(time_s: ArrayLike, values: ArrayLike, end_s: float,
+                    window_s: float = WINDOW_S) -> np.ndarray:
+    """Per column, True where each of the `OBSERVATION_BINS` bins of (end_s − window_s,
+    end_s] holds at least `MIN_BIN_SAMPLES` valid (finite) samples: the estimator's rule
+    for an observation, over the whole window that `window_line_fit` reads.
+
+    Why the whole window: the ratio law reads a level at end_s and a rise over the window
+    off a line through its samples.  With the last bins lost (a logger gap) that line
+    extrapolates the last measured seconds over the rest of the window, and a lone sample
+    at the window's start gave a level 60 s old and no rise, so Eq. 5 took the whole
+    pressure change since the run start as this window's.
+    """
+    time = np.asarray(time_s, dtype=float)
+    vals = np.asarray(values, dtype=float)
+    vals = vals[:, None] if vals.ndim == 1 else vals
+    edges = end_s - window_s + window_s * np.arange(OBSERVATION_BINS + 1) / OBSERVATION_BINS
+    observed = np.ones(vals.shape[1], dtype=bool)
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        observed &= bin_mean(time, vals, lo, hi)[1] >= MIN_BIN_SAMPLES
+    return observed
 
 
 def window_line_fit(

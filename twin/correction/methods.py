@@ -92,7 +92,14 @@ class RatioCorrection:
 
     By default the factors enter with the exponents `gains` = (1, 0, 0.5), see PAPER_GAINS.
     Levels and rises are least-squares lines over the last window (noise-robust); f_P is the Eq. 5
-    pressure factor from the measured ring and sleeve rises since the run start.  Every
+    pressure factor from the measured ring and sleeve rises since the run start.  A sensor
+    not measured through the last window (fewer than two valid samples in one of its 20 s
+    bins, the estimator's rule for an observation: a dropout or logger gap, which the
+    data-quality check marks invalid, a stuck sensor) is left out
+    (`WindowFeatures.without_dead_sensors`, as bpnn's anchor leaves it out), so what it
+    corrects is held: read on its last value, a 5-min gap of every channel compared a
+    stale ring with the twin's moving one and took the contact resistances to 0.6× in one
+    window.  Every
     factor is guarded (see `RatioGuards`) and the result kept within the guards' band
     around the nominal value.  A speed change rescales the previous values by the change of
     the nominal ones, so the correction carries over as a factor.
@@ -124,12 +131,14 @@ class RatioCorrection:
     False: the values held for the window, the paper's literal boundary conditions."""
 
     def correct(self, features: WindowFeatures) -> Correction:
-        f = features
         g = self.guards
-        if f.window == 0:
+        if features.window == 0:
             # nothing measured yet that the twin could be compared with
-            return Correction.relative_to(f.nominal, f.previous,
+            return Correction.relative_to(features.nominal, features.previous,
                                           loads_follow_rings=self.loads_follow_rings)
+        # a sensor not measured through the window just ended (a dropout, a logger gap)
+        # is absent, not read on its last value: every factor it enters is neutral
+        f = features.without_dead_sensors()
         # levels and rises from a line through the last window: the measured samples are
         # noisy, and ratios of noisy differences would swing the correction window to window
         meas_now, meas_rise = window_line_fit(
@@ -138,7 +147,6 @@ class RatioCorrection:
         sim_now, sim_rise = window_line_fit(
             f.simulated_time_s, f.simulated_C, f.start_s, f.window_s
         )
-        meas_now = np.where(np.isfinite(meas_now), meas_now, f.measured_now())
         sim_now = np.where(np.isfinite(sim_now), sim_now, f.simulated_now())
         meas_initial = f.measured_initial()
         meas_prev = meas_now - meas_rise
@@ -296,12 +304,13 @@ class BpnnCorrection:
 
     Inference is plain numpy on the loaded weights (no torch needed at replay time).  An
     anchored model (the default) corrects the ratio-law value, `ratio_anchor`, by the
-    factor exp(output); where its inputs are not finite (window 0, a dead sensor) the
-    value is the anchor.  The twin's state and simulated key points it reads come from
-    the re-run of a window with a missed speed change (`rerun_missed_speed`).  A
-    paper-configuration model predicts the value itself; non-finite
-    inputs fall back to the previous window's correction factor on the current nominal
-    value.  The output is kept within the guards' band around the nominal value.  A
+    factor exp(output); where its inputs are not finite (window 0, a sensor not measured
+    through the last window) the value is the anchor.  The twin's state and
+    simulated key points it reads come from the re-run of a window with a missed speed
+    change (`rerun_missed_speed`).  A paper-configuration model predicts the value itself;
+    non-finite inputs (a sensor not measured through the last window, not read on its
+    last value) fall back to the previous window's correction factor on the current
+    nominal value.  The output is kept within the guards' band around the nominal value.  A
     stopped bearing has no heat: its heat network is not asked.
 
     One object replays one run at a time: window 0 restarts the anchor's chain.
@@ -336,7 +345,9 @@ class BpnnCorrection:
             # with speed and with the fit's temperatures (Eq. 5), a held absolute value
             # would drift away from it (a stuck sleeve sensor held R at its cold value)
             fallback = features.carried_previous()
-            inputs = features.network_inputs()
+            # a sensor not measured through the last window gives no input, not its last
+            # value: its networks keep the factor
+            inputs = features.without_dead_sensors().network_inputs()
         values = np.empty(4)
         for i, output in enumerate(OUTPUTS):
             x = inputs[output]

@@ -281,7 +281,12 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
-from twin.correction.features import WindowFeatures
+from twin.correction.features import (
+    MIN_BIN_SAMPLES,
+    OBSERVATION_BINS,
+    WindowFeatures,
+    bin_mean,
+)
 from twin.correction.rerun import (
     first_window_at_speed,
     recorded_step_speeds,
@@ -343,8 +348,9 @@ class EstimatorConfig:
     report_readings: bool = True
     """Report T1..T5 as what the thermocouples read (the metal at their points through
     the lag sensor_lag_s); False: the metal temperature at their points."""
-    bins_per_window: int = 3
-    """Observation bins per 60 s window; each bin's mean is one observation per sensor."""
+    bins_per_window: int = OBSERVATION_BINS
+    """Observation bins per 60 s window; each bin's mean is one observation per sensor
+    (one with fewer than `MIN_BIN_SAMPLES` valid samples is none)."""
     initial_field_sd_C: float = 0.2
     """Uncertainty of the uniform start field (the mean of the first T1..T5)."""
     drift_rel_sd: float = 0.01
@@ -673,7 +679,7 @@ class EnsembleEstimator:
         for i, b in enumerate(bins):
             lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
             m, counts = bin_mean(t_meas, meas, lo, hi)
-            observed.append(np.where(counts >= 2, m, np.nan))  # a lone sample is too noisy
+            observed.append(np.where(counts >= MIN_BIN_SAMPLES, m, np.nan))
             y_mean.append(read[b].mean(axis=0))
             anom = 0.5 * (fc.sensors_anomalies_C[i] + fc.sensors_anomalies_C[i + 1])
             if lag_anomalies is not None:  # a member reads its metal with its own lag
@@ -690,7 +696,7 @@ class EnsembleEstimator:
                 lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
                 m, counts = bin_mean(t_meas, np.asarray(f.measured_drift_um, float)[:, None],
                                      lo, hi)
-                observed.append(np.where(counts >= 2, m, np.nan))
+                observed.append(np.where(counts >= MIN_BIN_SAMPLES, m, np.nan))
                 drift_seen |= bool(counts[0] >= 2)
                 y_mean.append(drift[b].mean(keepdims=True))
                 y_anom.append(0.5 * (drift_anom[i] + drift_anom[i + 1])[None, :])
@@ -878,13 +884,3 @@ class EnsembleEstimator:
             a = cfg.band_learning_rate
             self._band_var[channel] = (1 - a) * self._band_var[channel] + a * max(
                 float(np.nanmean(excess)), floor**2)
-
-def bin_mean(time_s: np.ndarray, values: np.ndarray, lo_s: float,
-             hi_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per column, the mean of the finite values sampled in (lo_s, hi_s] and their count."""
-    rows = (time_s > lo_s + 1e-9) & (time_s <= hi_s + 1e-9)
-    v = values[rows]
-    ok = np.isfinite(v)
-    counts = ok.sum(axis=0)
-    total = np.where(ok, v, 0.0).sum(axis=0)
-    return np.where(counts > 0, total / np.maximum(counts, 1), np.nan), counts

@@ -64,10 +64,15 @@ import numpy as np
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import (
+    MIN_BIN_SAMPLES,
+    OBSERVATION_BINS,
+    RING_SENSOR,
+    SLEEVE_SENSOR,
     BoundaryValues,
     TwinState,
     WindowFeatures,
     correction_factors,
+    window_observed,
 )
 from twin.correction.rerun import (
     LOAD_UPDATE_STEPS,
@@ -79,7 +84,8 @@ from twin.correction.rerun import (
 )
 from twin.correction.result import Correction, Corrector
 from twin.lag import first_order_lag
-from twin.runs import RecordedRun
+from twin.runs import TEMPERATURES, RecordedRun
+from twin.runs.quality import finding, true_runs
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
 
@@ -255,6 +261,48 @@ def check_field_time(run: RecordedRun, time_s: float) -> None:
         raise ValueError(f"time {time_s:g} s is outside the replayed span (0, {span_s:g}] s")
 
 
+def measured_temperatures(run: RecordedRun) -> np.ndarray:
+    """(n, 5) T1..T5 as the corrections read them: NaN where the data-quality check marks
+    a sample invalid (a long dropout's or gap's fill, a stuck or dead sensor)."""
+    return np.where(run.valid_T, run.T_C, np.nan)
+
+
+HELD_CORRECTION = "correction_held"
+"""quality.json kind of `held_correction_findings`."""
+
+
+def held_correction_findings(run: RecordedRun) -> list[dict]:
+    """quality.json findings (`twin.runs.quality.finding`): per ring and sleeve
+    thermocouple (T1..T4, what `ratio` and `bpnn` correct by), the windows whose correction
+    finds it not measured through the 60 s before the window starts
+    (`WindowFeatures.seen_in_last_window`: a logger gap, a long dropout, a stuck sensor).
+    They compute nothing from it there and hold what it corrects; the estimator leaves
+    its unobserved bins out of its update.  Spans are the held windows' [start, end) in
+    run time."""
+    measured = measured_temperatures(run)
+    ends = WINDOW_S * np.arange(1, n_windows(run))  # window k's correction reads up to 60k s
+    lo = np.searchsorted(run.time_s, ends - WINDOW_S - 1e-9, side="right")
+    hi = np.searchsorted(run.time_s, ends + 1e-9, side="right")
+    unseen = np.array([~window_observed(run.time_s[a:b], measured[a:b], end)
+                       for a, b, end in zip(lo, hi, ends, strict=True)]).reshape(-1, 5)
+    found = []
+    for column in sorted({*RING_SENSOR.values(), *SLEEVE_SENSOR.values()}):
+        stretches = true_runs(unseen[:, column])
+        if not stretches:
+            continue
+        windows = ", ".join(f"{a + 1}" if a == b else f"{a + 1}-{b + 1}" for a, b in stretches)
+        found.append(finding(
+            TEMPERATURES[column], HELD_CORRECTION,
+            "ratio and bpnn compute nothing from this sensor in these windows and hold what "
+            "it corrects; the estimator leaves its unobserved bins out",
+            spans_s=[(ends[a], ends[b] + WINDOW_S) for a, b in stretches],
+            count=int(unseen[:, column].sum()),
+            detail=f"fewer than {MIN_BIN_SAMPLES} valid samples in a "
+                   f"{WINDOW_S / OBSERVATION_BINS:g} s bin of the {WINDOW_S:g} s before the "
+                   f"start of window {windows}"))
+    return found
+
+
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
     T0 = np.where(first.valid_T[0], first.T_C[0], np.nan)
@@ -321,7 +369,7 @@ def replay_method(
     T0 = initial_temperature_C(run)
     T = np.full(model.n_dofs, T0)
 
-    measured_T = np.where(run.valid_T, run.T_C, np.nan)
+    measured_T = measured_temperatures(run)
     measured_drift = None
     if run.disp_um is not None and "disp_z_um" in run.valid:
         measured_drift = np.where(run.valid["disp_z_um"], run.disp_um[:, 2], np.nan)

@@ -41,6 +41,8 @@ from twin.loop.overlap import ForkedTask, ForkedTaskError
 from twin.loop.replay import (
     MethodReplay,
     deck_window_solver,
+    held_correction_findings,
+    measured_temperatures,
     method_replay_from_json,
     method_replay_to_json,
     replay_method,
@@ -236,7 +238,8 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     plots.start(str(out_dir))
     if snapshots != "none":
         _write_snapshots(out_dir, model, results[primary], snapshots, title=run.name)
-    write_quality(run, out_dir / "quality.json")
+    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run)]),
+                  out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
         for w in r.windows:
@@ -389,7 +392,7 @@ def measured_reference(
     start = run.before(np.array([run.time_s[0]]))
     meas_T0 = np.where(start.valid_T[0], start.T_C[0], np.nan)
     if np.any(~np.isfinite(meas_T0)):  # a sensor that starts invalid: its first good value
-        good = np.where(run.valid_T, run.T_C, np.nan)
+        good = measured_temperatures(run)
         for i in np.where(~np.isfinite(meas_T0))[0]:
             finite = np.isfinite(good[:, i])
             meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
