@@ -560,20 +560,22 @@ def test_the_expansion_member_is_the_drift_scaled(tmp_path, spindle_model):
     np.testing.assert_allclose(rise[fc.substeps - 1::fc.substeps], mean_scale * rise_members[1:])
 
 
-def write_speed_step_run(path, model):  # noqa: ANN001, ANN201
+def _step_speed(t: float) -> float:
+    return 6000.0 if t < 76.0 else 12000.0 if t < 100.0 else 3000.0
+
+
+def write_speed_step_run(path, model, speed_at=_step_speed, windows=6):  # noqa: ANN001, ANN201
     """A 6-window run of the nominal model whose speed steps from 6000 to 12000 rpm at 76 s
     and down to 3000 rpm at 100 s, both inside window 1 (loads fixed at 60 s); each step
     at the speed recorded at its start, its loads at the rings' temperatures at its start
-    (as the spindle's, and the twin's, follow them), ideal thermocouples.  Returns `path`."""
+    (as the spindle's, and the twin's, follow them), ideal thermocouples.  Returns `path`.
+    `speed_at(t)` (rpm at t s) and `windows` give another profile and length."""
     from twin.runs import write_run
 
     T = np.full(model.n_dofs, 24.0)
     times, temps = [0.0], [model.sensor_matrix @ T]
 
-    def speed_at(t):
-        return 6000.0 if t < 76.0 else 12000.0 if t < 100.0 else 3000.0
-
-    for i in range(6 * 15):
+    for i in range(windows * 15):
         t_end = 4.0 * (i + 1)
         s = model.sensor_matrix @ T
         bc = nominal_conditions(model, speed_at(t_end - 4.0), 24.0, None,

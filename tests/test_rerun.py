@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.contract import STEPS_PER_WINDOW
-from twin.correction.methods import BpnnCorrection, RatioCorrection
+from twin.correction.methods import BpnnCorrection, OpenLoop, RatioCorrection
 from twin.correction.modelfile import load_model
 from twin.correction.rerun import rerun_window, speed_stretches
 from twin.loop.replay import (
@@ -82,6 +82,48 @@ def test_bpnn_starts_the_next_window_from_the_rerun(tmp_path, spindle_model, mon
     assert with_rerun < 0.7 * without
 
 
+def _heat_factors_and_error(run, model, corrector) -> tuple[np.ndarray, float]:
+    """Each window's heat factors (windows, 2) and the mean |error| of T1..T5 after 120 s."""
+    replay = replay_method(run, model, corrector, solver=direct_window_solver(model),
+                           keep_fields=False)
+    factors = np.array([np.array(w.correction.values[:2]) / np.array(w.nominal[:2])
+                        for w in replay.windows])
+    late = replay.time_s > 120.0
+    return factors, float(np.abs(replay.T_twin_C - run.at(replay.time_s).T_C)[late].mean())
+
+
+def test_the_ratio_law_reads_the_rerun_not_the_missed_speed_change(tmp_path, spindle_model):
+    """The step of the bpnn test above for the ratio law: its Eq. 2 compared the measured
+    ring with a forecast that missed 24 s at 12 000 rpm and read a heat 1.5-1.8x too high
+    (the truth is the nominal heat); from the re-run the factors stay near 1."""
+    run = read_run(write_speed_step_run(tmp_path / "step.csv", spindle_model))
+    rerun, _ = _heat_factors_and_error(run, spindle_model, RatioCorrection())
+    forecast, _ = _heat_factors_and_error(run, spindle_model,
+                                          RatioCorrection(rerun_missed_speed=False))
+    assert np.all(np.abs(np.log(forecast[2])) > 0.3)
+    assert np.all(np.abs(np.log(rerun[2])) < 0.1)
+
+
+SPEEDS_EVERY_28_S = (6000.0, 11000.0, 8000.0, 13000.0, 7000.0, 12000.0, 9000.0)
+
+
+def test_the_ratio_law_is_calm_when_the_speed_changes_inside_every_window(
+        tmp_path, spindle_model):
+    """A new speed every 28 s, so inside every window, on the nominal model itself (true
+    factors 1).  Read off the forecast, each window's missed change became a heat factor
+    for the next window at another speed: the front heat swung 0.5 <-> 2.1.  From the
+    re-runs the factors stay near 1 and the twin is closer to the measurement."""
+    run = read_run(write_speed_step_run(
+        tmp_path / "fast.csv", spindle_model, windows=12,
+        speed_at=lambda t: SPEEDS_EVERY_28_S[int(t // 28.0) % len(SPEEDS_EVERY_28_S)]))
+    rerun, error = _heat_factors_and_error(run, spindle_model, RatioCorrection())
+    forecast, error_forecast = _heat_factors_and_error(
+        run, spindle_model, RatioCorrection(rerun_missed_speed=False))
+    assert np.abs(np.log(forecast)).max() > 0.6
+    assert np.abs(np.log(rerun)).max() < 0.2
+    assert error < 0.9 * error_forecast
+
+
 def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
         tmp_path, spindle_model):
     """Window 0's deck from the uniform start, window 1's deck from its end (the reported
@@ -125,10 +167,14 @@ def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
     # a replay done in another process brings its re-run decks back
     assert method_replay_from_json(method_replay_to_json(replay)).windows[1].rerun_deck == \
         w[1].rerun_deck
-    # the paper's ratio law keeps the forecast
-    ratio = replay_method(run, model, RatioCorrection(), solver=direct_window_solver(model),
+    # the ratio law re-runs as bpnn does; open loop keeps the forecast
+    ratio = replay_method(run, model, RatioCorrection(), solver=deck_window_solver(model),
                           keep_fields=False)
-    assert all(x.rerun_deck is None for x in ratio.windows)
+    assert ratio.windows[1].rerun_deck is not None
+    assert all(x.rerun_deck is None for x in ratio.windows if x.window != 1)
+    forecast = replay_method(run, model, OpenLoop(), solver=direct_window_solver(model),
+                             keep_fields=False)
+    assert all(x.rerun_deck is None for x in forecast.windows)
 
     session = Session.from_mesh(model.mesh, model.materials, order=model.order,
                                 T_ref_C=model.elastic.T_ref)

@@ -14,10 +14,10 @@ every `LOAD_UPDATE_STEPS` (every solver step), as every window's do by default.
 
 One implementation serves every method that does it: the `estimator`
 (`twin.estimation.method`, with its analysed factors) and the loop's state correction for
-`bpnn` (`twin.loop.replay`, through the window decks; the training fit may ask for it too,
-`twin.loop.windowfit.WindowFit.rerun_missed_speed`).  Each passes
-its own `advance(speed_rpm, T, n_steps, start_s)`, the solver of one constant-speed
-stretch; this module finds the change, the speed of every solver step and the stretches.
+`bpnn` and `ratio` (`twin.loop.replay`, through the window decks; the training fit may ask
+for it too, `twin.loop.windowfit.WindowFit.rerun_missed_speed`).  Each passes its own
+`advance(speed_rpm, T, n_steps, start_s)`, the solver of one constant-speed stretch; this
+module finds the change, the speed of every solver step and the stretches.
 
     changed = speed_change_s(features, forecast_speed_rpm)   # None: nothing to re-run
     speeds = recorded_step_speeds(features, steps, step_s)

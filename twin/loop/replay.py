@@ -26,16 +26,15 @@ The temperature state carries over from window to window.  A stop (speed 0) is a
 ordinary window: no bearing or motor heat, the twin cools; each value's correction factor
 is held through the stop and resumes at the restart (`WindowFeatures.previous_factors`).
 
-Re-run of a missed speed change (methods with `rerun_missed_speed`: `bpnn`; the paper's
-`ratio` and `open_loop` keep the forecast, the `estimator` re-runs inside its own
-analysis).  When the recorded speed changed inside window k−1, after its loads were
-fixed, that window is re-run from its start field with the recorded speed
-(`twin.correction.rerun`: per speed, step by step, each with the nominal loads at
-its own temperatures times the window's correction factors, as the spindle's loads follow
-its rings) before window k's correction; all of it was measured before 60k s.  So is
-window 0 of a run whose loads were held (not `loads_follow_rings`) at the cold start's
-temperatures for 60 s while the rings warmed by kelvins and the Palmgren heat fell by
-about a fifth.
+Re-run of a missed speed change (methods with `rerun_missed_speed`: `bpnn` and `ratio`;
+`open_loop` keeps the forecast, the `estimator` re-runs inside its own analysis).  When the
+recorded speed changed inside window k−1, after its loads were fixed, that window is
+re-run from its start field with the recorded speed (`twin.correction.rerun`: per speed,
+step by step, each with the nominal loads at its own temperatures times the window's
+correction factors, as the spindle's loads follow its rings) before window k's correction;
+all of it was measured before 60k s.  So is window 0 of a run whose loads were held (not
+`loads_follow_rings`) at the cold start's temperatures for 60 s while the rings warmed by
+kelvins and the Palmgren heat fell by about a fifth.
 Window k then starts from the re-run's end field, and the method reads its
 simulated key points over window k−1 from the re-run (`WindowFeatures.simulated_C`), not
 from the forecast that missed the input.  The reported trajectory of window k−1 stays its
