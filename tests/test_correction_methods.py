@@ -402,7 +402,7 @@ def test_anchor_closes_a_doubled_rear_contact_under_a_heat_surge():
     assert np.all(old_err[2:4] > 2 * err[2:4])
 
 
-def test_anchor_counts_the_contact_pressure_change_once():
+def test_the_ratio_law_and_the_anchor_count_the_contact_pressure_change_once():
     """The loop evaluates the nominal resistance every window with Eq. 4/5 at the twin's own
     ring and sleeve temperatures.  A twin that matches the measurement exactly while its
     rings warm ahead of the sleeves (the fit tightens, R falls) has that fall in its new
@@ -430,8 +430,14 @@ def test_anchor_counts_the_contact_pressure_change_once():
                        previous, previous_factors=tuple(factors))
     anchor = ratio_anchor(f, factors) / np.array(nominal)
     assert anchor == pytest.approx(factors, rel=1e-12)
-    with_eq5 = np.array(RatioCorrection(gains=ANCHOR_GAINS).correct(f).values) / np.array(nominal)
-    assert np.all(with_eq5[2:] < 0.99 * factors[2:])
+    # so does the `ratio` method: its resistances keep their factors (its heats are
+    # Eq. 2 on a ring that matches: unchanged too)
+    ratio = np.array(RatioCorrection().correct(f).values) / np.array(nominal)
+    assert ratio == pytest.approx(factors, rel=1e-12)
+    # the literal Eq. 5 step on top lowers both resistances by the fall a second time
+    for gains in (ANCHOR_GAINS, (1.0, 0.0, 0.5)):
+        with_eq5 = np.array(RatioCorrection(gains=gains, pressure_step=True).correct(f).values)
+        assert np.all(with_eq5[2:] / np.array(nominal[2:]) < 0.99 * factors[2:])
 
 
 def test_series_resistance_correction_is_newtons_step_beyond_the_noise():

@@ -88,11 +88,13 @@ class RatioCorrection:
     window's values, so those are the H and R the ratios correct (REFERENCE.md §1):
 
         H = H_prev · (t_m − t_amb)/(t_f − t_amb) · C_H,   C_H = rise_m / rise_f over the last window
-        R = R_prev · f_P(now)/f_P(prev) · C_C,            C_C = drop_m / drop_f ring-to-sleeve
+        R = R'_prev · C_C,                                C_C = drop_m / drop_f ring-to-sleeve
 
+    with R'_prev the previous value on the nominal resistance, which is Eq. 4 corrected by
+    Eq. 5 at the twin's own ring and sleeve temperatures (the loop evaluates it every step):
+    R' of the paper, Eq. 5 counted once (`pressure_step`).
     By default the factors enter with the exponents `gains` = (1, 0, 0.5), see PAPER_GAINS.
-    Levels and rises are least-squares lines over the last window (noise-robust); f_P is the Eq. 5
-    pressure factor from the measured ring and sleeve rises since the run start.  A sensor
+    Levels and rises are least-squares lines over the last window (noise-robust).  A sensor
     not measured through the last window (fewer than two valid samples in one of its 20 s
     bins, the estimator's rule for an observation: a dropout or logger gap, which the
     data-quality check marks invalid, a stuck sensor) is left out
@@ -109,9 +111,29 @@ class RatioCorrection:
     fits: tuple[ContactFit, ContactFit] = (ContactFit(), ContactFit(fit_radius_m=0.0425))
     gains: tuple[float, float, float] = (1.0, 0.0, 0.5)
     """Exponents on the Eq. 2, Eq. 3 and Eq. 6 factors; `PAPER_GAINS` is the paper's law."""
-    pressure_step: bool = True
-    """Apply Eq. 5, the contact pressure change of the measured rings and sleeves over the
-    last window (the paper's law).  False for `ANCHOR_LAW`: see there."""
+    pressure_step: bool = False
+    """Also apply Eq. 5 as a step, R_prev · f_P(now)/f_P(prev), f_P the pressure factor of
+    the measured ring and sleeve rises since the run start, the previous one off the
+    line's level minus its rise (the literal form until 2026-11-27).
+
+    Why not by default: Eq. 5 is already in the value it would multiply.  The paper applies
+    it once, to the cold Eq. 4 value (R' from R), then Eq. 6 (R'' = C_C · R').  The twin's
+    nominal resistance is that R': Eq. 4 corrected by Eq. 5 at its own ring and sleeve
+    temperatures, which the loop re-evaluates every window and every solver step
+    (`twin.spindle.conditions.contact_resistance`), and the previous value is carried as a
+    factor on it.  The step put the measured pressure change on top, so each warm-up
+    counted it twice: in a cold start's first minute the rings warm ahead of their
+    sleeves, the nominal resistance falls (to 0.66 of its cold value at the rear on suite
+    7070 run 9) and the step took another 0.6-0.65 off it, which Eq. 6's square root then
+    took a dozen windows to give back; on a twin that matched the measurement exactly the
+    step still moved R (tests/test_correction_methods.py).  `ANCHOR_LAW` dropped it for the
+    same reason.
+
+    Measured on three suites of 8 runs of 40 min (with the re-run of `rerun_missed_speed`
+    on both sides; temperature / deformation accuracy, median / worst, %): 707070
+    99.35 / 97.32 and 92.68 / 84.96 -> 99.45 / 97.40 and 93.89 / 84.96; 4242 99.11 /
+    98.81 and 88.14 / 75.07 -> 99.43 / 99.13 and 89.15 / 78.92; 9191 99.23 / 98.71 and
+    91.42 / 82.98 -> 99.27 / 99.16 and 90.51 / 84.28."""
     heat_share_before_clip: bool = False
     """Take this window's heat change out of the Eq. 6 drop ratio before the contact
     guard clips it (True: the clip bounds the resistance's own step) or after (False, the
@@ -262,7 +284,8 @@ ANCHOR_LAW = RatioCorrection(gains=ANCHOR_GAINS, pressure_step=False,
 how the resistance is corrected, both about what the anchor's previous value already holds
 (and, third, the metal in series with the contact, `SPINDLE_CONTACT_METAL`):
 
-- No Eq. 5 step (`pressure_step`): the anchor carries its resistance as a factor on the
+- No Eq. 5 step (`pressure_step`; the `ratio` method's default too since 2026-11-27):
+  the anchor carries its resistance as a factor on the
   nominal value, and the loop evaluates that nominal value every window with Eq. 4/5 at the
   twin's own ring and sleeve temperatures (`twin.spindle.conditions.contact_resistance`).
   The measured pressure change was therefore applied twice: in a run's first minute the
