@@ -131,9 +131,9 @@ class RatioCorrection:
 
     Measured on three suites of 8 runs of 40 min (with the re-run of `rerun_missed_speed`
     on both sides; temperature / deformation accuracy, median / worst, %): 707070
-    99.35 / 97.32 and 92.68 / 84.96 -> 99.45 / 97.40 and 93.89 / 84.96; 4242 99.11 /
-    98.81 and 88.14 / 75.07 -> 99.43 / 99.13 and 89.15 / 78.92; 9191 99.23 / 98.71 and
-    91.42 / 82.98 -> 99.27 / 99.16 and 90.51 / 84.28."""
+    99.42 / 97.32 and 92.30 / 84.96 -> 99.45 / 97.40 and 93.89 / 84.96; 4242 99.30 /
+    98.93 and 88.13 / 77.12 -> 99.42 / 99.14 and 89.15 / 78.89; 9191 99.24 / 98.71 and
+    91.42 / 82.98 -> 99.27 / 99.17 and 90.51 / 84.28."""
     heat_share_before_clip: bool = False
     """Take this window's heat change out of the Eq. 6 drop ratio before the contact
     guard clips it (True: the clip bounds the resistance's own step) or after (False, the
@@ -164,9 +164,9 @@ class RatioCorrection:
 
     Measured (temperature / deformation accuracy, median / worst, %): three emulated 30-min
     runs with a new speed every 20-40 s, 97.39 / 97.39 and 92.59 / 90.06 -> 98.52 / 98.45
-    and 95.40 / 93.53; suites (8 x 40 min) 707070 99.13 / 97.08 and 90.24 / 84.63 ->
-    99.35 / 97.32 and 92.68 / 84.96, 4242 99.09 / 98.78 and 87.95 / 75.07 -> 99.11 / 98.81
-    and 88.14 / 75.07, 9191 99.18 / 98.71 and 92.32 / 83.12 -> 99.23 / 98.71 and 91.42 /
+    and 95.40 / 93.53; suites (8 x 40 min) 707070 99.13 / 97.08 and 90.19 / 84.63 ->
+    99.42 / 97.32 and 92.30 / 84.96, 4242 99.31 / 98.90 and 87.95 / 77.12 -> 99.30 / 98.93
+    and 88.13 / 77.12, 9191 99.21 / 98.71 and 92.38 / 83.12 -> 99.24 / 98.71 and 91.42 /
     82.98.  Holding the factors through a window with a change instead (not updating from
     it) left `ratio` at open loop on the fast runs (every window has a change: 97.87 /
     87.72 median) and measured as the re-run on the suites."""
