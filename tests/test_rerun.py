@@ -124,6 +124,23 @@ def test_the_ratio_law_is_calm_when_the_speed_changes_inside_every_window(
     assert error < 0.9 * error_forecast
 
 
+def test_after_a_rerun_every_window_reads_the_history_the_twin_ran(tmp_path, spindle_model):
+    """The run above (a new speed every 28 s) on the nominal model itself with ideal
+    thermocouples: with every window re-run, the twin's history is the truth and every
+    correction factor stays 1.  When window k's start row in the history was the forecast's
+    end of window k−1 (the re-run went to window k's correction alone), the next window's
+    line read it as its first point: heat factors off by up to 6.5 %."""
+    run = read_run(write_speed_step_run(
+        tmp_path / "fast.csv", spindle_model, windows=12,
+        speed_at=lambda t: SPEEDS_EVERY_28_S[int(t // 28.0) % len(SPEEDS_EVERY_28_S)]))
+    for corrector in (RatioCorrection(), BpnnCorrection(load_model(BUNDLED_MODEL))):
+        replay = replay_method(run, spindle_model, corrector,
+                               solver=direct_window_solver(spindle_model), keep_fields=False)
+        factors = np.array([np.array(w.correction.values) / np.array(w.nominal)
+                            for w in replay.windows])
+        assert np.abs(np.log(factors)).max() < 1e-4, type(corrector).__name__
+
+
 def test_the_decks_reproduce_the_reported_trajectory_and_the_carried_state(
         tmp_path, spindle_model):
     """Window 0's deck from the uniform start, window 1's deck from its end (the reported

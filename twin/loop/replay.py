@@ -35,10 +35,15 @@ correction factors, as the spindle's loads follow its rings) before window k's c
 all of it was measured before 60k s.  So is window 0 of a run whose loads were held (not
 `loads_follow_rings`) at the cold start's temperatures for 60 s while the rings warmed by
 kelvins and the Palmgren heat fell by about a fifth.
-Window k then starts from the re-run's end field, and the method reads its
-simulated key points over window k−1 from the re-run (`WindowFeatures.simulated_C`), not
-from the forecast that missed the input.  The reported trajectory of window k−1 stays its
-forecast (what was known when it started).  Every stretch is solved through a deck like any
+Window k then starts from the re-run's end field, and the re-run's key points replace
+the forecast's over window k−1 in the history every later window's method reads
+(`WindowFeatures.simulated_C`): the trajectory the twin's state followed, not the forecast
+that missed the input.  Copied for window k alone, as until 2026-11-27, the history kept
+the forecast's end of window k−1 as the start of window k, which the next window's line
+reads (its first point): on the nominal model itself, with ideal thermocouples and a new
+speed every 28 s, `ratio`'s and `bpnn`'s heat factors wandered by up to 6.5 % (now none).
+The reported trajectory of window k−1 stays its forecast (what was known when it
+started).  Every stretch is solved through a deck like any
 window; together they are `WindowRecord.rerun_deck` (`decks/window_kkk_rerun.inp`): run in
 the session from window k−1's start field (the state its own deck started from) they give
 the field window k's deck starts from, so the decks reproduce both the reported trajectory
@@ -434,13 +439,12 @@ def replay_method(
             # the twin's state is the re-run's: it starts the window, its key points over
             # the window just ended are what the method compares with the measurement
             T = rerun[-1]
-            seen = sim_T[:n_sim].copy()
-            seen[-STEPS_PER_WINDOW:] = (model.sensor_matrix @ rerun.T).T
-            bc = conditions(speed, ambient, coolant, seen[-1])
+            sim_T[n_sim - STEPS_PER_WINDOW:n_sim] = (model.sensor_matrix @ rerun.T).T
+            bc = conditions(speed, ambient, coolant, sim_T[n_sim - 1])
             nominal = BoundaryValues(bc.H_front, bc.H_rear, bc.R_front, bc.R_rear)
             features = dataclasses.replace(
-                features, simulated_C=seen, nominal=nominal, previous=previous or nominal,
-                twin_state=TwinState(T, bc))
+                features, simulated_C=sim_T[:n_sim], nominal=nominal,
+                previous=previous or nominal, twin_state=TwinState(T, bc))
         corr = corrector.correct(features)
         if corr.state_C is not None:  # an estimator's analysed field
             T = np.asarray(corr.state_C, dtype=float)
