@@ -101,10 +101,9 @@ class RatioCorrection:
     (`WindowFeatures.without_dead_sensors`, as bpnn's anchor leaves it out), so what it
     corrects is held: read on its last value, a 5-min gap of every channel compared a
     stale ring with the twin's moving one and took the contact resistances to 0.6× in one
-    window.  Every
-    factor is guarded (see `RatioGuards`) and the result kept within the guards' band
-    around the nominal value.  A speed change rescales the previous values by the change of
-    the nominal ones, so the correction carries over as a factor.
+    window.  Every factor is guarded (see `RatioGuards`) and the result kept within the
+    guards' band around the nominal value.  A speed change rescales the previous values by
+    the change of the nominal ones, so the correction carries over as a factor.
     """
 
     guards: RatioGuards = DEFAULT_GUARDS
