@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "16b5bc6f97c4b6aeb1b5359280bc56bd279947570dcba33e39e4951c8af46d58"
+BUNDLED_MODEL_SHA256 = "c9e141ce54c972a95b9fcdf018674d1b9b1d9433cc0931b0caeb917d27368c8c"
 
 
 def _make_model():
