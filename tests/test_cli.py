@@ -271,6 +271,17 @@ def test_bad_choice_or_bound_exits_2_naming_the_option(argv, option, tmp_path, m
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("value", ["inf", "nan", "-inf"])
+def test_a_bound_refuses_a_value_that_is_no_finite_number_in_those_words(value, tmp_path):
+    # 'must be above 0, got inf' read as if infinity were not above 0
+    result = CliRunner().invoke(app, ["simulate", "--speed", "9000", "--minutes", value,
+                                      "--ambient", "25", "--out", str(tmp_path / "OUT")])
+    assert result.exit_code == 2, result.output
+    assert (f"Invalid value for '--minutes': must be a finite number above 0, got {value}"
+            in result.output)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_methods_are_normalised_before_the_command_runs():
     from twin.cli.inputs import method_list
 
