@@ -663,3 +663,43 @@ def test_a_snapshots_marker_names_the_shown_fields_largest_value():
     values = np.array([3.0, 96.42, 12.0])
     assert field_marker("displacement", values) == (1, "max 96.4 µm")
     assert field_marker("temperature", np.array([25.0, 50.83, 40.0])) == (1, "max 50.8 °C")
+
+
+def test_a_run_tells_its_progress_window_by_window(runs_dir, tmp_path):
+    # a replay told nothing until its run was done: a 4-h run stood at 0:00:00 for a minute
+    # (the windows' callback turned the fork off, so the CLI never passed one)
+    from twin.loop.batch import replay_batch
+
+    told = []
+    result = replay_batch([runs_dir / "hot_9000.csv"], tmp_path / "out",
+                          ["open_loop", "ratio"], None,
+                          on_window=lambda *args: told.append(args))
+    assert result.failed == []
+    # where it may fork, the primary (ratio) is replayed by a forked child meanwhile, as
+    # without a callback, and this process tells its own windows only
+    total = told[-1][3]
+    assert total in (MINUTES, 2 * MINUTES)
+    methods = ["open_loop"] * MINUTES + ["ratio"] * (total - MINUTES)
+    assert told == [("hot_9000", m, k, total) for k, m in enumerate(methods, start=1)]
+
+
+def test_the_progress_bar_moves_before_the_run_is_done(runs_dir, tmp_path, monkeypatch):
+    from rich.progress import Progress
+
+    statuses = []
+    update = Progress.update
+
+    def recorded(self, task, **kw):  # noqa: ANN001, ANN003, ANN202
+        statuses.append((kw.get("completed"), kw.get("status")))
+        return update(self, task, **kw)
+
+    monkeypatch.setattr(Progress, "update", recorded)
+    result = invoke("replay", str(runs_dir / "hot_9000.csv"), "--out", str(tmp_path / "out"),
+                    "--methods", "open_loop,ratio", "--snapshots", "none")
+    assert result.exit_code == 0, result.output
+    assert statuses[-1] == (1, "done")
+    moving = statuses[:-1]
+    assert moving and moving[-1][0] == 1
+    assert [c for c, _ in moving] == sorted({c for c, _ in moving})  # forward, each once
+    assert moving[0] in ((1 / MINUTES, f"{100 // MINUTES} % (open_loop)"),  # forked
+                         (0.5 / MINUTES, f"{50 // MINUTES} % (open_loop)"))  # alone

@@ -103,6 +103,12 @@ def replay(
             progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
             raise_if_interrupted()  # a Ctrl-C a library swallowed stops the batch here
 
+        def tell_window(name: str, method: str, done: int, total: int) -> None:
+            # a long run (a 24-h one replays for minutes) showed a bar standing at 0:00:00
+            # until it was done: the bar is redrawn here, as no refresh thread may run
+            progress.update(tasks[name], completed=done / total,
+                            status=f"{100 * done // total} % ({method})", refresh=True)
+
         try:
             raise_if_interrupted()  # the solver's imports may have swallowed one
             result = replay_batch(
@@ -118,6 +124,7 @@ def replay(
                 progress=tell,
                 assimilate_drift=drift_assimilation,
                 plotter=plotter if in_this_process else None,
+                on_window=None if quiet else tell_window,
             )
         except KeyboardInterrupt:
             # the run under way went with its folder (a failed rerun leaves no earlier

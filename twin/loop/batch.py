@@ -9,7 +9,7 @@ matches.
 from __future__ import annotations
 
 import signal
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,15 +54,17 @@ class BatchResult:
 
 
 def run_job(job: ReplayJob, spindle=None, overlap: bool = False,  # noqa: ANN001
-            plotter: ForkedTask | None = None) -> dict:
+            plotter: ForkedTask | None = None,
+            on_window: Callable[[str, int, int], None] | None = None) -> dict:
     """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
-    spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`:
-    see `replay_run_to_dir`); never raises: returns {"ok": accuracy} or {"error": ...}."""
+    spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`,
+    `on_window`: see `replay_run_to_dir`); never raises: returns {"ok": accuracy} or
+    {"error": ...}."""
     try:
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
             spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
-            plotter=plotter, fields=job.fields,
+            plotter=plotter, fields=job.fields, on_window=on_window,
         )
         return {"ok": acc}
     except InputError as exc:
@@ -94,6 +96,7 @@ def replay_batch(
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
     fields: str = "every",
+    on_window: Callable[[str, str, int, int], None] | None = None,
 ) -> BatchResult:
     """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
 
@@ -102,6 +105,9 @@ def replay_batch(
     goes missing from it.  Temporary files of killed earlier batches are removed first.
     plotter: a `twin.loop.report.run_plotter` forked earlier, for the first run replayed
     in this process (not used by worker processes or dask).
+    on_window(run_name, method, done, total): told after each window a run replayed in
+    this process has solved (`replay_run_to_dir`; none from --jobs workers or dask), so
+    that a long run shows its progress before it is done.
     """
     out_root = Path(out_root)
     result = BatchResult()
@@ -134,7 +140,8 @@ def replay_batch(
 
     try:
         # closed on leaving: a Ctrl-C here ends the worker processes before they go on
-        with closing(_execute(todo, jobs, dask_address, progress, plotter)) as outcomes:
+        with closing(_execute(todo, jobs, dask_address, progress, plotter,
+                              on_window)) as outcomes:
             for outcome in outcomes:
                 if "ok" in outcome:
                     result.accuracies.append(outcome["ok"])
@@ -190,7 +197,8 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
 
 
 def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202
-             plotter: ForkedTask | None):
+             plotter: ForkedTask | None,
+             on_window: Callable[[str, str, int, int], None] | None = None):
     if dask_address:
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
@@ -215,7 +223,11 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progres
 
         spindle = SpindleModel.load() if todo else None
         for job in todo:
-            outcome = run_job(job, spindle, overlap=True, plotter=plotter)
+            told = None
+            if on_window is not None:
+                told = (lambda name: lambda m, k, n: on_window(name, m, k, n))(
+                    run_name(job.run_path))
+            outcome = run_job(job, spindle, overlap=True, plotter=plotter, on_window=told)
             _tell(progress, outcome)
             yield outcome
         return
