@@ -745,3 +745,13 @@ def test_a_ctrl_c_a_library_swallows_or_wraps_is_still_told(command, capsys, mon
     assert _console_exit(command, monkeypatch) == 130
     assert capsys.readouterr().err == "interrupted\n"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_simulate_at_a_standstill_tells_no_negative_zero(tmp_path):
+    # 0 rpm: "nose drift axial 0.00 µm, radial -0.00 µm" (a rounding of -1e-17)
+    result = CliRunner().invoke(app, ["simulate", "--speed", "0", "--minutes", "1",
+                                      "--ambient", "22", "--field-every", "0",
+                                      "--out", str(tmp_path / "sim")])
+    assert result.exit_code == 0, result.output
+    assert "nose drift axial 0.00 µm, radial 0.00 µm" in result.output, result.output
+    assert "-0.00" not in result.output
