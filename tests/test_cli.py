@@ -521,6 +521,10 @@ def test_synth_creates_the_run_file_folder_as_every_other_out_does(tmp_path):
     (lambda p: p.write_text("time_s\n"),
      "missing: is a file; a replay folder (twin replay --out DIR) is expected"),
     (lambda p: p.mkdir(), "missing: not a replay folder (no <run>/accuracy.json inside)"),
+    # one run's folder of a replay: what to give instead was left to the user
+    (lambda p: (p.mkdir(), (p / "accuracy.json").write_text("{}")),
+     "missing: is one run's folder of a replay (it holds accuracy.json): give the replay's "
+     "folder, ."),
 ])
 def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
