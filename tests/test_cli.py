@@ -759,3 +759,16 @@ def test_simulate_at_a_standstill_tells_no_negative_zero(tmp_path):
     assert result.exit_code == 0, result.output
     assert "nose drift axial 0.00 µm, radial 0.00 µm" in result.output, result.output
     assert "-0.00" not in result.output
+
+
+def test_synth_says_the_run_length_apart_from_its_own_time(tmp_path):
+    # "wrote run.csv (1801 samples, 1.4 s)" read as a 1.4 s run or a 1.4 s sample interval
+    out = tmp_path / "run.csv"
+    result = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "2",
+                                      "--ambient", "25", "--seed", "1", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    import re
+
+    assert re.fullmatch(rf"wrote {re.escape(str(out))} \(121 samples over 2 min, emulated in "
+                        rf"\d+\.\d s\) and {re.escape(str(tmp_path / 'run.truth.csv'))}\n",
+                        result.output), result.output
