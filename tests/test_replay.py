@@ -703,3 +703,10 @@ def test_the_progress_bar_moves_before_the_run_is_done(runs_dir, tmp_path, monke
     assert [c for c, _ in moving] == sorted({c for c, _ in moving})  # forward, each once
     assert moving[0] in ((1 / MINUTES, f"{100 // MINUTES} % (open_loop)"),  # forked
                          (0.5 / MINUTES, f"{50 // MINUTES} % (open_loop)"))  # alone
+
+
+def test_the_report_says_its_speed_and_ambient_are_a_runs_means(replayed):
+    # a 6000/9000/12000 rpm run showed as "9003 rpm" under "speed [rpm]"
+    page = (replayed / "report.html").read_text()
+    assert "<th rowspan=2>mean speed [rpm]</th><th rowspan=2>mean ambient [°C]</th>" in page
+    assert "mean 9000 rpm, mean ambient 25.00 °C, 5.0 min" in page
