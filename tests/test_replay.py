@@ -710,3 +710,16 @@ def test_the_report_says_its_speed_and_ambient_are_a_runs_means(replayed):
     page = (replayed / "report.html").read_text()
     assert "<th rowspan=2>mean speed [rpm]</th><th rowspan=2>mean ambient [°C]</th>" in page
     assert "mean 9000 rpm, mean ambient 25.00 °C, 5.0 min" in page
+
+
+def test_the_mean_line_says_over_how_many_runs_a_method_is_averaged(runs_dir, tmp_path):
+    # a folder holding one run replayed with open_loop and another with open_loop and
+    # ratio printed both means side by side, one over two runs and one over one
+    out = tmp_path / "out"
+    assert replay(runs_dir / "hot_9000.csv", out=out, methods="open_loop").exit_code == 0
+    result = invoke("replay", str(runs_dir / "hot_12000.csv"), "--out", str(out),
+                    "--methods", "open_loop,ratio", "--snapshots", "none")
+    assert result.exit_code == 0, result.output
+    line = " ".join(result.output.split())  # rich wraps it
+    assert "mean accuracy — open_loop: T " in line and "open_loop (" not in line
+    assert "; ratio (1 of 2 runs): T " in line, line

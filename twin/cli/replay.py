@@ -145,9 +145,14 @@ def _mean_line(out: Path) -> str:
     import json
 
     summary = json.loads((Path(out) / "summary.json").read_text())
+    runs = summary.get("runs", [])
     parts = []
     for m, v in summary.get("mean", {}).items():
         t = v.get("temperature_accuracy_pct")
         d = v.get("deformation_accuracy_pct")
-        parts.append(f"{m}: T {t:.2f} %" + (f", deformation {d:.2f} %" if d is not None else ""))
+        # a folder may hold runs replayed with other methods: a mean over fewer runs says so
+        n = sum(m in r.get("methods", {}) for r in runs)
+        over = "" if n == len(runs) else f" ({n} of {len(runs)} runs)"
+        parts.append(f"{m}{over}: T {t:.2f} %"
+                     + (f", deformation {d:.2f} %" if d is not None else ""))
     return "mean accuracy — " + "; ".join(parts)
