@@ -369,10 +369,27 @@ def test_an_unreachable_dask_scheduler_is_bad_input_naming_the_option(monkeypatc
         raise OSError(f"Timed out trying to connect to {address} after {timeout}")
 
     monkeypatch.setattr(dask.distributed, "Client", refuse)
-    job = batch.ReplayJob("run.csv", "out", ("ratio",), None, "none")
     with pytest.raises(InputError) as info:
-        list(batch._execute([job], 1, "tcp://127.0.0.1:1", None, None))
+        batch.dask_client("tcp://127.0.0.1:1")
     assert info.value.column == "--dask" and "tcp://127.0.0.1:1" in str(info.value)
+
+
+def test_an_unreachable_dask_scheduler_leaves_no_out_folder(monkeypatch, tmp_path):
+    # the batch made DIR, then waited 20 s for the scheduler and left DIR empty behind it
+    import dask.distributed
+
+    from twin.loop.batch import replay_batch
+
+    def refuse(address, timeout):  # noqa: ANN001, ANN202 - stands in for Client
+        raise OSError(f"Timed out trying to connect to {address} after {timeout}")
+
+    monkeypatch.setattr(dask.distributed, "Client", refuse)
+    run = tmp_path / "run.csv"
+    run.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C\n")
+    with pytest.raises(InputError, match="cannot reach the dask scheduler"):
+        replay_batch([run], tmp_path / "out", ["ratio"], None,
+                     dask_address="tcp://127.0.0.1:1")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
 
 
 def test_model_info_reads_well_and_says_which_networks_the_gate_kept():

@@ -72,6 +72,8 @@ def replay(
     model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
     console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
+    if dask:  # an unreachable one takes 20 s to be told
+        console.print(f"connecting to the dask scheduler at {dask} …")
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Column

@@ -122,25 +122,33 @@ def replay_batch(
     check_distinct_names(named)  # refused before anything is written
     named = [(path, name) for path, name in named
              if not _refused_folder(out_root / name, path, result)]
-    out_root.mkdir(parents=True, exist_ok=True)
-    remove_orphans(out_root)
+    # reached before anything is written: an unreachable scheduler (a 20 s wait) left an
+    # empty DIR behind; _execute closes it
+    client = dask_client(dask_address) if dask_address else None
     todo: list[ReplayJob] = []
-    for path, name in named:
-        if resume:
-            finished = _finished(out_root / name, path, methods, model_path, assimilate_drift,
-                                 fields, snapshots)
-            if finished is not None:
-                result.accuracies.append(finished)
-                result.skipped.append(name)
-                if progress:
-                    progress(name, "skipped")
-                continue
-        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
-                              assimilate_drift, fields))
+    try:
+        out_root.mkdir(parents=True, exist_ok=True)
+        remove_orphans(out_root)
+        for path, name in named:
+            if resume:
+                finished = _finished(out_root / name, path, methods, model_path,
+                                     assimilate_drift, fields, snapshots)
+                if finished is not None:
+                    result.accuracies.append(finished)
+                    result.skipped.append(name)
+                    if progress:
+                        progress(name, "skipped")
+                    continue
+            todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
+                                  assimilate_drift, fields))
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
 
     try:
         # closed on leaving: a Ctrl-C here ends the worker processes before they go on
-        with closing(_execute(todo, jobs, dask_address, progress, plotter,
+        with closing(_execute(todo, jobs, client, progress, plotter,
                               on_window)) as outcomes:
             for outcome in outcomes:
                 if "ok" in outcome:
@@ -196,18 +204,25 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
     return accuracy
 
 
-def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None, progress,  # noqa: ANN001, ANN202
+def dask_client(address: str):  # noqa: ANN201 - a dask.distributed Client
+    """A client of the dask scheduler at `address`, or InputError naming --dask."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout="20s")
+    except OSError as exc:  # nothing listens there: the address given is wrong
+        raise InputError(f"cannot reach the dask scheduler at {address} ({exc})",
+                         column="--dask") from None
+
+
+def _execute(todo: list[ReplayJob], jobs: int, client, progress,  # noqa: ANN001, ANN202
              plotter: ForkedTask | None,
              on_window: Callable[[str, str, int, int], None] | None = None):
-    if dask_address:
-        from dask.distributed import Client
+    """Each job's outcome as it comes: on `client` (a connected dask client, closed here),
+    in `jobs` worker processes, or in this process."""
+    if client is not None:
         from dask.distributed import as_completed as dask_completed
 
-        try:
-            client = Client(dask_address, timeout="20s")
-        except OSError as exc:  # nothing listens there: the address given is wrong
-            raise InputError(f"cannot reach the dask scheduler at {dask_address} ({exc})",
-                             column="--dask") from None
         with client:
             futures = client.map(run_job, todo, pure=False)
             for fut in dask_completed(futures):
