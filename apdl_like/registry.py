@@ -48,17 +48,20 @@ ABBREVIATION_LENGTH = 4  # MAPDL reads a command by its first four characters
 
 
 def lookup(name: str) -> CommandSpec | None:
-    """The command `name` stands for: exact, or the same first four letters.
+    """The command `name` stands for: exact, or the same first four characters.
 
-    `FINI` is FINISH, `ANTY` ANTYPE, `/SOLUTION` /SOLU (a longer spelling); a name that fits
-    several commands stands for none.
+    `FINI` is FINISH, `ANTY` ANTYPE, `/SOLUTION` /SOLU (a longer spelling), `/SOL` /SOLU
+    (MAPDL counts a command's slash or star among the four: users' decks write `/SOL`); a
+    name that fits several commands stands for none.
     """
     spec = REGISTRY.get(name)
     if spec is not None:
         return spec
-    core = name.lstrip("/*")
-    if len(core) < ABBREVIATION_LENGTH:
+    if len(name) < ABBREVIATION_LENGTH:
         return None
+    # a longer name is matched on its first four letters after the slash or star, so
+    # `/OUTP` is /OUTPUT and not also /OUT
+    core = name.lstrip("/*")
     prefix = name[: len(name) - len(core) + ABBREVIATION_LENGTH]
     matches = [spec for key, spec in REGISTRY.items()
                if key.startswith(prefix) and (key.startswith(name) or name.startswith(key))]

@@ -188,6 +188,17 @@ def test_abbreviations_and_processor_rules():
     assert settings.nsubst == 4 and s.state.listing.warnings == []
 
 
+def test_slash_and_star_commands_abbreviate_to_four_characters_with_their_prefix():
+    # MAPDL reads the first four characters, the slash or star included: `/SOL` is /SOLU
+    # (common in users' decks) and `/PRE` /PREP7; `/POS` fits /POST1 and /POST26 and so
+    # stands for neither, and three characters stand for nothing
+    s = Session()
+    s.run_text("/PRE\nET,1,PLANE55\nFINI\n/SOL\nANTYPE,TRANS\nNSUB,4\nFINI\n/POS\n/SO\n",
+               "deck.inp")
+    assert s.db.settings.antype == "TRANS" and s.db.settings.nsubst == 4
+    assert [w.split(": ")[2] for w in s.state.listing.warnings] == ["/POS", "/SO"]
+
+
 def test_runaway_loops_stop(tmp_path):
     # nested loops: each small, the product over the limit
     deck = "*DO,I,1,1000\n*DO,J,1,1000\n*ENDDO\n*ENDDO\n"

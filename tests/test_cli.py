@@ -271,6 +271,17 @@ def test_bad_choice_or_bound_exits_2_naming_the_option(argv, option, tmp_path, m
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("value", ["inf", "nan", "-inf"])
+def test_a_bound_refuses_a_value_that_is_no_finite_number_in_those_words(value, tmp_path):
+    # 'must be above 0, got inf' read as if infinity were not above 0
+    result = CliRunner().invoke(app, ["simulate", "--speed", "9000", "--minutes", value,
+                                      "--ambient", "25", "--out", str(tmp_path / "OUT")])
+    assert result.exit_code == 2, result.output
+    assert (f"Invalid value for '--minutes': must be a finite number above 0, got {value}"
+            in result.output)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_methods_are_normalised_before_the_command_runs():
     from twin.cli.inputs import method_list
 
@@ -358,10 +369,27 @@ def test_an_unreachable_dask_scheduler_is_bad_input_naming_the_option(monkeypatc
         raise OSError(f"Timed out trying to connect to {address} after {timeout}")
 
     monkeypatch.setattr(dask.distributed, "Client", refuse)
-    job = batch.ReplayJob("run.csv", "out", ("ratio",), None, "none")
     with pytest.raises(InputError) as info:
-        list(batch._execute([job], 1, "tcp://127.0.0.1:1", None, None))
+        batch.dask_client("tcp://127.0.0.1:1")
     assert info.value.column == "--dask" and "tcp://127.0.0.1:1" in str(info.value)
+
+
+def test_an_unreachable_dask_scheduler_leaves_no_out_folder(monkeypatch, tmp_path):
+    # the batch made DIR, then waited 20 s for the scheduler and left DIR empty behind it
+    import dask.distributed
+
+    from twin.loop.batch import replay_batch
+
+    def refuse(address, timeout):  # noqa: ANN001, ANN202 - stands in for Client
+        raise OSError(f"Timed out trying to connect to {address} after {timeout}")
+
+    monkeypatch.setattr(dask.distributed, "Client", refuse)
+    run = tmp_path / "run.csv"
+    run.write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C\n")
+    with pytest.raises(InputError, match="cannot reach the dask scheduler"):
+        replay_batch([run], tmp_path / "out", ["ratio"], None,
+                     dask_address="tcp://127.0.0.1:1")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
 
 
 def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
@@ -510,6 +538,10 @@ def test_synth_creates_the_run_file_folder_as_every_other_out_does(tmp_path):
     (lambda p: p.write_text("time_s\n"),
      "missing: is a file; a replay folder (twin replay --out DIR) is expected"),
     (lambda p: p.mkdir(), "missing: not a replay folder (no <run>/accuracy.json inside)"),
+    # one run's folder of a replay: what to give instead was left to the user
+    (lambda p: (p.mkdir(), (p / "accuracy.json").write_text("{}")),
+     "missing: is one run's folder of a replay (it holds accuracy.json): give the replay's "
+     "folder, ."),
 ])
 def test_report_says_what_is_wrong_with_its_folder(make, message, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
@@ -752,3 +784,26 @@ def test_a_ctrl_c_does_not_outlive_the_console_script_that_saw_it(capsys, monkey
     assert _console_exit(raise_if_interrupted, monkeypatch) == 0
     assert _console_exit(_ctrl_c_wrapped, monkeypatch) == 130
     assert capsys.readouterr().err == "interrupted\ninterrupted\n"
+
+
+def test_simulate_at_a_standstill_tells_no_negative_zero(tmp_path):
+    # 0 rpm: "nose drift axial 0.00 µm, radial -0.00 µm" (a rounding of -1e-17)
+    result = CliRunner().invoke(app, ["simulate", "--speed", "0", "--minutes", "1",
+                                      "--ambient", "22", "--field-every", "0",
+                                      "--out", str(tmp_path / "sim")])
+    assert result.exit_code == 0, result.output
+    assert "nose drift axial 0.00 µm, radial 0.00 µm" in result.output, result.output
+    assert "-0.00" not in result.output
+
+
+def test_synth_says_the_run_length_apart_from_its_own_time(tmp_path):
+    # "wrote run.csv (1801 samples, 1.4 s)" read as a 1.4 s run or a 1.4 s sample interval
+    out = tmp_path / "run.csv"
+    result = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "2",
+                                      "--ambient", "25", "--seed", "1", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    import re
+
+    assert re.fullmatch(rf"wrote {re.escape(str(out))} \(121 samples over 2 min, emulated in "
+                        rf"\d+\.\d s\) and {re.escape(str(tmp_path / 'run.truth.csv'))}\n",
+                        result.output), result.output

@@ -239,3 +239,27 @@ def test_a_stop_while_the_report_is_drawn_leaves_no_earlier_report_beside_the_mo
     assert load_model(out).metadata["seed"] == 1
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("m.")) == [
         "m.safetensors"]
+
+
+@pytest.mark.slow
+def test_one_run_is_not_told_as_held_out(runs, tmp_path):
+    # one run is split by its windows, so the gate replays the run the networks were
+    # trained on: train and model-info told it as "the held-out runs"
+    out = tmp_path / "one.safetensors"
+    result = _invoke(["train", str(runs[0]), "--out", str(out), "--epochs", "20"])
+    assert result.exit_code == 0, result.output
+    told = ("the run they were trained on (a single run: none is held out)")
+    assert f"checking the networks in closed loop on {told} …" in result.output
+    assert "held-out runs" not in result.output
+    info = _invoke(["model-info", str(out)])
+    assert info.exit_code == 0, info.output
+    assert f"temperature accuracy on {told}: anchor " in info.output, info.output
+    # several runs: whole runs are held out, and a gate run is named as one
+    out = tmp_path / "three.safetensors"
+    gate = _toy_run(tmp_path / "gate_6000.csv", 6000.0, seed=9)
+    result = _invoke(["train", *map(str, runs), "--out", str(out), "--epochs", "20",
+                      "--gate-runs", str(gate)])
+    assert result.exit_code == 0, result.output
+    told = "the held-out runs and the gate runs"
+    assert f"checking the networks in closed loop on {told} …" in result.output
+    assert f"temperature accuracy on {told}: anchor " in _invoke(["model-info", str(out)]).output

@@ -773,3 +773,63 @@ def test_a_logger_gap_holds_ratio_and_bpnn_and_quality_json_says_which_windows(
         assert factors[3] == pytest.approx(factors[2], rel=1e-12), method
         assert factors[4] == pytest.approx(factors[2], rel=1e-12), method
         assert factors[5] != pytest.approx(factors[2], rel=1e-6), method  # read again
+
+
+def test_a_run_tells_its_progress_window_by_window(runs_dir, tmp_path):
+    # a replay told nothing until its run was done: a 4-h run stood at 0:00:00 for a minute
+    # (the windows' callback turned the fork off, so the CLI never passed one)
+    from twin.loop.batch import replay_batch
+
+    told = []
+    result = replay_batch([runs_dir / "hot_9000.csv"], tmp_path / "out",
+                          ["open_loop", "ratio"], None,
+                          on_window=lambda *args: told.append(args))
+    assert result.failed == []
+    # where it may fork, the primary (ratio) is replayed by a forked child meanwhile, as
+    # without a callback, and this process tells its own windows only
+    total = told[-1][3]
+    assert total in (MINUTES, 2 * MINUTES)
+    methods = ["open_loop"] * MINUTES + ["ratio"] * (total - MINUTES)
+    assert told == [("hot_9000", m, k, total) for k, m in enumerate(methods, start=1)]
+
+
+def test_the_progress_bar_moves_before_the_run_is_done(runs_dir, tmp_path, monkeypatch):
+    from rich.progress import Progress
+
+    statuses = []
+    update = Progress.update
+
+    def recorded(self, task, **kw):  # noqa: ANN001, ANN003, ANN202
+        statuses.append((kw.get("completed"), kw.get("status")))
+        return update(self, task, **kw)
+
+    monkeypatch.setattr(Progress, "update", recorded)
+    result = invoke("replay", str(runs_dir / "hot_9000.csv"), "--out", str(tmp_path / "out"),
+                    "--methods", "open_loop,ratio", "--snapshots", "none")
+    assert result.exit_code == 0, result.output
+    assert statuses[-1] == (1, "done")
+    moving = statuses[:-1]
+    assert moving and moving[-1][0] == 1
+    assert [c for c, _ in moving] == sorted({c for c, _ in moving})  # forward, each once
+    assert moving[0] in ((1 / MINUTES, f"{100 // MINUTES} % (open_loop)"),  # forked
+                         (0.5 / MINUTES, f"{50 // MINUTES} % (open_loop)"))  # alone
+
+
+def test_the_report_says_its_speed_and_ambient_are_a_runs_means(replayed):
+    # a 6000/9000/12000 rpm run showed as "9003 rpm" under "speed [rpm]"
+    page = (replayed / "report.html").read_text()
+    assert "<th rowspan=2>mean speed [rpm]</th><th rowspan=2>mean ambient [°C]</th>" in page
+    assert "mean 9000 rpm, mean ambient 25.00 °C, 5.0 min" in page
+
+
+def test_the_mean_line_says_over_how_many_runs_a_method_is_averaged(runs_dir, tmp_path):
+    # a folder holding one run replayed with open_loop and another with open_loop and
+    # ratio printed both means side by side, one over two runs and one over one
+    out = tmp_path / "out"
+    assert replay(runs_dir / "hot_9000.csv", out=out, methods="open_loop").exit_code == 0
+    result = invoke("replay", str(runs_dir / "hot_12000.csv"), "--out", str(out),
+                    "--methods", "open_loop,ratio", "--snapshots", "none")
+    assert result.exit_code == 0, result.output
+    line = " ".join(result.output.split())  # rich wraps it
+    assert "mean accuracy — open_loop: T " in line and "open_loop (" not in line
+    assert "; ratio (1 of 2 runs): T " in line, line

@@ -115,6 +115,45 @@ def test_missing_required_column(tmp_path):
     expect_error(path, 2, "T4_C", "missing required column")
 
 
+def test_a_missing_column_is_told_beside_the_name_the_file_has(tmp_path):
+    # 'missing required column' for a header of TIME_S or Time_s: the names are
+    # case-sensitive, and the message now says which name the file has
+    cols = warmup()
+    cols["Time_s"] = cols.pop("time_s")
+    path = write(tmp_path, csv_text(cols))
+    err = expect_error(path, 1, "time_s", "missing required column")
+    assert err.reason.endswith("(the header has 'Time_s'; column names are case-sensitive)")
+
+
+def test_a_missing_column_without_a_near_name_lists_the_header(tmp_path):
+    # a logger's own time column (a timestamp, minutes): the header is listed, so the user
+    # sees what the reader found
+    cols = warmup()
+    cols["timestamp"] = cols.pop("time_s")
+    path = write(tmp_path, csv_text(cols))
+    err = expect_error(path, 1, "time_s", "missing required column")
+    assert err.reason.endswith("(the header has speed_rpm, ambient_C, T1_C, T2_C, T3_C, "
+                               "T4_C, T5_C, timestamp)"), err.reason
+
+
+def test_a_units_row_under_the_header_is_told_as_one(tmp_path):
+    # a spreadsheet's export with a row of units under the names (s, rpm, °C ...) failed
+    # as "cannot read 's' as a number", leaving the user to guess why
+    lines = csv_text(warmup()).splitlines()
+    lines.insert(1, "s,rpm,°C,°C,°C,°C,°C,°C")
+    path = write(tmp_path, "\n".join(lines) + "\n")
+    err = expect_error(path, 2, "time_s", "cannot read 's' as a number")
+    assert err.reason.endswith("; no cell of line 2 is a number: a units row? remove it "
+                               "(the names carry the units: time_s, T1_C)"), err.reason
+    # a text cell among numbers is told as before
+    fields = lines[2].split(",")
+    fields[3] = "open"
+    lines[1] = ",".join(fields)
+    path = write(tmp_path, "\n".join(lines) + "\n")
+    err = expect_error(path, 2, "T1_C", "cannot read 'open' as a number")
+    assert err.reason == "cannot read 'open' as a number"
+
+
 def test_unparseable_number_names_editor_line(tmp_path):
     text = csv_text(warmup(), "# name: x\n\n").splitlines()
     # line 1 metadata, 2 blank, 3 header, 4.. data: sample 10 sits on line 13

@@ -170,7 +170,9 @@ def between(low: float, high: float = math.inf) -> Callable[[float], float]:
     def check(value: float) -> float:
         if not low < value < high:
             upper = "" if high == math.inf else f" and below {high:g}"
-            raise typer.BadParameter(f"must be above {low:g}{upper}, got {value:g}")
+            # "must be above 0, got inf" read as if infinity were not above 0
+            finite = "" if math.isfinite(value) else "a finite number "
+            raise typer.BadParameter(f"must be {finite}above {low:g}{upper}, got {value:g}")
         return value
 
     return check

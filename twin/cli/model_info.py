@@ -9,6 +9,7 @@ import typer
 
 def model_info(model: Path = typer.Argument(..., help="Correction model file.")) -> None:
     """Check a correction model file and print what it was trained on and how well."""
+    from twin.cli.train import gated_runs
     from twin.correction.modelfile import load_model
 
     m = load_model(model, option=None)  # an argument, not --model
@@ -24,7 +25,7 @@ def model_info(model: Path = typer.Argument(..., help="Correction model file."))
         kept = ", ".join(meta["networks_kept"]) or "none (bpnn gives the anchor)"
         scores = meta.get("held_out_temperature_accuracy_pct") or {}
         typer.echo(f"networks kept by the closed-loop gate: {kept}"
-                   + ("; temperature accuracy on its held-out and gate runs: " if scores else "")
+                   + (f"; temperature accuracy on {gated_runs(meta)}: " if scores else "")
                    + ", ".join(f"{group} {pct:.2f} %" for group, pct in scores.items()))
 
 

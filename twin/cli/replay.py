@@ -72,6 +72,8 @@ def replay(
     model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
     console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
+    if dask:  # an unreachable one takes 20 s to be told
+        console.print(f"connecting to the dask scheduler at {dask} …")
 
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Column
@@ -103,6 +105,12 @@ def replay(
             progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
             raise_if_interrupted()  # a Ctrl-C a library swallowed stops the batch here
 
+        def tell_window(name: str, method: str, done: int, total: int) -> None:
+            # a long run (a 24-h one replays for minutes) showed a bar standing at 0:00:00
+            # until it was done: the bar is redrawn here, as no refresh thread may run
+            progress.update(tasks[name], completed=done / total,
+                            status=f"{100 * done // total} % ({method})", refresh=True)
+
         try:
             raise_if_interrupted()  # the solver's imports may have swallowed one
             result = replay_batch(
@@ -118,6 +126,7 @@ def replay(
                 progress=tell,
                 assimilate_drift=drift_assimilation,
                 plotter=plotter if in_this_process else None,
+                on_window=None if quiet else tell_window,
             )
         except KeyboardInterrupt:
             # the run under way went with its folder (a failed rerun leaves no earlier
@@ -138,9 +147,14 @@ def _mean_line(out: Path) -> str:
     import json
 
     summary = json.loads((Path(out) / "summary.json").read_text())
+    runs = summary.get("runs", [])
     parts = []
     for m, v in summary.get("mean", {}).items():
         t = v.get("temperature_accuracy_pct")
         d = v.get("deformation_accuracy_pct")
-        parts.append(f"{m}: T {t:.2f} %" + (f", deformation {d:.2f} %" if d is not None else ""))
+        # a folder may hold runs replayed with other methods: a mean over fewer runs says so
+        n = sum(m in r.get("methods", {}) for r in runs)
+        over = "" if n == len(runs) else f" ({n} of {len(runs)} runs)"
+        parts.append(f"{m}{over}: T {t:.2f} %"
+                     + (f", deformation {d:.2f} %" if d is not None else ""))
     return "mean accuracy — " + "; ".join(parts)

@@ -22,6 +22,9 @@ def report(out: Path = typer.Argument(..., help="a replay output folder")) -> No
         raise InputError("is a file; a replay folder (twin replay --out DIR) is expected",
                          file=str(out))
     if not is_replay_folder(out):
+        if (out / "accuracy.json").is_file():  # DIR/<run>/ given for DIR
+            raise InputError("is one run's folder of a replay (it holds accuracy.json): give "
+                             f"the replay's folder, {out.parent}", file=str(out))
         raise InputError("not a replay folder (no <run>/accuracy.json inside)", file=str(out))
     # the folder is the command's argument, no option: the writer's checks named '--out'
     check_out_dir(out, option=None, files=["summary.json", "report.html"])

@@ -64,8 +64,10 @@ def simulate_command(
     info = write_simulation(model, result, out)
     if not quiet:
         where = info["max_temperature_at"]
+        # rounded before printing: a drift of -1e-17 µm (a standstill) printed as -0.00
+        axial, radial = (round(info["nose_drift_um"][k], 2) + 0.0 for k in ("axial", "radial"))
         typer.echo(
             f"{speed:g} rpm, {info['minutes']:g} min: max {info['max_temperature_C']:.2f} °C in "
-            f"{where['region']}, nose drift axial {info['nose_drift_um']['axial']:.2f} µm, "
-            f"radial {info['nose_drift_um']['radial']:.2f} µm -> {out}"
+            f"{where['region']}, nose drift axial {axial:.2f} µm, radial {radial:.2f} µm -> "
+            f"{out}"
         )

@@ -123,8 +123,9 @@ def synth(
                          column=exc.column) from None
     run_path, truth_path = write_synth(run, out)
     if not quiet:
-        typer.echo(f"wrote {run_path} ({run.n_samples} samples, {run.elapsed_s:.1f} s) "
-                   f"and {truth_path}")
+        # the run's length and the time the emulation took, each said as what it is
+        typer.echo(f"wrote {run_path} ({run.n_samples} samples over {minutes:g} min, "
+                   f"emulated in {run.elapsed_s:.1f} s) and {truth_path}")
 
 
 synth.__doc__ = SYNTH_HELP
@@ -175,7 +176,8 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
         t0 = time.perf_counter()
         paths = write_case(case, out, model)
         if not quiet:
-            typer.echo(f"[{k}/{n}] wrote {paths['run']} ({time.perf_counter() - t0:.1f} s)")
+            typer.echo(f"[{k}/{n}] wrote {paths['run']} (emulated in "
+                       f"{time.perf_counter() - t0:.1f} s)")
     if not quiet:
         per_minute = (time.perf_counter() - start) / (n * minutes)
         typer.echo(f"{n} runs in {out} ({per_minute:.2f} s per run-minute)")

@@ -112,7 +112,9 @@ def train(
     model = results[chosen.name].model
     if chosen.anchored:
         if not quiet:
-            typer.echo("checking the networks in closed loop on the held-out runs …", err=True)
+            told = {**model.metadata, "gate_runs": [p.name for p in gate_runs]}
+            typer.echo(f"checking the networks in closed loop on {gated_runs(told)} …",
+                       err=True)
         held_out = [recorded[name] for name in model.metadata["held_out_runs"]]
         held_out += [run_from_table(table, max_speed_rpm=limit)
                      for table in tables[len(runs):]]
@@ -136,3 +138,14 @@ def train(
                   for k in ("r2_value", "r2_factor")}
             typer.echo(f"{output:18s} R² {r2['r2_value']} (factor {r2['r2_factor']})")
         typer.echo(f"wrote {out}, {json_path.name}, {html_path.name}")
+
+
+def gated_runs(meta: dict) -> str:
+    """The runs the closed-loop gate replayed, as `train` and `model-info` tell them: one
+    training run is split by its windows, so the gate replays the run the networks were
+    trained on (it was told as "the held-out runs")."""
+    gate = " and the gate runs" if meta.get("gate_runs") else ""
+    if len(meta.get("training_runs", [])) == 1:
+        return f"the run they were trained on (a single run: none is held out){gate}"
+    return f"the held-out runs{gate}"
+

@@ -31,6 +31,8 @@ from twin.loop.runfiles import (
 from twin.loop.summary import collect_summary, read_accuracy
 
 if TYPE_CHECKING:
+    from dask.distributed import Client
+
     from twin.spindle.model import SpindleModel
 
 
@@ -82,15 +84,18 @@ class BatchResult:
 
 
 def run_job(job: ReplayJob, spindle: SpindleModel | None = None, overlap: bool = False,
-            plotter: ForkedTask | None = None) -> dict:
+            plotter: ForkedTask | None = None,
+            on_window: Callable[[str, int, int], None] | None = None) -> dict:
     """Replay one run on `spindle` (a loaded `SpindleModel`; None: load the reference
-    spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`:
-    see `replay_run_to_dir`); never raises: returns {"ok": accuracy} or {"error": ...}."""
+    spindle for this run), with forked helpers on the spare core if `overlap` (`plotter`,
+    `on_window`: see `replay_run_to_dir`); never raises: returns {"ok": accuracy} or
+    {"error": ...}."""
     try:
         acc = replay_run_to_dir(
             job.run_path, job.out_root, job.methods, job.model_path, job.snapshots,
             spindle=spindle, overlap=overlap, assimilate_drift=job.assimilate_drift,
-            plotter=plotter, fields=job.fields, stop=_stop_check(job.stop_event),
+            plotter=plotter, fields=job.fields, on_window=on_window,
+            stop=_stop_check(job.stop_event),
         )
         return {"ok": acc}
     except InputError as exc:
@@ -122,6 +127,7 @@ def replay_batch(
     assimilate_drift: bool = True,
     plotter: ForkedTask | None = None,
     fields: str = "every",
+    on_window: Callable[[str, str, int, int], None] | None = None,
 ) -> BatchResult:
     """Replay `runs` into `out_root`; summary.json then lists every run folder in it.
 
@@ -130,6 +136,9 @@ def replay_batch(
     goes missing from it.  Temporary files of killed earlier batches are removed first.
     plotter: a `twin.loop.report.run_plotter` forked earlier, for the first run replayed
     in this process (not used by worker processes or dask).
+    on_window(run_name, method, done, total): told after each window a run replayed in
+    this process has solved (`replay_run_to_dir`; none from --jobs workers or dask), so
+    that a long run shows its progress before it is done.
     """
     out_root = Path(out_root)
     result = BatchResult()
@@ -144,25 +153,34 @@ def replay_batch(
     check_distinct_names(named)  # refused before anything is written
     named = [(path, name) for path, name in named
              if not _refused_folder(out_root / name, path, result)]
-    out_root.mkdir(parents=True, exist_ok=True)
-    remove_orphans(out_root)
+    # reached before anything is written: an unreachable scheduler (a 20 s wait) left an
+    # empty DIR behind; _execute closes it
+    client = dask_client(dask_address) if dask_address else None
     todo: list[ReplayJob] = []
-    for path, name in named:
-        if resume:
-            finished = _finished(out_root / name, path, methods, model_path, assimilate_drift,
-                                 fields, snapshots)
-            if finished is not None:
-                result.accuracies.append(finished)
-                result.skipped.append(name)
-                if progress:
-                    progress(name, "skipped")
-                continue
-        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
-                              assimilate_drift, fields))
+    try:
+        out_root.mkdir(parents=True, exist_ok=True)
+        remove_orphans(out_root)
+        for path, name in named:
+            if resume:
+                finished = _finished(out_root / name, path, methods, model_path,
+                                     assimilate_drift, fields, snapshots)
+                if finished is not None:
+                    result.accuracies.append(finished)
+                    result.skipped.append(name)
+                    if progress:
+                        progress(name, "skipped")
+                    continue
+            todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
+                                  assimilate_drift, fields))
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
 
     try:
         # closed on leaving: a Ctrl-C here ends the worker processes before they go on
-        with closing(_execute(todo, jobs, dask_address, progress, plotter)) as outcomes:
+        with closing(_execute(todo, jobs, client, progress, plotter,
+                              on_window)) as outcomes:
             for outcome in outcomes:
                 if "ok" in outcome:
                     result.accuracies.append(outcome["ok"])
@@ -217,18 +235,28 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
     return accuracy
 
 
-def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None,
+def dask_client(address: str) -> Client:
+    """A client of the dask scheduler at `address`, or InputError naming --dask."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout="20s")
+    except OSError as exc:  # nothing listens there: the address given is wrong
+        raise InputError(f"cannot reach the dask scheduler at {address} ({exc})",
+                         column="--dask") from None
+
+
+def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
              progress: Callable[[str, str], None] | None,
-             plotter: ForkedTask | None) -> Iterator[dict]:
-    if dask_address:
-        from dask.distributed import Client, Event
+             plotter: ForkedTask | None,
+             on_window: Callable[[str, str, int, int], None] | None = None,
+             ) -> Iterator[dict]:
+    """Each job's outcome as it comes: on `client` (a connected dask client, closed here),
+    in `jobs` worker processes, or in this process."""
+    if client is not None:
+        from dask.distributed import Event
         from dask.distributed import as_completed as dask_completed
 
-        try:
-            client = Client(dask_address, timeout="20s")
-        except OSError as exc:  # nothing listens there: the address given is wrong
-            raise InputError(f"cannot reach the dask scheduler at {dask_address} ({exc})",
-                             column="--dask") from None
         with client:
             stop = Event(f"twin-replay-stop-{uuid.uuid4().hex}", client=client)
             futures = client.map(run_job, [replace(j, stop_event=stop.name) for j in todo],
@@ -251,7 +279,11 @@ def _execute(todo: list[ReplayJob], jobs: int, dask_address: str | None,
 
         spindle = SpindleModel.load() if todo else None
         for job in todo:
-            outcome = run_job(job, spindle, overlap=True, plotter=plotter)
+            told = None
+            if on_window is not None:
+                told = (lambda name: lambda m, k, n: on_window(name, m, k, n))(
+                    run_name(job.run_path))
+            outcome = run_job(job, spindle, overlap=True, plotter=plotter, on_window=told)
             _tell(progress, outcome)
             yield outcome
         return

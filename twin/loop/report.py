@@ -375,7 +375,9 @@ def _page(out_root: Path, summary: dict) -> str:
         snapshots = sorted(p for p in (run_dir / "snapshots").glob("*.png") if p.is_file())[-2:]
         page_runs.append({
             "name": r["run"],
-            "caption": f"{r['speed_rpm']:.0f} rpm, ambient {r['ambient_C']:.2f} °C, "
+            # accuracy.json's speed and ambient are the run's means (of a run with speed
+            # steps or a stop too): said so
+            "caption": f"mean {r['speed_rpm']:.0f} rpm, mean ambient {r['ambient_C']:.2f} °C, "
                        f"{r['duration_s'] / 60:.1f} min",
             "plots": _plots(run_dir) if (run_dir / "keypoints.csv").is_file() else [],
             "findings": _findings(run_dir),

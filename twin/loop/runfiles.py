@@ -137,7 +137,8 @@ def replay_run_to_dir(
     """Replay one run with `methods`, write its folder, return its accuracy.json dict.
     `assimilate_drift`: the estimator's option (twin.estimation.method.EstimatorConfig).
     `snapshots`, `fields`: the window ends pictured and written as field files
-    (`WINDOW_END_CHOICES`).
+    (`WINDOW_END_CHOICES`).  `on_window(method, done, total)`: told after each window
+    replayed in this process (`_replay_methods`).
 
     The folder DIR/<run-name>/ is replaced as a whole (`replaced_folder`): a shorter rerun
     leaves none of the longer run's files, and a failed one leaves no earlier result.
@@ -333,24 +334,25 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
     written by `write_primary_fields` as soon as it is replayed.  `keep_fields`: the
     primary keeps its window-end fields (for the field files or the snapshots).
 
-    With `fork` (and no per-window callback, which could not cross processes) a forked
-    child on the second core replays the primary and writes its fields (their structural
-    solves and stress recovery cost about as much as replaying one more method) and, with
-    four methods or more, some of the others, so that each process replays about half; it
-    sends its replays back as JSON with only the fields the snapshots show.  The parent
-    replays the rest meanwhile.
+    With `fork` a forked child on the second core replays the primary and writes its
+    fields (their structural solves and stress recovery cost about as much as replaying one
+    more method) and, with four methods or more, some of the others, so that each process
+    replays about half; it sends its replays back as JSON with only the fields the
+    snapshots show.  The parent replays the rest meanwhile.
+    `on_window(method, done, total)` is told after each window this process replays:
+    `done` of the `total` windows of the methods it replays itself (a callback cannot
+    cross processes; the child's half runs alongside).  It was once given only without
+    the fork, and so never: a replay showed no progress until its run was done.
     Each window's solve depends on its own inputs only (the session's cached
     factorizations are keyed by the matrix), so the split changes no number.  Should the
     child fail, the parent replays its methods itself: the error, if it is one, is then
     raised here with its own type.
     """
-    def replay(corrector: Corrector) -> MethodReplay:
-        callback = None
-        if on_window is not None:
-            callback = (lambda name: lambda k, n: on_window(name, k, n))(corrector.name)
+    def replay(corrector: Corrector,
+               told: Callable[[int, int], None] | None = None) -> MethodReplay:
         r = replay_method(run, model, corrector,
                           keep_fields=keep_fields and corrector.name == primary,
-                          on_window=callback, solver=solver)
+                          on_window=told, solver=solver)
         if r.method == primary:
             write_primary_fields(r)
         return r
@@ -363,13 +365,20 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
 
     others = [c for c in correctors if c.name != primary]
     away = []
-    if fork and on_window is None and others:
+    if fork and others:
         away = [c for c in correctors if c.name == primary] + others[: (len(others) - 1) // 2]
+    here = [c for c in correctors if c not in away]
+
+    def told(i: int, corrector: Corrector) -> Callable[[int, int], None] | None:
+        if on_window is None:
+            return None
+        return lambda k, n: on_window(corrector.name, i * n + k, len(here) * n)
+
     side = ForkedTask(replay_away, fork=bool(away))
     with side:
         if away:
             side.start()
-        results = {c.name: replay(c) for c in correctors if c not in away}
+        results = {c.name: replay(c, told(i, c)) for i, c in enumerate(here)}
         try:
             sent = json.loads(side.join() or "[]")
         except ForkedTaskError:

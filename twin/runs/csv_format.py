@@ -17,7 +17,7 @@ from twin.errors import InputError
 from twin.io.atomic import atomic_target
 from twin.paths import read_input_text
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
-from twin.runs.table import RawTable, parse_cell
+from twin.runs.table import RawTable, is_number, parse_cell
 
 LINE = "line"
 """What an error calls a place in a CSV file (`RawTable.row_unit`): its line, numbered as an
@@ -86,7 +86,15 @@ def read_csv_table(path: str | os.PathLike[str],
                              f"{len(fields)}", file=file, row=line, row_unit=LINE)
         row = values[k]
         for j, (i, name) in enumerate(known):
-            row[j] = parse_cell(fields[i], file, line, name, LINE)
+            try:
+                row[j] = parse_cell(fields[i], file, line, name, LINE)
+            except InputError as exc:
+                if k == 0 and not any(is_number(f) for f in fields):
+                    raise InputError(f"{exc.reason}; no cell of line {line} is a number: a "
+                                     "units row? remove it (the names carry the units: "
+                                     "time_s, T1_C)", file=file, row=line, column=name,
+                                     row_unit=LINE) from None
+                raise
     columns = {name: values[:, j].copy() for j, (_, name) in enumerate(known)}
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,

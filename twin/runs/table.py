@@ -57,6 +57,11 @@ MAX_NUMBER_CHARS = 64
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
+def is_number(cell: str) -> bool:
+    """Whether `cell` is a plain decimal number as `parse_cell` reads one."""
+    return _NUMBER.fullmatch(cell.strip()) is not None
+
+
 def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> float:
     """One cell of a run table as a float (NaN for a missing value), or `InputError` at
     `row` (a "line" or a "row", as `RawTable.row_unit`)."""
@@ -66,7 +71,7 @@ def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> fl
                          row=row, column=column, row_unit=row_unit)
     if text.lower() in MISSING_TOKENS:
         return math.nan
-    if not _NUMBER.fullmatch(text):
+    if not is_number(text):
         raise InputError(f"cannot read {cell!r} as a number", file=file, row=row,
                          column=column, row_unit=row_unit)
     value = float(text)

@@ -39,11 +39,27 @@ FAHRENHEIT_AIR_RANGE_C = (OPERATING_TEMPERATURE_C[1], 130.0)
 to the second is Fahrenheit: 45–130 °F is 7–54 °C, any room or coolant logged in °F."""
 
 
+HEADER_NAMES_TOLD = 12
+"""At most this many of a file's column names are listed beside a missing column."""
+
+
 def required_column(table: RawTable, name: str) -> np.ndarray:
-    """The column `name`, or InputError at the header if the file lacks it."""
+    """The column `name`, or InputError at the header if the file lacks it, saying what
+    the header has instead: a logger's `TIME_S` or `timestamp` was told only as a missing
+    `time_s`."""
     if name not in table.columns:
-        raise table.error("missing required column", table.header_row, name)
+        raise table.error(f"missing required column {_header_hint(table, name)}",
+                          table.header_row, name)
     return table.columns[name]
+
+
+def _header_hint(table: RawTable, name: str) -> str:
+    header = [*table.columns, *table.ignored_columns]
+    near = [h for h in header if h.strip().lower() == name.lower()]
+    if near:
+        return f"(the header has {near[0]!r}; column names are case-sensitive)"
+    told = ", ".join(header[:HEADER_NAMES_TOLD])
+    return f"(the header has {told}{', …' if len(header) > HEADER_NAMES_TOLD else ''})"
 
 
 def column_with_values(table: RawTable, name: str) -> np.ndarray:
