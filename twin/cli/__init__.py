@@ -57,6 +57,10 @@ def build_app() -> typer.Typer:
         no_args_is_help=True,
         add_completion=False,
         pretty_exceptions_enable=False,
+        # click's plain help: rich's table gave a long flag pair (--drift-assimilation/
+        # --no-drift-assimilation) two columns, and at 80 columns the help text got 17
+        # characters a line ("[default: open_loop,ratio…"); at 120 half the width was blank
+        rich_markup_mode=None,
     )
     app.callback()(_options)
     for name, function in COMMANDS:
