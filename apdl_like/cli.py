@@ -52,8 +52,8 @@ def _options(
 @app.command("run")
 @report_errors
 def run(
-    deck: Path = typer.Argument(..., help="The APDL deck (.inp, .mac, .cdb); /INPUT is "
-                                          "resolved in its folder."),
+    deck: Path = typer.Argument(..., metavar="DECK", help="The APDL deck (.inp, .mac, "
+                                ".cdb); /INPUT is resolved in its folder."),
     out: Path = typer.Option(..., "--out", help="Output folder (created if missing)."),
     quiet: bool = typer.Option(False, "--quiet", help="No summary on success (warnings are "
                                "still told, on stderr)."),

@@ -76,8 +76,9 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
 @drift_app.command("fit")
 @report_errors
 def fit(
-    data: list[Path] = typer.Argument(..., help="Data files (CSV or Parquet): time_s, "
-                                      "optional speed_rpm, *_C temperatures, *_um drifts."),
+    data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet): "
+                                      "time_s, optional speed_rpm, *_C temperatures, *_um "
+                                      "drifts."),
     target: str = typer.Option(..., "--target", help="Displacement column(s) to model, "
                                "comma-separated (e.g. ch1_um,ch2_um)."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
@@ -130,8 +131,8 @@ def fit(
 @report_errors
 def predict(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
-    data: Path = typer.Argument(..., help="Data file: time_s, speed_rpm (if the model uses "
-                                "it) and the model's temperature columns."),
+    data: Path = typer.Argument(..., metavar="DATA", help="Data file: time_s, speed_rpm (if "
+                                "the model uses it) and the model's temperature columns."),
     out: Path = typer.Option(..., "--out", help="PRED.csv to write: time_s and per target "
                              "<target>, <target>_lo, <target>_hi (90 % interval)."),
     quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
@@ -158,7 +159,8 @@ def predict(
 @report_errors
 def report(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
-    data: list[Path] = typer.Argument(..., help="Data files holding the model's targets."),
+    data: list[Path] = typer.Argument(..., metavar="DATA",
+                               help="Data files holding the model's targets."),
     out: Path = typer.Option(..., "--out", help="Folder for metrics.json and report.html."),
     quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
 ) -> None:
@@ -185,7 +187,7 @@ def report(
 @drift_app.command("select")
 @report_errors
 def select(
-    data: list[Path] = typer.Argument(..., help="Data files (CSV or Parquet)."),
+    data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet)."),
     target: str = typer.Option(..., "--target", help="Displacement column(s), comma-separated."),
     top: int | None = typer.Option(None, "--top", min=1, help="Show only the best K."),
     out: Path | None = typer.Option(None, "--out", help="Also write the ranking as JSON."),

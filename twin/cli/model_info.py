@@ -7,7 +7,8 @@ from pathlib import Path
 import typer
 
 
-def model_info(model: Path = typer.Argument(..., help="Correction model file.")) -> None:
+def model_info(model: Path = typer.Argument(..., metavar="MODEL",
+                                                 help="Correction model file.")) -> None:
     """Check a correction model file and print what it was trained on and how well."""
     from twin.cli.train import gated_runs
     from twin.correction.modelfile import load_model

@@ -21,8 +21,8 @@ from twin.io.destinations import check_out_dir
 
 def replay(
     runs: list[Path] = typer.Argument(
-        None, help="recorded runs (CSV/Parquet) or folders of them, e.g. a `twin synth --suite` "
-        "folder; none: the bundled example runs"
+        None, metavar="RUN", help="recorded runs (CSV/Parquet) or folders of them, e.g. a "
+        "`twin synth --suite` folder; none: the bundled example runs"
     ),
     out: Path = typer.Option(..., "--out", help="output folder"),
     model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),

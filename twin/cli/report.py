@@ -10,7 +10,7 @@ import typer
 from twin.errors import EXIT_INPUT_ERROR, InputError
 
 
-def report(out: Path = typer.Argument(..., help="a replay output folder")) -> None:
+def report(out: Path = typer.Argument(..., metavar="DIR", help="a replay output folder")) -> None:
     """Rebuild DIR/report.html and DIR/summary.json from a replay folder."""
     from twin.io.destinations import check_out_dir
     from twin.loop.report import build_report

@@ -12,7 +12,7 @@ from twin.io.destinations import check_out_file
 
 
 def snapshot(
-    run: Path = typer.Argument(..., help="recorded run (CSV/Parquet)"),
+    run: Path = typer.Argument(..., metavar="RUN", help="recorded run (CSV/Parquet)"),
     time_s: float = typer.Option(..., "--time", min=0.0, help="run time of the picture, s"),
     out: Path = typer.Option(..., "--out", help="PNG file"),
     field: Field = typer.Option(Field.TEMPERATURE, "--field", help="the field shown"),

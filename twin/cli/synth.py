@@ -9,7 +9,7 @@ import typer
 from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError, TomlError
 
-SYNTH_HELP = r"""Emulate a recorded run: the truth model plus sensor lag, noise and faults.
+SYNTH_HELP = """Emulate a recorded run: the truth model plus sensor lag, noise and faults.
 
 One run: --speed RPM or --profile CSV, with --minutes, --ambient, --seed
 and --out RUN.csv.  A suite: --suite N --seed S [--minutes M] --out DIR
@@ -21,15 +21,18 @@ are refused (--overwrite removes them).
 
 Scenario TOML (--scenario): every table is time_s plus values, linear in
 time; anything left out takes a seeded default.
-  \[bearing_heat.front|rear]        factor on the Palmgren heat
-  \[contact_resistance.front|rear]  factor on the ring/sleeve resistance
-  \[coolant] inlet_C, \[ambient] ambient_C, \[xy_drift] x_um, y_um
+
+\b
+  [bearing_heat.front|rear]        factor on the Palmgren heat
+  [contact_resistance.front|rear]  factor on the ring/sleeve resistance
+  [coolant] inlet_C, [ambient] ambient_C, [xy_drift] x_um, y_um
 Model-form error (the truth only; the twin keeps its nominal model):
-  \[motor_heat]                     factor on the motor loss
-  \[film.coolant|housing|air_gap|rotor]  factor on that group's films
-  \[material] conductivity, expansion  constant multipliers
-  \[sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple offset)
-  \[faults] stuck, dropouts, spikes;  \[model] size_factor
+  [motor_heat]                     factor on the motor loss
+  [film.coolant|housing|air_gap|rotor]  factor on that group's films
+  [material] conductivity, expansion  constant multipliers
+  [sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple offset)
+  [faults] stuck, dropouts, spikes;  [model] size_factor
+
 Unknown keys are errors naming the file and line.  Without a scenario the
 truth still differs from the twin: motor ±15 %, films ±25 %, conductivity
 ±5 %, expansion ±3 %, thermocouples up to 1 mm off (twin.plant.truth)."""

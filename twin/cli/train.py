@@ -16,8 +16,9 @@ MAX_EPOCHS = 100_000
 
 
 def train(
-    runs: list[Path] = typer.Argument(..., help="Recorded runs (CSV or Parquet) to train on; "
-                                      "a folder stands for the runs in it, as in replay."),
+    runs: list[Path] = typer.Argument(..., metavar="RUN", help="Recorded runs (CSV or "
+                                      "Parquet) to train on; a folder stands for the runs in "
+                                      "it, as in replay."),
     out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
     # bounded: a run alone has no validation split to stop early, so 1e20 ran for ever
     epochs: int = typer.Option(5000, "--epochs", min=1, max=MAX_EPOCHS,
