@@ -807,3 +807,24 @@ def test_synth_says_the_run_length_apart_from_its_own_time(tmp_path):
     assert re.fullmatch(rf"wrote {re.escape(str(out))} \(121 samples over 2 min, emulated in "
                         rf"\d+\.\d s\) and {re.escape(str(tmp_path / 'run.truth.csv'))}\n",
                         result.output), result.output
+
+
+@pytest.mark.parametrize("args, ends", [
+    (["simulate", "--speed", "-100", "--minutes", "2", "--ambient", "20"],
+     "option '--speed': speed_rpm must be a non-negative number, got -100.0; "
+     "see 'twin simulate --help'"),
+    (["simulate", "--speed", "100", "--minutes", "99999", "--ambient", "20"],
+     "got 99999; see 'twin simulate --help'"),
+])
+def test_a_bad_option_value_the_command_finds_ends_as_clicks_own(tmp_path, args, ends):
+    # click's usage errors (`--jobs 0`) end with "; see 'twin CMD --help'", as the README
+    # promises for every bad option value; those the command itself found did not
+    proc = subprocess.run([sys.executable, "-m", "twin", *args, "--out", str(tmp_path / "o")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("error: ") and proc.stderr.rstrip("\n").endswith(ends), \
+        proc.stderr
+    # a value read against a file keeps its file's place, without the hint
+    from twin.errors import InputError, _help_hint
+
+    assert _help_hint(InputError("beyond the run", file="run.csv", column="--time")) == ""

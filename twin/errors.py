@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import importlib
 import os
 import signal
 import sys
@@ -151,6 +152,25 @@ class MetadataError(InputError):
         return cls(message, file=file, field=key_path(loc) or None)
 
 
+def _help_hint(exc: InputError) -> str:
+    """`; see 'twin simulate --help'` after a bad value of an option alone (no file), as
+    click ends the usage errors it finds itself (an unknown option, a value out of its
+    bounds): `--speed -100` ended without it, `--jobs 0` with it."""
+    if exc.file is not None or not (exc.column or "").startswith("--"):
+        return ""
+    # the running command's click context: typer vendors click as typer._click since 0.2x,
+    # and used click itself before (pyproject allows typer >= 0.12); neither is imported
+    # here unless a command runs
+    for module in ("typer._click.globals", "click"):
+        try:
+            context = importlib.import_module(module).get_current_context(silent=True)
+        except (ImportError, AttributeError):
+            continue
+        if context is not None:
+            return f"; see '{context.command_path} --help'"
+    return ""
+
+
 def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     """Wrap a CLI command: `InputError` → one line and exit 2, anything unexpected → one
     line and exit 1 (no traceback either way), Ctrl-C → 130, a closed pipe → 141."""
@@ -171,7 +191,7 @@ def report_errors(func: Callable[..., Any]) -> Callable[..., Any]:
             raise_if_interrupted()
             return result
         except InputError as exc:
-            print(f"error: {exc}", file=sys.stderr)
+            print(f"error: {exc}{_help_hint(exc)}", file=sys.stderr)
             raise Exit(EXIT_INPUT_ERROR) from None
         except Exit:
             raise
