@@ -192,7 +192,7 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
             ):
                 ax2.plot(
                     w,
-                    corr.numbers(key)[sel],
+                    _running_factor(corr, key, sel),
                     style,
                     color=METHOD_COLORS.get(m),
                     label=f"{m} {key}",
@@ -203,6 +203,18 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
     if ax2.get_lines():  # open loop alone has no factors to show
         ax2.legend(fontsize=6, ncol=2)
     return _png(fig)
+
+
+def _running_factor(corr: _Columns, key: str, sel: np.ndarray) -> np.ndarray:
+    """corrections.csv's `key` for the rows `sel`, with a gap where a C_H compares a window
+    of a stopped bearing (heat 0) or the one after it: 0 and the fallback 1 there are no
+    correction, and the line fell to 0 at every stop as if the correction had."""
+    values = corr.numbers(key)[sel]
+    if not key.startswith("C_H_"):
+        return values
+    running = corr.numbers("H_" + key.removeprefix("C_H_"))[sel] > 0
+    after_stop = np.concatenate(([False], ~running[:-1]))
+    return np.where(running & ~after_stop, values, np.nan)
 
 
 def run_plotter(fork: bool = True) -> ForkedTask:
