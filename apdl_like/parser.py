@@ -61,7 +61,11 @@ class Statement:
     def shown(self) -> str:
         if self.name == BAD_LINE:
             return self.fields[1]
-        return f"{self.fields[0]}=" if self.name == "=" else self.name
+        if self.name == "=":
+            # the assignment as the user wrote it (`B=A*2`, not `B=`), comment left out
+            written = _strip_comment(self.text).strip()
+            return written if written else f"{self.fields[0]}="
+        return self.name
 
 
 @dataclass(slots=True)

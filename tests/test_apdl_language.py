@@ -128,6 +128,17 @@ def test_parameters_do_and_if():
     assert s.params["BRANCH"] == 2.0 and s.params["BOTH"] == 0.0 and s.params["LAST"] == 1.0
 
 
+def test_a_failed_assignment_is_named_as_written():
+    # the statement was shown as its target only, 'B=: undefined parameter A', which
+    # reads as if the deck had written `B=`
+    with pytest.raises(ApdlError) as info:
+        run("X = 1\nB=A*2   ! twice A\n")
+    assert str(info.value) == "deck.inp:2: B=A*2: undefined parameter A"
+    with pytest.raises(ApdlError) as info:
+        run("C = 1 $ V(2) = C, Q\n")
+    assert str(info.value) == "deck.inp:1: V(2) = C, Q: undefined parameter Q"
+
+
 def test_nested_loops():
     s = run("N = 0\n*DO,I,1,4\n*DO,J,1,I\nN = N + 1\n*ENDDO\n*ENDDO\n")
     assert s.params["N"] == 10.0
@@ -445,7 +456,7 @@ E = TB(5)
     # halfway in both: 15
     assert p["D"] == pytest.approx(15.0)
     assert p["E"] == pytest.approx(7.5)  # the RAMP refilled column 1 with 5, 10, 15
-    with pytest.raises(ApdlError, match=r"deck.inp:2: TB=: subscript 1 of table TB is 4"):
+    with pytest.raises(ApdlError, match=r"deck.inp:2: TB\(4,1\) = 1: subscript 1 of table TB is 4"):
         run("*DIM,TB,TABLE,3\nTB(4,1) = 1\n")
 
 
