@@ -263,6 +263,7 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
     lines = text.splitlines()
     number = 0
     queued: list[str] = []  # the further commands of a line with `$`
+    open_blocks = 0  # *DO and *IF,...,THEN not yet closed: /EOF inside one runs when reached
     while queued or number < len(lines):
         if not queued:
             queued = commands_on(lines[number])
@@ -271,8 +272,12 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
         st = lex_line(raw, file, number)
         if st is None:
             continue
-        if st.name == "/EOF":
-            break
+        if st.name == "/EOF" and open_blocks <= 0:
+            break  # the file ends here; what follows is never read
+        if st.name == "*DO" or (st.name == "*IF" and _if_is_block(st)):
+            open_blocks += 1
+        elif st.name in ("*ENDDO", "*ENDIF"):
+            open_blocks -= 1
         if st.name not in _DATA_COMMANDS:
             statements.append(st)
             continue

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -241,6 +242,58 @@ def test_input_stays_in_the_deck_folder(tmp_path):
     with pytest.raises(ApdlError, match="not found") as info:  # was a RuntimeError
         Session().run_file(tmp_path / "loops.inp")
     assert info.value.line == 1
+
+
+def test_macros_run_beside_the_deck_with_local_arguments(tmp_path):
+    # MAPDL's *USE and its macro search: `name.mac` beside the deck runs as a command;
+    # ARG1..AR19 are the macro's own (0 when not given), the caller's come back after it
+    (tmp_path / "hyp.mac").write_text(
+        "HYP = SQRT(ARG1**2 + ARG2**2)\nSEEN3 = ARG3\nINNER = 0\n"
+        "*IF,ARG3,NE,0,THEN\n  TWICE,ARG1 + 1\n  AFTER_INNER = ARG1\n*ENDIF\n")
+    (tmp_path / "twice.mac").write_text("INNER = 2*ARG1\nARG1 = -1\n")
+    (tmp_path / "early.mac").write_text(
+        "*IF,ARG1,EQ,0,THEN\n  WHY = 'no ARG1'\n  /EOF\n*ENDIF\nEARLY = ARG1\n")
+    (tmp_path / "label.mac").write_text("*VWRITE,ARG1\n('label ',A8)\nN19 = AR19\n")
+    (tmp_path / "main.inp").write_text(
+        "ARG1 = 100\n*USE,hyp,3,4\nA_HYP = HYP\nA_SEEN3 = SEEN3\n"
+        "hyp,5,12,1\nearly\nearly,7\n"
+        "label,'plate',,,,,,,,,,,,,,,,,,9\nN19_BY_NAME = N19\n*USE,label.mac,'x'\n")
+    s = Session()
+    s.run_file(tmp_path / "main.inp")
+    p = s.params
+    assert (p["A_HYP"], p["A_SEEN3"]) == (5.0, 0.0)  # 3-4-5; ARG3 not given: 0
+    assert p["HYP"] == 13.0 and p["SEEN3"] == 1.0  # 5-12-13 by the macro's name
+    assert p["INNER"] == 12.0  # twice.mac got ARG1 = 5 + 1
+    assert p["AFTER_INNER"] == 5.0  # twice.mac's ARG1 = -1 stayed in twice.mac
+    assert p["WHY"] == "no ARG1" and p["EARLY"] == 7.0  # /EOF left `early` the first time
+    # AR19 = 9 by name; *USE (18 arguments at most) leaves it 0
+    assert p["N19_BY_NAME"] == 9.0 and p["N19"] == 0.0
+    # Fortran's A8 right-justifies a shorter text in its 8 columns
+    assert [line for line in s.log if "label" in line] == ["label    plate", "label        x"]
+    assert p["ARG1"] == 100.0 and "ARG2" not in p  # the deck's own ARG1 is back
+    assert s.state.listing.warnings == []
+
+
+def test_macro_calls_that_go_wrong_name_their_line(tmp_path):
+    (tmp_path / "bad.mac").write_text("X = 1\nY = NOPE + 1\n")
+    cases = {
+        "*USE,missing\n": ("main.inp", 1, "macro file 'missing' not found"),
+        "*USE,../outside\n": ("main.inp", 1, "outside the deck's folder"),
+        "bad\n": ("bad.mac", 2, "undefined parameter NOPE"),
+        "*USE,bad,UNDEF*2\n": ("main.inp", 1, "argument ARG1 (UNDEF*2): undefined"),
+        "*USE,bad" + ",1" * 19 + "\n": ("main.inp", 1, "at most 18 arguments, got 19"),
+    }
+    for deck, (file, line, message) in cases.items():
+        (tmp_path / "main.inp").write_text(deck)
+        with pytest.raises(ApdlError, match=re.escape(message)) as info:
+            Session().run_file(tmp_path / "main.inp")
+        assert info.value.file.endswith(file) and info.value.line == line, deck
+    # a name with no macro beside the deck stays an unknown command: a warning
+    (tmp_path / "main.inp").write_text("NOSUCHMACRO,1\nZ = 1\n")
+    s = Session()
+    s.run_file(tmp_path / "main.inp")
+    assert s.params["Z"] == 1.0 and "unknown or unsupported command NOSUCHMACRO" in \
+        s.state.listing.warnings[0]
 
 
 def test_file_size_limit(tmp_path, monkeypatch):
