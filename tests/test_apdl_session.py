@@ -289,7 +289,7 @@ PRNSOL,TEMP
 @pytest.mark.parametrize("text, where", [
     ("/PREP7\nN,1,0,0\nET,1,PLANE55\nMP,KXX,1,-1\n", "d.inp:4: MP"),
     ("/SOLU\nSOLVE\n", "d.inp:2: SOLVE"),
-    ("A = 1/0\n", "d.inp:1: A="),
+    ("A = 1/0\n", "d.inp:1: A = 1/0: division by zero"),
 ])
 def test_cli_bad_deck_exits_2_without_traceback(tmp_path, text, where):
     deck = tmp_path / "d.inp"
