@@ -191,6 +191,8 @@ class SessionState:
     # ETABLE columns (per element of the table) and SSUM's last totals
     element_table: dict[str, np.ndarray] = field(default_factory=dict)
     element_sums: dict[str, float] = field(default_factory=dict)
+    # NSORT's last sort: node numbers and sort keys in sorted order (*GET,,SORT reads it)
+    node_sort: tuple[np.ndarray, np.ndarray] | None = None
     radiation: Radiation = field(default_factory=Radiation)
     load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving
