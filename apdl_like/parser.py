@@ -219,6 +219,7 @@ BLOCK_COMMANDS = ("NBLOCK", "EBLOCK", "CMBLOCK")
 FORMAT_COMMANDS = ("*VWRITE", "*MWRITE", "*VREAD", "*MSG")  # the next line is their format
 _DATA_COMMANDS = frozenset((*BLOCK_COMMANDS, *FORMAT_COMMANDS))  # data or format follows
 MAX_BLOCK_LINES = 5_000_000
+MAX_MSG_LINES = 10  # a *MSG format and its '&' continuations, as MAPDL reads them
 
 
 def _block_lines(st: Statement, lines: list[str], start: int) -> tuple[tuple[str, ...], int]:
@@ -299,8 +300,14 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
                 statements.append(Statement(file, st.line, BAD_LINE,
                                             ("the format line is missing", st.name)))
                 break
-            st = Statement(st.file, st.line, st.name, st.fields, st.text, (lines[number],))
+            block = [lines[number]]
             number += 1
+            # *MSG: a format line ending in '&' goes on on the next line (10 lines at most)
+            while (st.name == "*MSG" and block[-1].rstrip().endswith("&")
+                   and len(block) < MAX_MSG_LINES and number < len(lines)):
+                block.append(lines[number])
+                number += 1
+            st = Statement(st.file, st.line, st.name, st.fields, st.text, tuple(block))
         statements.append(st)
     program = Program(file, statements)
     try:

@@ -152,6 +152,7 @@ class Listing:
     files: dict[str, list[str]] = field(default_factory=dict)
     target: str | None = None  # /OUT file receiving output; None: the log
     command_file: str | None = None  # *CFOPEN file receiving *CFWRITE lines
+    errors: int = 0  # *MSG,ERROR messages (MAPDL's error count; the run goes on)
 
     def write(self, text: str) -> None:
         if self.target is None:

@@ -296,6 +296,43 @@ def test_macro_calls_that_go_wrong_name_their_line(tmp_path):
         s.state.listing.warnings[0]
 
 
+def test_msg_writes_its_format_with_mapdls_fortran_descriptors():
+    # MAPDL documents %I, %G, %C as Fortran I9 (of NINT), 1PG16.9 and A8: 'Inner' is
+    # right-justified in 8 columns (after the format's own blank), 1.2 is F editing with 9
+    # significant digits and 4 blanks after, 148.5 rounds half away from zero to 149 (and
+    # -2.5 to -3); a G value past 1e9 takes the 1P E form, one digit before the point
+    s = run("R = 25\n*MSG,INFO,'Inner',R,1.2,148.5\n"
+            "Radius ( %C) = %I, Thick = %G, Length = %I\n"
+            "*MSG,NOTE,-2.5,1.23456789012e10,99.5\nhalf %I big %G &\n"
+            " and %8.3F%% done%/next line\nAFTER = 1\n")
+    assert s.log == [
+        "Radius (    Inner) =        25, Thick =   1.20000000    , Length =       149",
+        " *** NOTE ***",
+        "half        -3 big  1.234567890E+10  and   99.500% done",  # joined as written
+        "next line",
+    ]
+    assert s.params["AFTER"] == 1.0 and s.state.listing.warnings == []
+
+
+def test_msg_warn_and_error_go_on_fatal_stops_at_its_line():
+    s = run("*MSG,WARN,3\n%I nodes left\n*MSG,ERROR\nbad input\n*MSG,ERROR\nagain\nZ = 5\n")
+    assert s.params["Z"] == 5.0  # ERROR counts, the batch run goes on
+    assert s.state.listing.errors == 2
+    assert s.state.listing.warnings == ["warning: deck.inp:1: *MSG: 3 nodes left",
+                                        "error: deck.inp:3: *MSG: bad input",
+                                        "error: deck.inp:5: *MSG: again"]
+    assert s.log[:2] == [" *** WARNING ***", "        3 nodes left"]
+    with pytest.raises(ApdlError) as info:
+        run("T = 412\n*MSG,FATAL,T\nT = %I exceeds the limit\nZ = 5\n")
+    assert str(info.value) == "deck.inp:2: *MSG: FATAL: T = 412 exceeds the limit"
+    for deck, message in [("*MSG,INFO,1,2\nonly %I\n", "1 data descriptor(s) (%I, %G, %C, "
+                           "...) for 2 value(s)"),
+                          ("*MSG,LOUD\ntext\n", "Lab) must be one of INFO"),
+                          ("*MSG,INFO,1\n", "format line is missing")]:
+        with pytest.raises(ApdlError, match=re.escape(message)):
+            run(deck)
+
+
 def test_file_size_limit(tmp_path, monkeypatch):
     import apdl_like.parser as parser
 
