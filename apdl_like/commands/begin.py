@@ -54,7 +54,7 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
 @command("*GET", ANY, 8)
 def star_get(s: SessionState, c: Call) -> None:
     """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM MAX|MIN,
-    COUNT ...)."""
+    COUNT ...), and *GET,Par,SORT,,MAX|MIN|IMAX|IMIN after NSORT."""
     name = c.raw(1).upper()
     if not is_parameter_name(name):
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
