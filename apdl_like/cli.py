@@ -109,8 +109,10 @@ def run(
     if stopped is not None:
         raise stopped
     if not quiet:
+        errors = session.state.listing.errors
+        told = f"; {errors} *MSG,ERROR message(s) in log.txt" if errors else ""
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
-                   f"{len(written)} files to {out}")
+                   f"{len(written)} files to {out}{told}")
 
 
 def _spindle_session(base_dir: Path, strict: bool) -> Session:

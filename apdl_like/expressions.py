@@ -56,7 +56,7 @@ def _sign(a: float, b: float) -> float:
     return math.copysign(abs(a), b)
 
 
-def _nint(a: float) -> float:
+def nint(a: float) -> float:
     # Fortran NINT: halves away from zero (Python's round() would go to even).
     return float(math.floor(abs(a) + 0.5)) * (1.0 if a >= 0 else -1.0)
 
@@ -78,7 +78,7 @@ BUILTINS: dict[str, tuple[Callable[..., float], int, int]] = {
     "MIN": (min, 1, 20),
     "MAX": (max, 1, 20),
     "SIGN": (_sign, 2, 2),
-    "NINT": (_nint, 1, 1),
+    "NINT": (nint, 1, 1),
     "MOD": (math.fmod, 2, 2),
 }
 

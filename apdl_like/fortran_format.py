@@ -4,7 +4,8 @@ Edit descriptors: `Aw` (text, right-justified in w, or its first w characters), 
 `Ew.d`, `Gw.d`, `Iw`, `nX` (blanks), quoted literals, `/` (new line), repeat counts (`3F10.2`,
 `2(A8,F8.3)`).  A number too wide for its field prints as w asterisks, as Fortran does.
 Output stops at the first data descriptor with no value left.  A C-style line
-(`%14.5G %I %C`) is accepted too.
+(`%14.5G %I %C`) is accepted too; *MSG's lines are C-style, their bare `%I`, `%G`, `%C` the
+Fortran `I9` (NINT), `1PG16.9` and `A8` MAPDL documents for them.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import re
 from collections.abc import Sequence
 
 from apdl_like.errors import ApdlError
+from apdl_like.expressions import nint
 from apdl_like.parser import split_fields
 
 Item = tuple[str, int, int]  # (kind, width, decimals): kind in A F E G I X ' /
@@ -98,15 +100,23 @@ def exponential(value: float, width: int, decimals: int) -> str:
     return _stars(text, width)
 
 
-def general(value: float, width: int, decimals: int) -> str:
-    """Gw.d: F editing with d significant digits for 0.1 ≤ |v| < 10^d, else E."""
+def general(value: float, width: int, decimals: int, scale: int = 0) -> str:
+    """Gw.d: F editing with d significant digits for 0.1 ≤ |v| < 10^d, else E; with the
+    scale factor 1 (`1PGw.d`) the E form has one digit before the point."""
     if math.isfinite(value) and value != 0.0:
         exp = math.floor(math.log10(abs(value))) + 1
         if 0 <= exp <= decimals:
             return fixed(value, width - 4, max(decimals - exp, 0)) + "    "
     elif value == 0.0:
         return fixed(0.0, width - 4, max(decimals - 1, 0)) + "    "
+    if scale == 1 and math.isfinite(value):
+        return _stars(f"{value:.{decimals}E}", width)
     return exponential(value, width, decimals)
+
+
+# *MSG's bare descriptors as the Fortran edits MAPDL names for them
+_MSG_BARE = {"I": lambda v: _stars(str(int(nint(v))), 9),
+             "G": lambda v: general(v, 16, 9, scale=1)}
 
 
 def format_line(items: Sequence[tuple[str, int, int, str]],
@@ -144,8 +154,16 @@ def format_line(items: Sequence[tuple[str, int, int, str]],
     return lines
 
 
-def format_c_line(line: str, values: Sequence[float | str]) -> list[str]:
-    """A C-style *VWRITE line: %w.dG/E/F, %wI, %wC or %wS, %wX, %/ (new line)."""
+def c_descriptors(line: str) -> int:
+    """How many values a C-style line reads (its %I, %G, %E, %F, %C and %S)."""
+    return sum(m.group(3).upper() in "IGEFCS" for m in _C_SPEC.finditer(line))
+
+
+def format_c_line(line: str, values: Sequence[float | str],
+                  bare_fortran: bool = False) -> list[str]:
+    """A C-style *VWRITE line: %w.dG/E/F, %wI, %wC or %wS, %wX, %/ (new line).  With
+    `bare_fortran` (*MSG) a descriptor with no width is MAPDL's Fortran one: %I is I9 of the
+    nearest integer, %G 1PG16.9, %C A8."""
     out, k, pos = [""], 0, 0
     for m in _C_SPEC.finditer(line):
         out[-1] += line[pos:m.start()]
@@ -165,6 +183,15 @@ def format_c_line(line: str, values: Sequence[float | str]) -> list[str]:
         value = values[k]
         k += 1
         w = int(width) if width and width != "-" else 0
+        if bare_fortran and not width and decimals is None and kind in "IGC":
+            if kind == "C":
+                text = str(value)
+                out[-1] += text[:8] if len(text) >= 8 else text.rjust(8)
+                continue
+            if isinstance(value, str):
+                raise ApdlError(f"%{kind}: {value!r} is text, a number is needed")
+            out[-1] += _MSG_BARE[kind](value)
+            continue
         if kind in ("C", "S"):
             text = str(value)
             out[-1] += text.ljust(abs(w)) if width.startswith("-") else text.rjust(w)

@@ -1,6 +1,12 @@
-"""Running a parsed deck: parameters, *DO/*IF control flow, /INPUT, command dispatch.
+"""Running a parsed deck: parameters, *DO/*IF control flow, /INPUT and macros, dispatch.
 
-Limits keep any deck finite: loop iterations per run, statements per run, /INPUT depth.
+A macro is a file beside the deck run with arguments: `*USE,Name,ARG1,...,AR18`, or its
+name as a command (`name,ARG1,...,AR19` runs `name.mac`, MAPDL's macro search, when no
+command has that name).  ARG1..ARG9 and AR10..AR19 are local to each macro: set from the
+call (0 when not given), the caller's own values back when the macro ends.  /INPUT and
+macros read their files the same way: only beside the deck.
+
+Limits keep any deck finite: loop iterations per run, statements per run, file depth.
 """
 
 from __future__ import annotations
@@ -23,13 +29,20 @@ if TYPE_CHECKING:
 
 MAX_LOOP_ITERATIONS = 100_000
 MAX_STATEMENTS = 2_000_000
-MAX_INPUT_DEPTH = 8
+MAX_INPUT_DEPTH = 20  # /INPUT and macro files inside each other (MAPDL nests macros 20 deep)
 IF_OPERATORS = ("EQ", "NE", "LT", "GT", "LE", "GE", "ABLT", "ABGT")
 EQ_TOLERANCE = 1e-10  # APDL compares *IF values with this absolute tolerance
 # statements `execute` runs itself (assignments, control flow, /INPUT, *REPEAT, bad lines);
 # every other name is a command for `_dispatch`
 _CONTROL = frozenset((BAD_LINE, "=", "*DO", "*ENDDO", "*IF", "*ELSEIF", "*ELSE", "*ENDIF",
-                      "*EXIT", "*CYCLE", "/INPUT", "*REPEAT"))
+                      "*EXIT", "*CYCLE", "/INPUT", "*REPEAT", "*USE", "/EOF"))
+# a macro's local parameters, in MAPDL's spelling: ARG1..ARG9, then AR10..AR19
+MACRO_ARGUMENTS = tuple(f"ARG{k}" for k in range(1, 10)) + tuple(f"AR{k}" for k in range(10, 20))
+MACRO_EXTENSION = "mac"
+
+
+class _EndOfFile(Exception):
+    """/EOF reached inside a block: the file being read ends there."""
 
 
 class _Exit(Exception):
@@ -123,7 +136,7 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
             raise st.error(f"more than {MAX_STATEMENTS} statements executed (runaway deck?)")
         name = st.name
         if name not in _CONTROL:  # a command: the usual statement, one set lookup
-            _dispatch(session, st)
+            _dispatch(session, st, depth)
             previous = st
             i += 1
             continue
@@ -164,11 +177,21 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
                 raise _Exit(program.enclosing_do[i], name == "*CYCLE")
             elif name == "/INPUT":
                 _input(session, st, depth)
+            elif name == "*USE":
+                name_field = st.fields[0] if st.fields else ""
+                if not name_field:
+                    raise st.error("field 1 (macro name) is required")
+                _run_macro(session, st, _macro_file(session, st, name_field), st.fields[1:],
+                           depth)
+            elif name == "/EOF":
+                raise _EndOfFile
             elif name == "*REPEAT":
-                _repeat(session, previous, st)
+                _repeat(session, previous, st, depth)
             else:
-                _dispatch(session, st)
+                _dispatch(session, st, depth)
                 previous = st
+        except _EndOfFile:
+            return
         except _Exit as jump:
             end = program.block_end[jump.do_index]
             if jump.cycle:
@@ -244,35 +267,91 @@ def _count_iteration(session: SessionState, st: Statement) -> None:
 
 
 def _input(session: SessionState, st: Statement, depth: int) -> None:
-    if depth + 1 > MAX_INPUT_DEPTH:
-        raise st.error(f"/INPUT nested deeper than {MAX_INPUT_DEPTH} files")
     fname = st.fields[0] if st.fields else ""
     ext = st.fields[1] if len(st.fields) > 1 else ""
     if not fname:
         raise st.error("field 1 (file name) is required")
-    if session.base_dir is None:
-        raise st.error("/INPUT needs a deck folder (run the deck from a file)")
     name = f"{fname}.{ext}" if ext else fname
+    execute(session, _read_beside_deck(session, st, name, "/INPUT file", depth), depth + 1)
+
+
+def _beside_deck(session: SessionState, st: Statement, name: str, what: str) -> Path:
+    """The file `name` in the deck's folder (DESIGN: files are read only beside the deck);
+    it need not exist."""
+    if session.base_dir is None:
+        raise st.error(f"{what} {name!r} needs a deck folder (run the deck from a file)")
     base = session.base_dir.resolve()
     # realpath, not Path.resolve: a symlink loop is a file not found, not a RuntimeError
     target = Path(os.path.realpath(base / name))
     if not target.is_relative_to(base):
-        raise st.error(f"/INPUT file {name!r} lies outside the deck's folder {str(base)!r}")
+        raise st.error(f"{what} {name!r} lies outside the deck's folder {str(base)!r}")
+    return target
+
+
+def _read_beside_deck(session: SessionState, st: Statement, name: str, what: str,
+                      depth: int) -> Program:
+    """Parse the file `name` beside the deck, for /INPUT or a macro run from a file at
+    `depth`, shown by its name."""
+    if depth + 1 > MAX_INPUT_DEPTH:
+        raise st.error(f"/INPUT and macro files nested deeper than {MAX_INPUT_DEPTH} files")
+    target = _beside_deck(session, st, name, what)
     if not target.exists():  # a symlink loop too
-        raise st.error(f"/INPUT file {name!r} not found in {str(base)!r}")
+        raise st.error(f"{what} {name!r} not found in {str(session.base_dir.resolve())!r}")
     shown = str(Path(st.file).parent / name) if st.file and not st.file.startswith("<") else name
     try:
         program = read_deck(target, shown)
     except ApdlError as exc:
         if exc.line is not None:
             raise
-        # a folder or a fifo was "not found"; the file's problem at the /INPUT's line
-        raise st.error(f"/INPUT file {name!r}: {exc.reason}") from None
+        # a folder or a fifo was "not found"; the file's problem at the calling line
+        raise st.error(f"{what} {name!r}: {exc.reason}") from None
     session.inputs.append(target)
-    execute(session, program, depth + 1)
+    return program
 
 
-def _repeat(session: SessionState, previous: Statement | None, st: Statement) -> None:
+def _macro_file(session: SessionState, st: Statement, name: str) -> str:
+    """*USE,Name: the file `Name` beside the deck, else `Name.mac` (its name as written,
+    then in lower case, as a Linux MAPDL looks for it)."""
+    candidates = [name, f"{name}.{MACRO_EXTENSION}", f"{name.lower()}.{MACRO_EXTENSION}"]
+    for candidate in candidates:
+        if _beside_deck(session, st, candidate, "macro file").is_file():
+            return candidate
+    raise st.error(f"macro file {name!r} not found in the deck's folder (tried "
+                   f"{', '.join(dict.fromkeys(candidates))})")
+
+
+def _run_macro(session: SessionState, st: Statement, file_name: str,
+               arguments: tuple[str, ...], depth: int) -> None:
+    """Run a macro file with ARG1..AR19 set from `arguments` (evaluated by the caller)."""
+    limit = len(MACRO_ARGUMENTS) - (1 if st.name == "*USE" else 0)
+    given = len(arguments)
+    while given and not arguments[given - 1].strip():
+        given -= 1
+    if given > limit:
+        raise st.error(f"a macro takes at most {limit} arguments, got {given}")
+    values: list[float | str] = []
+    for k, text in enumerate(arguments[:given]):
+        try:
+            values.append(value_of(text, session.params, session.model_functions)
+                          if text.strip() else 0.0)
+        except ApdlError as exc:
+            raise st.error(f"argument {MACRO_ARGUMENTS[k]} ({text.strip()}): "
+                           f"{exc.reason}") from None
+    program = _read_beside_deck(session, st, file_name, "macro file", depth)
+    params = session.params
+    callers = {name: params.pop(name) for name in MACRO_ARGUMENTS if name in params}
+    params.update(zip(MACRO_ARGUMENTS, values + [0.0] * (len(MACRO_ARGUMENTS) - len(values)),
+                      strict=True))
+    try:
+        execute(session, program, depth + 1)
+    finally:
+        for name in MACRO_ARGUMENTS:
+            params.pop(name, None)
+        params.update(callers)
+
+
+def _repeat(session: SessionState, previous: Statement | None, st: Statement,
+            depth: int) -> None:
     """*REPEAT,NTOT,VINC1,...,VINC11: the previous command NTOT-1 more times, field j
     increased by k·VINCj in the k-th repetition."""
     if previous is None:
@@ -293,12 +372,16 @@ def _repeat(session: SessionState, previous: Statement | None, st: Statement) ->
             fields[j] = repr(base + k * inc)
         _count_iteration(session, st)
         _dispatch(session, Statement(previous.file, st.line, previous.name, tuple(fields),
-                                     previous.text, previous.block))
+                                     previous.text, previous.block), depth)
 
 
-def _dispatch(session: SessionState, st: Statement) -> None:
+def _dispatch(session: SessionState, st: Statement, depth: int) -> None:
     spec = lookup(st.name)
     if spec is None:
+        macro = _macro_by_name(session, st)
+        if macro is not None:
+            _run_macro(session, st, macro, st.fields, depth)
+            return
         message = f"unknown or unsupported command {st.name}"
         if session.strict:
             raise st.error(message + " (--strict)")
@@ -328,3 +411,14 @@ def _dispatch(session: SessionState, st: Statement) -> None:
         raise st.error(str(exc)) from None
     except ArithmeticError as exc:  # the deck's numbers overflow (RECTNG at 1e300, ...)
         raise st.error(f"numbers out of range ({exc})") from None
+
+
+def _macro_by_name(session: SessionState, st: Statement) -> str | None:
+    """MAPDL's macro search for an unknown command `NAME`: `name.mac` beside the deck (in
+    lower case, as a Linux MAPDL writes and finds it, or in upper case)."""
+    if session.base_dir is None or not is_parameter_name(st.name):
+        return None
+    for candidate in (f"{st.name.lower()}.{MACRO_EXTENSION}", f"{st.name}.{MACRO_EXTENSION}"):
+        if _beside_deck(session, st, candidate, "macro file").is_file():
+            return candidate
+    return None

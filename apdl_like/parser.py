@@ -61,7 +61,11 @@ class Statement:
     def shown(self) -> str:
         if self.name == BAD_LINE:
             return self.fields[1]
-        return f"{self.fields[0]}=" if self.name == "=" else self.name
+        if self.name == "=":
+            # the assignment as the user wrote it (`B=A*2`, not `B=`), comment left out
+            written = _strip_comment(self.text).strip()
+            return written if written else f"{self.fields[0]}="
+        return self.name
 
 
 @dataclass(slots=True)
@@ -215,6 +219,7 @@ BLOCK_COMMANDS = ("NBLOCK", "EBLOCK", "CMBLOCK")
 FORMAT_COMMANDS = ("*VWRITE", "*MWRITE", "*VREAD", "*MSG")  # the next line is their format
 _DATA_COMMANDS = frozenset((*BLOCK_COMMANDS, *FORMAT_COMMANDS))  # data or format follows
 MAX_BLOCK_LINES = 5_000_000
+MAX_MSG_LINES = 10  # a *MSG format and its '&' continuations, as MAPDL reads them
 
 
 def _block_lines(st: Statement, lines: list[str], start: int) -> tuple[tuple[str, ...], int]:
@@ -259,6 +264,7 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
     lines = text.splitlines()
     number = 0
     queued: list[str] = []  # the further commands of a line with `$`
+    open_blocks = 0  # *DO and *IF,...,THEN not yet closed: /EOF inside one runs when reached
     while queued or number < len(lines):
         if not queued:
             queued = commands_on(lines[number])
@@ -267,8 +273,12 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
         st = lex_line(raw, file, number)
         if st is None:
             continue
-        if st.name == "/EOF":
-            break
+        if st.name == "/EOF" and open_blocks <= 0:
+            break  # the file ends here; what follows is never read
+        if st.name == "*DO" or (st.name == "*IF" and _if_is_block(st)):
+            open_blocks += 1
+        elif st.name in ("*ENDDO", "*ENDIF"):
+            open_blocks -= 1
         if st.name not in _DATA_COMMANDS:
             statements.append(st)
             continue
@@ -290,8 +300,14 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
                 statements.append(Statement(file, st.line, BAD_LINE,
                                             ("the format line is missing", st.name)))
                 break
-            st = Statement(st.file, st.line, st.name, st.fields, st.text, (lines[number],))
+            block = [lines[number]]
             number += 1
+            # *MSG: a format line ending in '&' goes on on the next line (10 lines at most)
+            while (st.name == "*MSG" and block[-1].rstrip().endswith("&")
+                   and len(block) < MAX_MSG_LINES and number < len(lines)):
+                block.append(lines[number])
+                number += 1
+            st = Statement(st.file, st.line, st.name, st.fields, st.text, tuple(block))
         statements.append(st)
     program = Program(file, statements)
     try:

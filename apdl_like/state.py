@@ -152,6 +152,7 @@ class Listing:
     files: dict[str, list[str]] = field(default_factory=dict)
     target: str | None = None  # /OUT file receiving output; None: the log
     command_file: str | None = None  # *CFOPEN file receiving *CFWRITE lines
+    errors: int = 0  # *MSG,ERROR messages (MAPDL's error count; the run goes on)
 
     def write(self, text: str) -> None:
         if self.target is None:
@@ -191,6 +192,8 @@ class SessionState:
     # ETABLE columns (per element of the table) and SSUM's last totals
     element_table: dict[str, np.ndarray] = field(default_factory=dict)
     element_sums: dict[str, float] = field(default_factory=dict)
+    # NSORT's last sort: node numbers and sort keys in sorted order (*GET,,SORT reads it)
+    node_sort: tuple[np.ndarray, np.ndarray] | None = None
     radiation: Radiation = field(default_factory=Radiation)
     load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -128,6 +129,17 @@ def test_parameters_do_and_if():
     assert s.params["BRANCH"] == 2.0 and s.params["BOTH"] == 0.0 and s.params["LAST"] == 1.0
 
 
+def test_a_failed_assignment_is_named_as_written():
+    # the statement was shown as its target only, 'B=: undefined parameter A', which
+    # reads as if the deck had written `B=`
+    with pytest.raises(ApdlError) as info:
+        run("X = 1\nB=A*2   ! twice A\n")
+    assert str(info.value) == "deck.inp:2: B=A*2: undefined parameter A"
+    with pytest.raises(ApdlError) as info:
+        run("C = 1 $ V(2) = C, Q\n")
+    assert str(info.value) == "deck.inp:1: V(2) = C, Q: undefined parameter Q"
+
+
 def test_nested_loops():
     s = run("N = 0\n*DO,I,1,4\n*DO,J,1,I\nN = N + 1\n*ENDDO\n*ENDDO\n")
     assert s.params["N"] == 10.0
@@ -230,6 +242,95 @@ def test_input_stays_in_the_deck_folder(tmp_path):
     with pytest.raises(ApdlError, match="not found") as info:  # was a RuntimeError
         Session().run_file(tmp_path / "loops.inp")
     assert info.value.line == 1
+
+
+def test_macros_run_beside_the_deck_with_local_arguments(tmp_path):
+    # MAPDL's *USE and its macro search: `name.mac` beside the deck runs as a command;
+    # ARG1..AR19 are the macro's own (0 when not given), the caller's come back after it
+    (tmp_path / "hyp.mac").write_text(
+        "HYP = SQRT(ARG1**2 + ARG2**2)\nSEEN3 = ARG3\nINNER = 0\n"
+        "*IF,ARG3,NE,0,THEN\n  TWICE,ARG1 + 1\n  AFTER_INNER = ARG1\n*ENDIF\n")
+    (tmp_path / "twice.mac").write_text("INNER = 2*ARG1\nARG1 = -1\n")
+    (tmp_path / "early.mac").write_text(
+        "*IF,ARG1,EQ,0,THEN\n  WHY = 'no ARG1'\n  /EOF\n*ENDIF\nEARLY = ARG1\n")
+    (tmp_path / "label.mac").write_text("*VWRITE,ARG1\n('label ',A8)\nN19 = AR19\n")
+    (tmp_path / "main.inp").write_text(
+        "ARG1 = 100\n*USE,hyp,3,4\nA_HYP = HYP\nA_SEEN3 = SEEN3\n"
+        "hyp,5,12,1\nearly\nearly,7\n"
+        "label,'plate',,,,,,,,,,,,,,,,,,9\nN19_BY_NAME = N19\n*USE,label.mac,'x'\n")
+    s = Session()
+    s.run_file(tmp_path / "main.inp")
+    p = s.params
+    assert (p["A_HYP"], p["A_SEEN3"]) == (5.0, 0.0)  # 3-4-5; ARG3 not given: 0
+    assert p["HYP"] == 13.0 and p["SEEN3"] == 1.0  # 5-12-13 by the macro's name
+    assert p["INNER"] == 12.0  # twice.mac got ARG1 = 5 + 1
+    assert p["AFTER_INNER"] == 5.0  # twice.mac's ARG1 = -1 stayed in twice.mac
+    assert p["WHY"] == "no ARG1" and p["EARLY"] == 7.0  # /EOF left `early` the first time
+    # AR19 = 9 by name; *USE (18 arguments at most) leaves it 0
+    assert p["N19_BY_NAME"] == 9.0 and p["N19"] == 0.0
+    # Fortran's A8 right-justifies a shorter text in its 8 columns
+    assert [line for line in s.log if "label" in line] == ["label    plate", "label        x"]
+    assert p["ARG1"] == 100.0 and "ARG2" not in p  # the deck's own ARG1 is back
+    assert s.state.listing.warnings == []
+
+
+def test_macro_calls_that_go_wrong_name_their_line(tmp_path):
+    (tmp_path / "bad.mac").write_text("X = 1\nY = NOPE + 1\n")
+    cases = {
+        "*USE,missing\n": ("main.inp", 1, "macro file 'missing' not found"),
+        "*USE,../outside\n": ("main.inp", 1, "outside the deck's folder"),
+        "bad\n": ("bad.mac", 2, "undefined parameter NOPE"),
+        "*USE,bad,UNDEF*2\n": ("main.inp", 1, "argument ARG1 (UNDEF*2): undefined"),
+        "*USE,bad" + ",1" * 19 + "\n": ("main.inp", 1, "at most 18 arguments, got 19"),
+    }
+    for deck, (file, line, message) in cases.items():
+        (tmp_path / "main.inp").write_text(deck)
+        with pytest.raises(ApdlError, match=re.escape(message)) as info:
+            Session().run_file(tmp_path / "main.inp")
+        assert info.value.file.endswith(file) and info.value.line == line, deck
+    # a name with no macro beside the deck stays an unknown command: a warning
+    (tmp_path / "main.inp").write_text("NOSUCHMACRO,1\nZ = 1\n")
+    s = Session()
+    s.run_file(tmp_path / "main.inp")
+    assert s.params["Z"] == 1.0 and "unknown or unsupported command NOSUCHMACRO" in \
+        s.state.listing.warnings[0]
+
+
+def test_msg_writes_its_format_with_mapdls_fortran_descriptors():
+    # MAPDL documents %I, %G, %C as Fortran I9 (of NINT), 1PG16.9 and A8: 'Inner' is
+    # right-justified in 8 columns (after the format's own blank), 1.2 is F editing with 9
+    # significant digits and 4 blanks after, 148.5 rounds half away from zero to 149 (and
+    # -2.5 to -3); a G value past 1e9 takes the 1P E form, one digit before the point
+    s = run("R = 25\n*MSG,INFO,'Inner',R,1.2,148.5\n"
+            "Radius ( %C) = %I, Thick = %G, Length = %I\n"
+            "*MSG,NOTE,-2.5,1.23456789012e10,99.5\nhalf %I big %G &\n"
+            " and %8.3F%% done%/next line\nAFTER = 1\n")
+    assert s.log == [
+        "Radius (    Inner) =        25, Thick =   1.20000000    , Length =       149",
+        " *** NOTE ***",
+        "half        -3 big  1.234567890E+10  and   99.500% done",  # joined as written
+        "next line",
+    ]
+    assert s.params["AFTER"] == 1.0 and s.state.listing.warnings == []
+
+
+def test_msg_warn_and_error_go_on_fatal_stops_at_its_line():
+    s = run("*MSG,WARN,3\n%I nodes left\n*MSG,ERROR\nbad input\n*MSG,ERROR\nagain\nZ = 5\n")
+    assert s.params["Z"] == 5.0  # ERROR counts, the batch run goes on
+    assert s.state.listing.errors == 2
+    assert s.state.listing.warnings == ["warning: deck.inp:1: *MSG: 3 nodes left",
+                                        "error: deck.inp:3: *MSG: bad input",
+                                        "error: deck.inp:5: *MSG: again"]
+    assert s.log[:2] == [" *** WARNING ***", "        3 nodes left"]
+    with pytest.raises(ApdlError) as info:
+        run("T = 412\n*MSG,FATAL,T\nT = %I exceeds the limit\nZ = 5\n")
+    assert str(info.value) == "deck.inp:2: *MSG: FATAL: T = 412 exceeds the limit"
+    for deck, message in [("*MSG,INFO,1,2\nonly %I\n", "1 data descriptor(s) (%I, %G, %C, "
+                           "...) for 2 value(s)"),
+                          ("*MSG,LOUD\ntext\n", "Lab) must be one of INFO"),
+                          ("*MSG,INFO,1\n", "format line is missing")]:
+        with pytest.raises(ApdlError, match=re.escape(message)):
+            run(deck)
 
 
 def test_file_size_limit(tmp_path, monkeypatch):
@@ -445,7 +546,7 @@ E = TB(5)
     # halfway in both: 15
     assert p["D"] == pytest.approx(15.0)
     assert p["E"] == pytest.approx(7.5)  # the RAMP refilled column 1 with 5, 10, 15
-    with pytest.raises(ApdlError, match=r"deck.inp:2: TB=: subscript 1 of table TB is 4"):
+    with pytest.raises(ApdlError, match=r"deck.inp:2: TB\(4,1\) = 1: subscript 1 of table TB is 4"):
         run("*DIM,TB,TABLE,3\nTB(4,1) = 1\n")
 
 

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from apdl_like.call import ANY, Call, CommandSpec, Handler, command, ignored, specs_of
+from apdl_like.commands.post1 import STRESS_COMPONENTS, sort_extreme
 from apdl_like.commands.post26 import get_variable, variable_at
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import is_parameter_name
@@ -50,13 +51,10 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
                    "PPATH", "PDEF", "PRPATH", "/CLABEL", "CMPL", "PRTIME")
 
 
-_STRESS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}
-
-
 @command("*GET", ANY, 8)
 def star_get(s: SessionState, c: Call) -> None:
     """*GET,Par,NODE|ELEM,n,Item1,IT1NUM (TEMP, U X|Y, S X|Y|Z|XY|EQV, LOC X|Y, NUM MAX|MIN,
-    COUNT ...)."""
+    COUNT ...), and *GET,Par,SORT,,MAX|MIN|IMAX|IMIN after NSORT."""
     name = c.raw(1).upper()
     if not is_parameter_name(name):
         raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
@@ -89,6 +87,9 @@ def star_get(s: SessionState, c: Call) -> None:
             raise ApdlError("VFQUERY has not been run")
         s.params[name] = s.radiation.average
         return
+    if entity == "SORT":  # *GET,Par,SORT,,MAX|MIN|IMAX|IMIN of the last NSORT
+        s.params[name] = sort_extreme(s, item)
+        return
     if entity == "ACTIVE":
         if item != "SET" or sub not in ("TIME", "LSTP"):
             raise ApdlError("ACTIVE supports *GET,Par,ACTIVE,0,SET,TIME|LSTP (the result set "
@@ -97,8 +98,8 @@ def star_get(s: SessionState, c: Call) -> None:
         s.params[name] = float(res.time if sub == "TIME" else res.load_step)
         return
     if entity not in ("NODE", "ELEM"):
-        raise ApdlError(f"field 2: entity must be NODE, ELEM, ACTIVE, FSUM, SSUM, VARI or RAD, "
-                        f"got {entity or '(empty)'!r}")
+        raise ApdlError(f"field 2: entity must be NODE, ELEM, ACTIVE, FSUM, SSUM, VARI, RAD or "
+                        f"SORT, got {entity or '(empty)'!r}")
     if item == "COUNT":  # MAPDL's spelling: *GET,Par,NODE,0,COUNT
         item, sub = "NUM", "COUNT"
     if item == "NUM":
@@ -129,9 +130,9 @@ def star_get(s: SessionState, c: Call) -> None:
                 raise ApdlError(f"field 5: U takes X or Y, got {sub or '(empty)'!r}")
             value = s.nodal_result("U" + sub, n)
         elif item == "S":
-            if sub not in _STRESS:
+            if sub not in STRESS_COMPONENTS:
                 raise ApdlError(f"field 5: S takes X, Y, Z, XY or EQV, got {sub or '(empty)'!r}")
-            value = s.nodal_result(_STRESS[sub], n)
+            value = s.nodal_result(STRESS_COMPONENTS[sub], n)
         elif item == "LOC":
             if sub not in ("X", "Y", "Z"):
                 raise ApdlError(f"field 5: LOC takes X, Y or Z, got {sub or '(empty)'!r}")

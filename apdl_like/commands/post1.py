@@ -1,4 +1,4 @@
-"""/POST1: result sets and nodal listings."""
+"""/POST1: result sets, nodal listings and nodal sorts."""
 
 from __future__ import annotations
 
@@ -57,6 +57,7 @@ def _at_time(s: SessionState, time_s: float) -> StepResult:
     return StepResult(step, time_s, "thermal", T, nodal_temperature=mesh.nodal(T))
 
 
+STRESS_COMPONENTS = {"X": "SX", "Y": "SY", "Z": "SZ", "XY": "SXY", "EQV": "SEQV"}  # S,Comp
 _ITEMS = {
     ("TEMP", ""): ["TEMP"],
     ("U", "X"): ["UX"], ("U", "Y"): ["UY"], ("U", "COMP"): ["UX", "UY"], ("U", ""): ["UX", "UY"],
@@ -93,6 +94,76 @@ def prnsol(s: SessionState, c: Call) -> None:
         s.say(f"{int(nodes.ids[i]):8d} " + "".join(f"{v:16.6E}" for v in values))
 
 
+def _nodal_values(s: SessionState, item: str, comp: str) -> np.ndarray:
+    """NSORT's item at every node (NaN where a node has none): TEMP, U X|Y|SUM,
+    S X|Y|Z|XY|EQV from the current result set, LOC X|Y in the active system."""
+    if item == "LOC" and comp in ("X", "Y"):
+        return np.asarray(s.db.active_system.from_global(s.db.nodes.xy))[:, "XY".index(comp)]
+    res = s.result()
+    if item == "TEMP" and comp == "":
+        return res.nodal_temperature
+    if item == "U" and comp in ("X", "Y", "SUM") or item == "S" and comp in STRESS_COMPONENTS:
+        if not res.nodal_structural:
+            raise ApdlError(f"{item},{comp} needs a structural result (the current one is "
+                            "thermal)")
+        ux, uy = res.nodal_structural["UX"], res.nodal_structural["UY"]
+        if item == "U":
+            return {"X": ux, "Y": uy, "SUM": np.hypot(ux, uy)}[comp]
+        return res.nodal_structural[STRESS_COMPONENTS[comp]]
+    raise ApdlError(f"NSORT supports TEMP, U,X|Y|SUM, S,X|Y|Z|XY|EQV and LOC,X|Y, got "
+                    f"{','.join(k for k in (item, comp) if k) or '(empty)'!r}")
+
+
+@command("NSORT", POST, 6)
+def nsort(s: SessionState, c: Call) -> None:
+    """NSORT,Item,Comp,ORDER,KABS,NUMB,SEL: the selected nodes sorted by a nodal value
+    (ORDER 0 descending, 1 ascending; KABS 1 sorts |value|), for *GET,,SORT and, with
+    SEL = SELECT, reselecting the first NUMB nodes of the sort."""
+    nodes = s.db.nodes
+    selected = nodes.selected  # first: it merges the nodes just added into the arrays
+    values = _nodal_values(s, c.label(1), c.label(2))
+    order = c.int_in(3, 0, 1, 0, "ORDER")
+    by_abs = c.int_in(4, 0, 1, 0, "KABS")
+    rows = np.nonzero(selected & np.isfinite(values))[0]
+    if rows.size == 0:
+        raise ApdlError("no selected node has the item to sort")
+    # stable on ascending node numbers: equal values keep the lower node first
+    rows = rows[np.argsort(nodes.ids[rows], kind="stable")]
+    keys = np.abs(values[rows]) if by_abs else values[rows]
+    ranked = np.argsort(keys if order else -keys, kind="stable")
+    count = c.int_in(5, 1, rows.size, rows.size, "NUMB") if c.given(5) else rows.size
+    rows, keys = rows[ranked][:count], keys[ranked][:count]
+    s.node_sort = (nodes.ids[rows].astype(float), keys.astype(float))
+    selection = c.label(6)
+    if selection == "SELECT":
+        mask = np.zeros_like(nodes.selected)
+        mask[rows] = True
+        nodes.selected = mask
+    elif selection:
+        raise ApdlError(f"field 6 (SEL) must be SELECT or blank, got {selection!r}")
+
+
+@command("NUSORT", POST, 0)
+def nusort(s: SessionState, c: Call) -> None:
+    """NUSORT: the nodes back in node-number order.  Listings here are always in that
+    order, and *GET,,SORT keeps reading the last sort, as MAPDL's "last sort" does."""
+
+
+def sort_extreme(s: SessionState, item: str) -> float:
+    """*GET,Par,SORT,,MAX|MIN|IMAX|IMIN: the largest or smallest sort key of the last
+    NSORT (|value| with KABS = 1), or the node holding it (the lower number on a tie)."""
+    if s.node_sort is None:
+        raise ApdlError("no NSORT has been run (*GET,,SORT reads the last sort)")
+    ids, keys = s.node_sort
+    if item not in ("MAX", "MIN", "IMAX", "IMIN"):
+        raise ApdlError(f"field 4: SORT supports MAX, MIN, IMAX and IMIN, got "
+                        f"{item or '(empty)'!r}")
+    extreme = keys.max() if item.endswith("MAX") else keys.min()
+    if not item.startswith("I"):
+        return float(extreme)
+    return float(ids[keys == extreme].min())
+
+
 COMMANDS = (
-    *specs_of(set_, prnsol),
+    *specs_of(set_, prnsol, nsort, nusort),
 )

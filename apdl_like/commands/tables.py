@@ -1,4 +1,4 @@
-"""Results tables and listings: *DIM, *VFILL, *VWRITE, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
+"""Results tables and listings: *DIM, *VFILL, *VWRITE, *MSG, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
 *LIST, *STATUS, SAVE and RESUME (valid in every processor).
 
 Files the deck writes are kept in memory by name (`SessionState.listing.files`) and written
@@ -16,7 +16,7 @@ import numpy as np
 
 from apdl_like.call import ANY, Call, CommandSpec, command, specs_of
 from apdl_like.errors import ApdlError
-from apdl_like.expressions import compile_expression, element_index
+from apdl_like.expressions import compile_expression, element_index, is_parameter_name
 from apdl_like.params import (
     column,
     dimension,
@@ -237,8 +237,58 @@ def star_set_values(s: SessionState, c: Call) -> None:
     store(params, name, subscripts(subs_text, params, funcs) if subs_text else [], values)
 
 
+# *MSG labels: the heading MAPDL writes above the message (INFO: none)
+MSG_HEADINGS = {"INFO": "", "NOTE": "NOTE", "UI": "NOTE", "WARN": "WARNING", "ERROR": "ERROR",
+                "FATAL": "FATAL ERROR"}
+
+
+@command("*MSG", ANY, 9)
+def star_msg(s: SessionState, c: Call) -> None:
+    """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message in the log under its
+    heading.  WARN and ERROR are told on stderr too and ERROR counted (the run goes on, as
+    in MAPDL batch); FATAL stops the run here."""
+    from apdl_like.fortran_format import c_descriptors, format_c_line
+
+    label = c.label(1, "INFO")
+    if label not in MSG_HEADINGS:
+        raise ApdlError(f"field 1 (Lab) must be one of {', '.join(MSG_HEADINGS)}, got {label!r}")
+    params = s.params
+    values: list[float | str] = []
+    last = max((i for i in range(2, c.count() + 1) if c.given(i)), default=1)
+    for i in range(2, last + 1):
+        text = c.raw(i).strip()
+        named = text.upper()
+        if is_text(text):
+            values.append(text[1:-1])
+        elif is_parameter_name(named) and isinstance(params.get(named), str):
+            values.append(params[named])  # a character parameter
+        else:
+            values.append(c.num(i, 0.0, f"VAL{i - 1}"))
+    # the format: its lines joined where each ends in '&'
+    fmt = "".join(line.rstrip()[:-1] if line.rstrip().endswith("&") else line
+                  for line in c.statement.block)
+    wanted = c_descriptors(fmt)
+    if wanted != len(values):
+        raise ApdlError(f"the format has {wanted} data descriptor(s) (%I, %G, %C, ...) for "
+                        f"{len(values)} value(s)")
+    lines = format_c_line(fmt, values, bare_fortran=True)
+    heading = MSG_HEADINGS[label]
+    one_line = " ".join(" ".join(lines).split())  # for stderr and the error
+    if label == "FATAL":
+        raise ApdlError(f"FATAL: {one_line}")
+    log = s.listing.log
+    if heading:
+        log.append(f" *** {heading} ***")
+    log.extend(lines)
+    if label in ("WARN", "ERROR"):
+        st = c.statement
+        if label == "ERROR":
+            s.listing.errors += 1
+        s.listing.warnings.append(f"{heading.lower()}: {st.file}:{st.line}: *MSG: {one_line}")
+
+
 COMMANDS = (
-    *specs_of(star_dim, star_vfill, star_vwrite, out, cfopen, cfwrite, cfclos, star_list,
+    *specs_of(star_dim, star_vfill, star_vwrite, star_msg, out, cfopen, cfwrite, cfclos, star_list,
               star_status, save, resume, star_set_values),
     CommandSpec("/OUTPUT", ANY, 4, out),
 )
