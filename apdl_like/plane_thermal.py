@@ -24,8 +24,10 @@ Transient load steps use twin.fem's θ-method (`twin.fem.stepper.theta_step`, `m
 TINTP sets θ, 1 backward Euler by default).  With AUTOTS the first substep is DELTIM's
 DTIME (or the span / NSBSTP), as MAPDL takes it; each next size is predicted from a
 step-doubling estimate of the last step's local error (against `STEP_TOLERANCE` × the
-temperature scale of the problem), growing at most 3× a step, between DTMIN and DTMAX; a
-step is bisected only when its Picard iteration does not converge.
+temperature range of the problem: its start and loads, or the range its temperatures have
+reached when wider, as in a heat-driven rise), growing at most 3× a step, between DTMIN
+and DTMAX; a later substep is bisected when its estimate exceeds twice that or its Picard
+iteration does not converge; the substeps land on the load step's end.
 """
 
 from __future__ import annotations
@@ -602,13 +604,14 @@ def march(model: PlaneThermal, inputs_at: Callable[[float], ThermalInputs], T0: 
           scale: float) -> tuple[list[float], list[np.ndarray]]:
     """Substeps from t0 to t1: fixed `dt` (the last one shortened to land on t1) or, with
     `adaptive`, a first substep of `dt` and then sizes predicted from a step-doubling error
-    estimate within [dt_min, dt_max] (`twin.fem.stepper.march_to`)."""
+    estimate, bisected when it is too large, within [dt_min, dt_max]
+    (`twin.fem.stepper.march_to`; `scale`, °C, the range the start and loads span)."""
     inputs_at = functools.lru_cache(maxsize=4)(inputs_at)  # a half step's end starts the next
 
     def step(T: np.ndarray, t: float, t_next: float, h: float) -> np.ndarray:
         return model.step(inputs_at(t), inputs_at(t_next), T, h, theta, nonlinear)
 
-    control = StepControl(dt_min, dt_max, STEP_TOLERANCE * max(scale, 1.0)) if adaptive else None
+    control = StepControl(dt_min, dt_max, STEP_TOLERANCE, scale) if adaptive else None
     try:
         return march_to(step, T0, t0, t1, dt, control)
     except SteppingError as exc:

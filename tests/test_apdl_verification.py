@@ -218,6 +218,74 @@ SOLVE
     assert s.params["T_A"] == pytest.approx(20.0 + 5e6 / (7800 * 460), rel=1e-10)
 
 
+def _heated_block(t_end: float) -> tuple[Session, float]:
+    """A block heated by HGEN q and cooled by a film to its start temperature (20 °C), with
+    AUTOTS and DELTIM,10,1,60: its loads and start span no temperature range, so the range
+    AUTOTS measures against is the rise.  k is large (Bi = hL/k ≈ 2e-5), so the block is
+    lumped: T = 20 + (qL/h)(1 − exp(−t/τ)), τ = ρcL/h = 200 s (L = 0.02 m, film on one
+    side).  Returns the session and the exact temperature at t_end."""
+    h, q, rho, c, length = 358.8, 1e6, 7800.0, 460.0, 0.02
+    s = run(f"""
+/PREP7
+ET,1,PLANE55
+MP,KXX,1,4.5E5
+MP,DENS,1,{rho}
+MP,C,1,{c}
+RECTNG,0,{length},0,{length}
+ESIZE,0.01
+AMESH,ALL
+/SOLU
+ANTYPE,TRANS
+TUNIF,20
+NSEL,S,LOC,X,{length}
+SF,ALL,CONV,{h},20
+ALLSEL
+BFE,ALL,HGEN,,{q}
+KBC,1
+AUTOTS,ON
+TIME,{t_end}
+DELTIM,10,1,60
+SOLVE
+*GET,T_A,NODE,1,TEMP
+""")
+    tau = rho * c * length / h
+    return s, 20.0 + q * length / h * (1.0 - math.exp(-t_end / tau))
+
+
+def test_autots_heat_up_grows_the_substep_and_meets_the_exponential():
+    """A smooth heat-up driven by heat generation: AUTOTS starts at DTIME (10 s), is never
+    below DTMIN (1 s) nor above DTMAX (60 s), lands on the end and, as the response
+    settles, grows its substeps (over 6τ: to DTMAX; over 3τ: well above DTMIN, where it
+    used to take every substep at DTMIN, 591 and 1014 of them); the end temperature is
+    within 0.1 % of the rise of the exact exponential (measured: 0.05 % at 3τ, 0.012 % at
+    6τ, backward Euler lagging)."""
+    for t_end, most in ((600.0, 400), (1200.0, 450)):
+        s, exact = _heated_block(t_end)
+        times = np.array(s.state.solution.substep_times)
+        sizes = np.diff(np.concatenate([[0.0], times]))
+        assert sizes[0] == 10.0 and times[-1] == t_end
+        assert np.all(sizes >= 1.0 * (1 - 1e-12)) and np.all(sizes <= 60.0 * (1 + 1e-12))
+        assert len(times) < most, t_end
+        assert sizes[-3:].min() > 3.0, t_end
+        assert abs(s.params["T_A"] - exact) < 1e-3 * (exact - 20.0), t_end
+    s, _ = _heated_block(2400.0)
+    assert max(np.diff(s.state.solution.substep_times)) == pytest.approx(60.0)
+
+
+def test_autots_heat_up_converges_as_the_tolerance_falls(monkeypatch):
+    """Backward Euler's error is first order in the substep, and step doubling sizes
+    substeps as the square root of the tolerance: 16 times the tolerance, 4 times the
+    error at the end (measured 3.9 at 6τ)."""
+    import apdl_like.plane_thermal as plane_thermal
+
+    errors = []
+    for tolerance in (16 * plane_thermal.STEP_TOLERANCE, plane_thermal.STEP_TOLERANCE):
+        monkeypatch.setattr(plane_thermal, "STEP_TOLERANCE", tolerance)
+        s, exact = _heated_block(1200.0)
+        errors.append(abs(s.params["T_A"] - exact))
+    assert 3.0 < errors[0] / errors[1] < 5.0
+
+
 def _sphere_center_cooling(n_radial: int) -> float:
     """VM111's sphere (R = 1/6 ft, k = 1/3, ρc = 66.67, h = 2 to 25 °F from 65 °F, 6 h) as a
     2° PLANE55 wedge of n_radial elements (VM111 itself: 15° and 3), AUTOTS from DTIME =

@@ -62,15 +62,17 @@ def test_march_to_fixed_steps_converge_at_the_method_order(theta, order):
     assert 2**order * 0.8 < errors[0] / errors[1] < 2**order * 1.25
 
 
+def cooling(T, t, t_next, h):
+    """One backward-Euler step of the lumped body cooling toward T_INF_C."""
+    return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
+
+
 def test_march_to_adaptive_meets_its_tolerance():
-    """Step doubling keeps the local error of each step at most the tolerance, so the end
-    value is within (number of steps) × tolerance of the exact exponential."""
-
-    def step(T, t, t_next, h):
-        return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
-
-    control = StepControl(dt_min=0.01, dt_max=50.0, tolerance=1e-3)
-    times, temps = stepper.march_to(step, np.array([80.0]), 0.0, 400.0, 1.0, control)
+    """Step doubling keeps the local error of each step near the tolerance (× the range the
+    temperatures span, at most 60 °C here), so the end value is within (number of steps) ×
+    that of the exact exponential."""
+    control = StepControl(dt_min=0.01, dt_max=50.0, tolerance=1e-3 / 60.0)
+    times, temps = stepper.march_to(cooling, np.array([80.0]), 0.0, 400.0, 1.0, control)
     exact = T_INF_C + 60.0 * math.exp(-2.0)
     assert times[-1] == 400.0 and np.all(np.diff(times) > 0)
     assert abs(temps[-1][0] - exact) < 1e-3 * len(times)
@@ -83,12 +85,8 @@ def test_march_to_adaptive_takes_the_first_substep_given_and_grows_at_most_three
     next size is predicted smaller from that error, and later ones grow at most
     OPNCONTROL's thermal OPENUPFACTOR (3) a step.  The end value still meets the
     exponential to the tolerance per step plus the first step's own error."""
-
-    def step(T, t, t_next, h):
-        return theta_step(T, h, 1.0, body(), lambda T1: body(), solve, False)
-
-    control = StepControl(dt_min=1e-3, dt_max=100.0, tolerance=1e-3)
-    times, temps = stepper.march_to(step, np.array([80.0]), 0.0, 400.0, 40.0, control)
+    control = StepControl(dt_min=1e-3, dt_max=100.0, tolerance=1e-3 / 60.0)
+    times, temps = stepper.march_to(cooling, np.array([80.0]), 0.0, 400.0, 40.0, control)
     sizes = np.diff([0.0, *times])
     assert sizes[0] == 40.0 and sizes[1] < 0.5 * sizes[0]
     assert np.all(sizes[1:-1] <= stepper.OPEN_UP_FACTOR * sizes[:-2] * (1 + 1e-12))
@@ -99,6 +97,54 @@ def test_march_to_adaptive_takes_the_first_substep_given_and_grows_at_most_three
     exact = T_INF_C + 60.0 * math.exp(-2.0)
     assert temps[-1][0] - exact > first_error  # the first step was not redone smaller
     assert temps[-1][0] - exact - first_error < 1e-3 * len(times)
+
+
+def _doubling_error(step, T, t, h):
+    full = step(T, t, t + h, h)
+    half = step(step(T, t, t + h / 2, h / 2), t + h / 2, t + h, h / 2)
+    return float(np.max(np.abs(full - half)))
+
+
+def test_march_to_bisects_a_substep_whose_error_is_too_large():
+    """AUTOTS's bisection: a substep whose error estimate is more than BISECTION_RATIO × the
+    tolerance is redone at half the size, so no kept substep after the first one (and
+    above DTMIN) exceeds it, even where the load jumps (the film's bulk temperature from
+    20 to 220 °C at t = 100 s, which the prediction from the smooth start cannot foresee).
+    The tolerance is relative to the range the temperatures have reached."""
+
+    def heated(T, t, t_next, h):
+        def system(time):
+            return body(K_W_K * (220.0 if time > 100.0 else T_INF_C))
+        return theta_step(T, h, 1.0, system(t), lambda T1: system(t_next), solve, False)
+
+    tolerance = 1e-4
+    control = StepControl(dt_min=1e-3, dt_max=100.0, tolerance=tolerance)
+    times, temps = stepper.march_to(heated, np.array([20.5]), 0.0, 400.0, 1.0, control)
+    starts = [0.0, *times[:-1]]
+    states = [np.array([20.5]), *temps[:-1]]
+    values = np.array([20.5, *(float(T[0]) for T in temps)])
+    for i in range(1, len(times)):
+        h = times[i] - starts[i]
+        kept = values[: i + 1]  # the start and the substeps kept before this one
+        limit = stepper.BISECTION_RATIO * tolerance * max(1.0, float(np.ptp(kept)))
+        assert _doubling_error(heated, states[i], starts[i], h) <= limit * (1 + 1e-9), i
+    exact = 220.0 - 200.0 * math.exp(-300.0 / 200.0)  # from ~20.5 °C at t = 100 s
+    assert temps[-1][0] == pytest.approx(exact, abs=0.5)
+
+
+def test_march_to_lands_on_the_end_in_equal_substeps():
+    """The substeps land on the load step's end: a rest shorter than two predicted substeps
+    is split in two equal ones rather than a full one and a sliver, unless a half would be
+    below DTMIN; a response that does not change lets each size grow threefold."""
+    control = StepControl(dt_min=0.1, dt_max=4.0, tolerance=1e-3)
+    times, _ = stepper.march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 10.0, 1.0,
+                                control)
+    assert np.diff([0.0, *times]) == pytest.approx([1.0, 3.0, 3.0, 3.0], rel=1e-12)
+    assert times[-1] == 10.0
+    control = StepControl(dt_min=0.5, dt_max=0.5, tolerance=1e-3)
+    times, _ = stepper.march_to(lambda T, t, t_next, h: T, np.array([1.0]), 0.0, 1.7, 0.5,
+                                control)
+    assert np.diff([0.0, *times]) == pytest.approx([0.5, 0.5, 0.5, 0.2], rel=1e-9)
 
 
 def test_march_to_bisects_a_step_that_fails_and_gives_up_at_dt_min():

@@ -16,7 +16,8 @@ what a step needs and never touches the problem's operators.
 `theta_step` is the general form, for a system assembled by the caller at each end of the
 step: loads that change in time, and k(T), ρc(T) by Picard iteration (`picard`).
 `march_to` strings such steps from t0 to t1, at a fixed Δt or with the step size chosen
-from a step-doubling estimate of the local error (`StepControl`).
+from a step-doubling estimate of the local error, bisected when it is too large
+(`StepControl`).
 """
 
 from __future__ import annotations
@@ -156,18 +157,40 @@ OPEN_UP_FACTOR = 3.0
 OPNCONTROL,OPENUPFACTOR default for thermal analyses."""
 
 
+BISECTION_RATIO = 2.0
+"""Under `StepControl` a substep whose error estimate exceeds this × the tolerance is redone
+at half the size (time step bisection); within it the estimate only predicts the next size."""
+
+
 @dataclass(frozen=True)
 class StepControl:
     """Automatic time stepping as MAPDL's AUTOTS documents it: time step *prediction*
-    (each next size from the last step) and *bisection* (a failed step redone with half
-    the size).  The prediction here is the step-doubling estimate of the last step's local
-    error against `tolerance` (°C); a step fails when its iteration does not converge.
-    Sizes stay within [dt_min, dt_max] (s) and grow at most `growth` times a step."""
+    (each next size from the last step's response) and *bisection* (a substep redone with
+    half the size).  The response measured is the step-doubling estimate of the substep's
+    local error (one step of h against two of h/2, the largest nodal difference), against
+    `tolerance` × the temperature range of the problem: `scale` (°C, what its loads and
+    start span) or, when wider, the range its temperatures have reached in the substeps
+    kept so far (a heat-driven rise), and at least 1 °C.  A smooth response grows the
+    size, at most `growth` times a step; a substep whose estimate exceeds
+    `BISECTION_RATIO` × the tolerance, or whose iteration does not converge, is bisected.
+    Sizes stay within [dt_min, dt_max] (s)."""
 
     dt_min: float
     dt_max: float
     tolerance: float
+    scale: float = 1.0
     growth: float = OPEN_UP_FACTOR
+
+
+def _next_size(h: float, remaining: float, dt_min: float) -> float:
+    """The next substep from the predicted size `h` so that the substeps land on the load
+    step's end: the rest in one substep when it fits, in two equal ones when it is less than
+    two (rather than a sliver after a full one), unless a half would be below dt_min."""
+    if remaining <= h:
+        return remaining
+    if remaining < 2.0 * h and 0.5 * remaining >= dt_min:
+        return 0.5 * remaining
+    return h
 
 
 def march_to(
@@ -180,41 +203,52 @@ def march_to(
 ) -> tuple[list[float], list[np.ndarray]]:
     """Steps from time t0 to t1 (s): `step(T, t, t_next, h)` advances T by h = t_next − t.
     Without `control` every step is `dt` (the last one shortened to land on t1).  With it
-    the first substep is `dt` (DELTIM's DTIME is "the starting time substep"); each step is
-    taken as one step of h and two of h/2 (the two halves are kept), and their difference,
-    the local error estimate, predicts the next h.  A step is redone with h/2 only when
-    `step` raises `SteppingError` (not converging), down to dt_min.  Returns the end time
-    and temperature of every step; the last time is t1 exactly."""
+    the first substep is `dt` (DELTIM's DTIME is "the starting time substep": bisected only
+    when it does not converge), each substep is taken as one step of h and two of h/2 (the
+    two halves are kept), and their difference, the local error estimate, predicts the next
+    h or bisects the substep (`StepControl`); at dt_min a substep is kept as it is, or, when
+    it does not converge, the `SteppingError` goes out.  Returns the end time and
+    temperature of every step; the last time is t1 exactly."""
     times: list[float] = []
     temps: list[np.ndarray] = []
     t, T = t0, T0
     h = dt
+    low = float(np.min(T0)) if T0.size else 0.0
+    high = float(np.max(T0)) if T0.size else 0.0
     while t < t1 - 1e-12 * max(1.0, abs(t1)):
         if len(times) >= MAX_SUBSTEPS:
             raise SteppingError(f"more than {MAX_SUBSTEPS} substeps in one load step")
-        h = min(h, t1 - t)
         if control is None:
+            h = min(h, t1 - t)
             T = step(T, t, t + h, h)
             t += h
             times.append(t)
             temps.append(T)
             continue
+        h = _next_size(h, t1 - t, control.dt_min)
+        at_min = h <= control.dt_min * (1 + 1e-9)
         try:
             full = step(T, t, t + h, h)
             half = step(T, t, t + 0.5 * h, 0.5 * h)
             half = step(half, t + 0.5 * h, t + h, 0.5 * h)
         except SteppingError:
-            if h <= control.dt_min * (1 + 1e-9):
+            if at_min:
                 raise
             h = max(control.dt_min, 0.5 * h)  # bisection
             continue
-        error = float(np.max(np.abs(full - half)))
+        error = float(np.max(np.abs(full - half))) if half.size else 0.0
+        tolerance = control.tolerance * max(control.scale, high - low, 1.0)
+        if error > BISECTION_RATIO * tolerance and times and not at_min:
+            h = max(control.dt_min, 0.5 * h)  # bisection
+            continue
+        if half.size:
+            low, high = min(low, float(np.min(half))), max(high, float(np.max(half)))
         t += h
         T = half  # the more accurate of the two
         times.append(t)
         temps.append(T)
         # local error ∝ h² (θ = 1) or h³ (θ = ½): the square root is the cautious guess
-        factor = control.growth if error == 0.0 else 0.9 * np.sqrt(control.tolerance / error)
+        factor = control.growth if error == 0.0 else 0.9 * np.sqrt(tolerance / error)
         h = min(control.dt_max, max(control.dt_min, h * min(control.growth, factor)))
     if times:
         times[-1] = t1
