@@ -467,7 +467,11 @@ class SolutionSettings:
     nsubst: int | None = None
     kbc: int = 0
     timint: bool | None = None  # None: the default of the analysis type
-    autots: bool | None = None  # None: MAPDL's default (on for a thermal transient)
+    # None: no AUTOTS given, stepped at fixed substeps as with AUTOTS,OFF.  MAPDL's own
+    # default (program-chosen, adaptive for most thermal transients) is not emulated: a
+    # deck that wants adaptive steps says AUTOTS,ON (the twin's window decks need fixed
+    # 4 s steps and say nothing)
+    autots: bool | None = None
     dtmin: float | None = None  # DELTIM bounds (with AUTOTS)
     dtmax: float | None = None
     nsub_max: int | None = None  # NSUBST bounds (with AUTOTS)
