@@ -1,5 +1,7 @@
 """The per-window correction methods, closed loop on a lumped plant with a known truth."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -572,4 +574,22 @@ def test_ratio_holds_what_a_sensor_lost_mid_window_corrects():
     g = WindowFeatures(10, 600.0, SPEED, AMBIENT, t, T, f.simulated_time_s, f.simulated_C,
                        nominal, f.previous, previous_factors=f.previous_factors)
     factors = np.array(RatioCorrection().correct(g).values) / np.array(nominal)
+    assert factors == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)
+
+
+def test_anchored_bpnn_networks_read_nothing_of_a_sensor_lost_mid_window():
+    """The logger stops 30 s before the window start: the anchor holds (ratio_anchor leaves
+    the sensors out), and so must the networks: their inputs are lines through the same
+    window, and read on the first half they stood for the second (the `ratio` method's and
+    the paper configuration's rule, which quality.json's correction_held tells)."""
+    f, nominal = _gap_features()
+    t, T = _measured()
+    T = T[t <= 600].copy()
+    T[t[t <= 600] > 570] = np.nan
+    g = dataclasses.replace(f, measured_C=T)
+    assert not g.seen_in_last_window()[:4].any()
+    method = make_corrector("bpnn", model=_ConstantCorrection())
+    method.anchor_factors = np.array(f.previous_factors)
+    factors = np.array(method.correct(g).values) / np.array(nominal)
+    # held, not the networks' 1.2 on the anchor
     assert factors == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)

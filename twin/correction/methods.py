@@ -384,7 +384,9 @@ class BpnnCorrection:
                 self.anchor_factors = np.ones(4)
             # without usable inputs the network's correction is none: the anchor itself
             fallback = ratio_anchor(features, self.anchor_factors)
-            inputs = features.anchored_inputs(fallback)
+            # as the anchor: a sensor not measured through the last window gives no input
+            # (a line through half a window would stand for the whole), the anchor stands
+            inputs = features.without_dead_sensors().anchored_inputs(fallback)
             self.anchor_factors = correction_factors(fallback, nominal,
                                                      fallback=self.anchor_factors)
         else:
