@@ -392,6 +392,27 @@ def test_an_unreachable_dask_scheduler_leaves_no_out_folder(monkeypatch, tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]
 
 
+def test_ctrl_c_while_connecting_to_the_dask_scheduler_leaves_no_out_folder(monkeypatch,
+                                                                           tmp_path):
+    # the connection (up to 20 s, "connecting to the dask scheduler at ...") comes before
+    # DIR is made; a Ctrl-C there rebuilt the report of a DIR nothing had been written to
+    # and so made it, with an empty summary.json and report.html
+    import dask.distributed
+
+    from twin.data import bundled_path
+
+    def interrupted(address, timeout):  # noqa: ANN001, ANN202 - stands in for Client
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(dask.distributed, "Client", interrupted)
+    run = bundled_path("runs", "spindle_9000rpm_30min.csv")
+    result = CliRunner().invoke(app, ["replay", str(run), "--out", str(tmp_path / "out"),
+                                      "--dask", "tcp://127.0.0.1:8786"])
+    assert result.exit_code == 130, result.output
+    assert "interrupted" in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     # R² printed to 16 digits, and nothing said that the gate had zeroed every network
     from twin.correction.modelfile import load_model

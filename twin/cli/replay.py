@@ -130,8 +130,11 @@ def replay(
             )
         except KeyboardInterrupt:
             # the run under way went with its folder (a failed rerun leaves no earlier
-            # result standing): summary.json and report.html must not list that result
-            build_report(out)
+            # result standing): summary.json and report.html must not list that result.
+            # No DIR yet (a Ctrl-C while the dask scheduler was reached): nothing to list,
+            # and rebuilding would make DIR with an empty report
+            if out.is_dir():
+                build_report(out)
             raise
     build_report(out, rebuild_summary=False)
     for failure in result.failed:
