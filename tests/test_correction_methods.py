@@ -593,3 +593,30 @@ def test_anchored_bpnn_networks_read_nothing_of_a_sensor_lost_mid_window():
     factors = np.array(method.correct(g).values) / np.array(nominal)
     # held, not the networks' 1.2 on the anchor
     assert factors == pytest.approx([1.07, 0.95, 1.2, 0.9], rel=1e-12)
+
+
+def test_a_slow_jittery_logger_still_observes_its_windows():
+    # at 0.1 Hz (the slowest rate a run may have) a 20 s bin holds two rows, and ±0.3 s of
+    # time-stamp jitter left one in every other bin: ratio and bpnn held their corrections
+    # in 21 of 29 windows of a clean run (and the estimator dropped those bins)
+    from twin.correction.features import min_bin_samples, window_observed
+
+    rng = np.random.default_rng(3)
+    slow = np.arange(0.0, 130.0, 10.0) + np.r_[0.0, rng.uniform(-0.3, 0.3, 12)]
+    # (20, 40] holds one row (30.2; the one at 40 came out at 40.05)
+    assert ((slow > 20) & (slow <= 40)).sum() == 1
+    values = np.full((slow.size, 1), 25.0)
+    assert min_bin_samples(slow[(slow > 0) & (slow <= 60)]) == 1
+    assert window_observed(slow, values, 60.0).all()
+    # 1 Hz: a lone valid sample in a bin is still too little
+    fast = np.arange(0.0, 121.0)
+    lone = np.full((fast.size, 1), np.nan)
+    lone[(fast > 0) & (fast <= 60)] = 25.0
+    lone[(fast > 20) & (fast <= 39)] = np.nan  # (20, 40] keeps only t = 40
+    assert min_bin_samples(fast) == 2
+    assert not window_observed(fast, lone, 60.0).all()
+    lone[(fast > 20) & (fast <= 38)] = np.nan
+    lone[38] = 25.0  # two valid samples: observed
+    assert window_observed(fast, lone, 60.0).all()
+    assert min_bin_samples(np.arange(0.0, 60.0, 5.0)) == 2  # 0.2 Hz: four rows a bin
+    assert min_bin_samples(np.array([1.0])) == 2

@@ -282,10 +282,10 @@ from threadpoolctl import threadpool_limits
 
 from twin.contract import STEP_S, STEPS_PER_WINDOW, WINDOW_S
 from twin.correction.features import (
-    MIN_BIN_SAMPLES,
     OBSERVATION_BINS,
     WindowFeatures,
     bin_mean,
+    min_bin_samples,
 )
 from twin.correction.rerun import (
     first_window_at_speed,
@@ -350,7 +350,7 @@ class EstimatorConfig:
     the lag sensor_lag_s); False: the metal temperature at their points."""
     bins_per_window: int = OBSERVATION_BINS
     """Observation bins per 60 s window; each bin's mean is one observation per sensor
-    (one with fewer than `MIN_BIN_SAMPLES` valid samples is none)."""
+    (one with fewer than `min_bin_samples` valid samples is none)."""
     initial_field_sd_C: float = 0.2
     """Uncertainty of the uniform start field (the mean of the first T1..T5)."""
     drift_rel_sd: float = 0.01
@@ -675,11 +675,13 @@ class EnsembleEstimator:
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
         meas = np.asarray(f.measured_C, float)
+        in_read = (t_meas > read_t[0] - cfg.step_s + 1e-9) & (t_meas <= read_t[-1] + 1e-9)
+        needed = min_bin_samples(t_meas[in_read], cfg.window_s)
         y_mean, y_anom, observed, sd = [], [], [], []
         for i, b in enumerate(bins):
             lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
             m, counts = bin_mean(t_meas, meas, lo, hi)
-            observed.append(np.where(counts >= MIN_BIN_SAMPLES, m, np.nan))
+            observed.append(np.where(counts >= needed, m, np.nan))
             y_mean.append(read[b].mean(axis=0))
             anom = 0.5 * (fc.sensors_anomalies_C[i] + fc.sensors_anomalies_C[i + 1])
             if lag_anomalies is not None:  # a member reads its metal with its own lag
@@ -696,8 +698,8 @@ class EnsembleEstimator:
                 lo, hi = read_t[b[0]] - cfg.step_s, read_t[b[-1]]
                 m, counts = bin_mean(t_meas, np.asarray(f.measured_drift_um, float)[:, None],
                                      lo, hi)
-                observed.append(np.where(counts >= MIN_BIN_SAMPLES, m, np.nan))
-                drift_seen |= bool(counts[0] >= 2)
+                observed.append(np.where(counts >= needed, m, np.nan))
+                drift_seen |= bool(counts[0] >= needed)
                 y_mean.append(drift[b].mean(keepdims=True))
                 y_anom.append(0.5 * (drift_anom[i] + drift_anom[i + 1])[None, :])
                 sd.append(np.sqrt(cfg.drift_model_sd_um**2 + (cfg.drift_rel_sd * m) ** 2

@@ -301,7 +301,8 @@ def held_correction_findings(run: RecordedRun) -> list[dict]:
             "it corrects; the estimator leaves its unobserved bins out",
             spans_s=[(ends[a], ends[b] + WINDOW_S) for a, b in stretches],
             count=int(unseen[:, column].sum()),
-            detail=f"fewer than {MIN_BIN_SAMPLES} valid samples in a "
+            detail=f"fewer than {MIN_BIN_SAMPLES} valid samples (1 where the logger writes "
+                   f"fewer than {2 * MIN_BIN_SAMPLES} rows in it) in a "
                    f"{WINDOW_S / OBSERVATION_BINS:g} s bin of the {WINDOW_S:g} s before the "
                    f"start of window {windows}"))
     return found
