@@ -157,7 +157,7 @@ class RatioCorrection:
     at another speed, where the next change read it back the other way.  With the speed
     changing every 20-40 s (every window) the front heat factor swung 0.76 <-> 1.74 on a
     run whose true factor is 1, and `ratio` scored below open loop in temperature (97.39
-    against 98.01 %).  Re-run with the recorded speed, t_f is the twin under the loads the
+    against 97.87 %, the medians of three such runs, as below).  Re-run with the recorded speed, t_f is the twin under the loads the
     spindle had, the law as the paper writes it compares like with like, and a window
     without a change is untouched.  False: the forecast, as until 2026-11-27.
 
