@@ -157,9 +157,10 @@ class RatioCorrection:
     at another speed, where the next change read it back the other way.  With the speed
     changing every 20-40 s (every window) the front heat factor swung 0.76 <-> 1.74 on a
     run whose true factor is 1, and `ratio` scored below open loop in temperature (97.39
-    against 97.87 %, the medians of three such runs, as below).  Re-run with the recorded speed, t_f is the twin under the loads the
-    spindle had, the law as the paper writes it compares like with like, and a window
-    without a change is untouched.  False: the forecast, as until 2026-11-27.
+    against 97.87 %, the medians of three such runs, as below).  Re-run with the recorded
+    speed, t_f is the twin under the loads the spindle had, the law as the paper writes it
+    compares like with like, and a window without a change is untouched.  False: the
+    forecast, as until 2026-11-27.
 
     Measured (temperature / deformation accuracy, median / worst, %): three emulated 30-min
     runs with a new speed every 20-40 s, 97.39 / 97.39 and 92.59 / 90.06 -> 98.52 / 98.45
