@@ -253,8 +253,9 @@ class WindowFeatures:
         left out entirely (NaN): a correction then holds what that sensor would correct
         instead of reading its last value before it died.
 
-        Why: `RatioCorrection` falls back on a sensor's last valid sample when the last
-        window has none.  For a sleeve in a dropout that stale value entered the Eq. 5
+        Why: read on its last valid sample, as `RatioCorrection` was where the last window
+        had none (until 2026-11-27), a sensor in a dropout gave a stale value.  For a sleeve
+        that stale value entered the Eq. 5
         pressure factor of *now* while the factor of the window before (level minus rise,
         and the rise is unknown) was neutral, so every window of the dropout multiplied
         the resistance by the whole pressure factor since the start: a rear sleeve lost

@@ -265,12 +265,6 @@ def check_field_time(run: RecordedRun, time_s: float) -> None:
         raise ValueError(f"time {time_s:g} s is outside the replayed span (0, {span_s:g}] s")
 
 
-def measured_temperatures(run: RecordedRun) -> np.ndarray:
-    """(n, 5) T1..T5 as the corrections read them: NaN where the data-quality check marks
-    a sample invalid (a long dropout's or gap's fill, a stuck or dead sensor)."""
-    return np.where(run.valid_T, run.T_C, np.nan)
-
-
 HELD_CORRECTION = "correction_held"
 """quality.json kind of `held_correction_findings`."""
 
@@ -283,7 +277,7 @@ def held_correction_findings(run: RecordedRun) -> list[dict]:
     They compute nothing from it there and hold what it corrects; the estimator leaves
     its unobserved bins out of its update.  Spans are the held windows' [start, end) in
     run time."""
-    measured = measured_temperatures(run)
+    measured = run.T_valid_C
     ends = WINDOW_S * np.arange(1, n_windows(run))  # window k's correction reads up to 60k s
     lo = np.searchsorted(run.time_s, ends - WINDOW_S - 1e-9, side="right")
     hi = np.searchsorted(run.time_s, ends + 1e-9, side="right")
@@ -310,7 +304,7 @@ def held_correction_findings(run: RecordedRun) -> list[dict]:
 
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
-    T0 = np.where(first.valid_T[0], first.T_C[0], np.nan)
+    T0 = first.T_valid_C[0]
     if not np.any(np.isfinite(T0)):
         return float(first.ambient_C[0])
     return float(np.nanmean(T0))
@@ -374,7 +368,7 @@ def replay_method(
     T0 = initial_temperature_C(run)
     T = np.full(model.n_dofs, T0)
 
-    measured_T = measured_temperatures(run)
+    measured_T = run.T_valid_C
     measured_drift = None
     if run.disp_um is not None and "disp_z_um" in run.valid:
         measured_drift = np.where(run.valid["disp_z_um"], run.disp_um[:, 2], np.nan)

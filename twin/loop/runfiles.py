@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from twin.contract import SENSOR_NAMES, WINDOW_S
+from twin.correction.features import first_finite
 from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
 from twin.loop.folders import replaced_folder
@@ -42,7 +43,6 @@ from twin.loop.replay import (
     MethodReplay,
     deck_window_solver,
     held_correction_findings,
-    measured_temperatures,
     method_replay_from_json,
     method_replay_to_json,
     replay_method,
@@ -394,17 +394,13 @@ def measured_reference(
     """What a replay is compared with at `time_s`: T1..T5 (k, 5) and the axial drift (k,)
     (NaN where invalid; None if not recorded), and T1..T5 at the run start (5,)."""
     measured = run.at(time_s)
-    meas_T = np.where(measured.valid_T, measured.T_C, np.nan)
+    meas_T = measured.T_valid_C
     meas_drift = None
     if measured.disp_um is not None and "disp_z_um" in measured.valid:
         meas_drift = np.where(measured.valid["disp_z_um"], measured.disp_um[:, 2], np.nan)
-    start = run.before(np.array([run.time_s[0]]))
-    meas_T0 = np.where(start.valid_T[0], start.T_C[0], np.nan)
+    meas_T0 = run.before(np.array([run.time_s[0]])).T_valid_C[0]
     if np.any(~np.isfinite(meas_T0)):  # a sensor that starts invalid: its first good value
-        good = measured_temperatures(run)
-        for i in np.where(~np.isfinite(meas_T0))[0]:
-            finite = np.isfinite(good[:, i])
-            meas_T0[i] = good[finite, i][0] if finite.any() else np.nan
+        meas_T0 = np.where(np.isfinite(meas_T0), meas_T0, first_finite(run.T_valid_C))
     return meas_T, meas_T0, meas_drift
 
 

@@ -134,7 +134,7 @@ class WindowFit:
     def _fit(self, f: WindowFeatures, nominal: np.ndarray) -> np.ndarray:
         times = f.start_s + STEP_S * np.arange(1, STEPS_PER_WINDOW + 1)
         measured = self.run.at(times)
-        target = np.where(measured.valid_T, measured.T_C, np.nan)[:, FIT_SENSORS]
+        target = measured.T_valid_C[:, FIT_SENSORS]
         seen = np.isfinite(target)
         theta = self._theta.copy()  # warm start: the values change slowly window to window
         if not seen.any():

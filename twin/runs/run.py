@@ -52,6 +52,12 @@ class Samples:
         """(n, 5) validity of T1..T5."""
         return np.stack([self.valid[n] for n in TEMPERATURES], axis=1)
 
+    @property
+    def T_valid_C(self) -> np.ndarray:
+        """(n, 5) T1..T5 as the twin reads them: NaN where the data-quality check marks a
+        sample invalid (a long dropout's or gap's fill, a stuck or dead sensor), °C."""
+        return np.where(self.valid_T, self.T_C, np.nan)
+
     def column(self, name: str) -> np.ndarray:
         """A column by its file name (`T3_C`, `disp_z_um`, ...)."""
         if name in TEMPERATURES:
