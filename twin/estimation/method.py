@@ -269,7 +269,7 @@ Band
     T1's median half-width 0.29 → 0.18 K on 381966.  Where the speed changes every
     20–40 s, every window a surprise, the pooled coverage is 86.4–86.7 % (was 88.7–89.7 %):
     the conformal step alone has to learn how often the speed changes, which it does in
-    the run's first five minutes (coverage 63–76 % there, 84–100 % later).  Both steps are
+    the run's first five minutes (coverage 63–76 % there, 70–100 % later).  Both steps are
     taken for each thermocouple and for the drift separately: the rings' misfit after a
     speed change is kelvins where the housing's is a tenth of one.  With a fixed model error
     a quiet run (0.02 K noise) was covered 100 % and a rough one 80 %; with both steps the
