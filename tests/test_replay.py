@@ -285,6 +285,69 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
 
 
 
+def test_resume_replays_a_run_that_other_code_replayed(runs_dir, tmp_path, monkeypatch):
+    """The resume token names the code: a folder whose token an earlier release wrote
+    (input, methods and model only, as before 2026-11-27) or that code with other sources
+    wrote is replayed again, not kept silently with results the methods no longer give;
+    one the same code wrote is kept."""
+    from twin.loop import runfiles
+    from twin.loop.batch import replay_batch
+
+    out = tmp_path / "out"
+    run = runs_dir / "hot_9000.csv"
+    assert replay(run, out=out, methods="open_loop").exit_code == 0
+    done = out / "hot_9000" / ".done.json"
+    token = json.loads(done.read_text())
+    assert token["code"] == runfiles.code_identity()
+    assert len(token["code"]["sources_sha256"]) == 64
+
+    def resumed() -> list[str]:
+        return replay_batch([run], out, ["open_loop"], None, resume=True).skipped
+
+    assert resumed() == ["hot_9000"]
+    # the token the code before this one wrote
+    done.write_text(json.dumps({"input_sha256": token["input_sha256"],
+                                "methods": ["open_loop"]}))
+    assert resumed() == []
+    assert json.loads(done.read_text()) == token  # written anew by this code
+    # other sources, same version string
+    other = {**token["code"], "sources_sha256": "0" * 64}
+    monkeypatch.setattr(runfiles, "code_identity", lambda: other)
+    assert resumed() == []
+    assert json.loads(done.read_text())["code"] == other
+    assert resumed() == ["hot_9000"]
+
+
+def test_the_sources_digest_follows_the_bytes_not_the_place(tmp_path):
+    from twin.version import sources_digest
+
+    def package(where):  # noqa: ANN001, ANN202
+        root = where / "twin"
+        (root / "loop" / "__pycache__").mkdir(parents=True)
+        (root / "data" / "meshes").mkdir(parents=True)
+        (root / "__init__.py").write_text("")
+        (root / "loop" / "replay.py").write_text("HOLD = True\n")
+        (root / "loop" / "__pycache__" / "replay.cpython-311.pyc").write_bytes(b"\0")
+        (root / "data" / "meshes" / "spindle.toml").write_text("[spindle]\n")
+        (root / "data" / "runs.csv").write_text("time_s\n")
+        return root
+
+    a, b = package(tmp_path / "a"), package(tmp_path / "b")
+    digest = sources_digest({"twin": a})
+    assert digest == sources_digest({"twin": b})  # another install of the same code
+    (b / "loop" / "__pycache__" / "replay.cpython-311.pyc").write_bytes(b"\1")
+    (b / "data" / "runs.csv").write_text("time_s,x\n")  # no source, no mesh
+    assert sources_digest({"twin": b}) == digest
+    (b / "loop" / "replay.py").write_text("HOLD = False\n")
+    assert sources_digest({"twin": b}) != digest
+    (b / "loop" / "replay.py").write_text("HOLD = True\n")
+    (b / "data" / "meshes" / "spindle.toml").write_text("[spindle]\nr = 1\n")
+    assert sources_digest({"twin": b}) != digest
+    (b / "data" / "meshes" / "spindle.toml").write_text("[spindle]\n")
+    (b / "loop" / "replay.py").rename(b / "loop" / "other.py")  # a module's name counts
+    assert sources_digest({"twin": b}) != digest
+
+
 def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path):
     # `--resume --snapshots every` after a `--snapshots none` batch skipped every run and
     # left it without a single picture

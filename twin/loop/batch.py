@@ -2,8 +2,8 @@
 
 One failing run never stops the others: its error is recorded in summary.json
 ("failed") and the batch goes on.  A finished run folder carries a `.done.json` token
-(input and model digests, methods), written last; --resume skips runs whose token
-matches.
+(input and model digests, methods, the code's version and source digest), written last;
+--resume skips runs whose token matches.
 """
 
 from __future__ import annotations
