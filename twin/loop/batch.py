@@ -287,11 +287,13 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
             _tell(progress, outcome)
             yield outcome
         return
+    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed  # --jobs only
 
     # the workers leave Ctrl-C (sent to the whole process group) to this process, which
     # ends them: interrupted on their own, a worker between runs died with a traceback, and
     # the others went on with the queued runs while the pool's shutdown waited for them
+    earlier = set(multiprocessing.active_children())
     with ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
                              initializer=_ignore_interrupts) as pool:
         try:
@@ -302,8 +304,12 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
                 _tell(progress, outcome)
                 yield outcome
         except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
-            # ProcessPoolExecutor has no public way to end its workers before Python 3.14
-            for worker in list(pool._processes.values()):
+            # the pool's workers: the children started since it was made (it starts them
+            # in `submit`, all at the first under fork, as needed otherwise; nothing else
+            # here starts one).  ProcessPoolExecutor has no public way to end its workers
+            # before Python 3.14 (`terminate_workers`); `multiprocessing.active_children`
+            # is public and names them
+            for worker in set(multiprocessing.active_children()) - earlier:
                 worker.terminate()
             pool.shutdown(wait=True, cancel_futures=True)
             raise
