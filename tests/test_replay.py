@@ -438,6 +438,56 @@ def test_ctrl_c_stops_the_worker_processes_and_their_queued_runs(runs_dir, tmp_p
     assert [p.name for p in out.iterdir() if p.name.startswith(".")] == []
     assert all(p.name in done for p in out.iterdir() if p.is_dir())
 
+def _batch_clients(cluster, earlier: set) -> list[str]:  # noqa: ANN001 - a LocalCluster
+    """The clients a batch left connected to the cluster's scheduler: those beside
+    `earlier` but the workers' own (a run's stop `Event` opens one in its worker)."""
+    return [c for c in cluster.scheduler.clients
+            if c not in earlier and not c.startswith("Client-worker-")]
+
+
+class _FakeClient:
+    """Stands in for a connected dask client where a batch stops before it runs a job."""
+
+    def __init__(self) -> None:
+        self.closed = 0
+
+    def close(self) -> None:
+        self.closed += 1
+
+    def __enter__(self) -> _FakeClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+@pytest.mark.parametrize("stop", ["out is a file", "ctrl-c while planning"])
+def test_a_dask_batch_that_stops_before_its_runs_closes_its_client(runs_dir, tmp_path,
+                                                                   monkeypatch, stop):
+    # the client's lifetime was split: replay_batch closed it when the set-up failed,
+    # _execute after the runs; one owner (`dask_session`) closes it once on every path
+    import twin.loop.batch as batch
+
+    client = _FakeClient()
+    monkeypatch.setattr(batch, "dask_client", lambda address: client)
+    out = tmp_path / "out"
+    if stop == "out is a file":
+        out.write_text("")
+        expected: type[BaseException] = FileExistsError
+    else:
+        def interrupted(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(batch, "_finished", interrupted)
+        expected = KeyboardInterrupt
+    with pytest.raises(expected):
+        batch.replay_batch([runs_dir / "hot_9000.csv"], out, ["open_loop"], None,
+                           dask_address="tcp://127.0.0.1:8786", resume=True)
+    assert client.closed == 1
+    # nothing was replayed, so nothing was cleaned up (no lock file made)
+    assert out.is_file() or sorted(p.name for p in out.iterdir()) == []
+
+
 @pytest.mark.slow
 def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
     from dask.distributed import Client, LocalCluster
@@ -457,9 +507,11 @@ def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
         ) as cluster,
         Client(cluster),
     ):
+        clients = set(cluster.scheduler.clients)
         dsk = replay_batch(
             runs, tmp_path / "dask", ["ratio"], None, dask_address=cluster.scheduler_address
         )
+        assert _batch_clients(cluster, clients) == []  # the batch closed its client
     assert not seq.failed and not par.failed and not dsk.failed
     # deterministic: the same inputs give the same numbers whichever way they ran
     assert seq.accuracies == par.accuracies == dsk.accuracies
@@ -491,9 +543,11 @@ def test_ctrl_c_of_a_dask_batch_ends_the_runs_the_cluster_had_started(runs_dir, 
                      dashboard_address=None) as cluster,
         Client(cluster) as client,
     ):
+        clients = set(cluster.scheduler.clients)
         with pytest.raises(KeyboardInterrupt):
             replay_batch(runs, out, ["open_loop", "ratio"], None, fields="none",
                          dask_address=cluster.scheduler_address, progress=ctrl_c)
+        assert _batch_clients(cluster, clients) == []
         deadline = time.monotonic() + 60
         while any(client.processing().values()) and time.monotonic() < deadline:
             time.sleep(0.2)
