@@ -877,8 +877,24 @@ def test_a_logger_gap_holds_ratio_and_bpnn_and_quality_json_says_which_windows(
     findings = json.loads((tmp_path / "out" / "gap" / "quality.json").read_text())["findings"]
     held = {f["column"]: f for f in findings if f["kind"] == HELD_CORRECTION}
     assert sorted(held) == ["T1_C", "T2_C", "T3_C", "T4_C"]
-    assert all(f["spans_s"] == [[180.0, 300.0]] and f["count"] == 2 for f in held.values())
+    # two windows, told as windows: every other finding's `count` is of samples
+    assert all(f["spans_s"] == [[180.0, 300.0]] and f["count_windows"] == 2
+               and "count" not in f for f in held.values())
+    assert all("count" in f for f in findings if f["kind"] != HELD_CORRECTION)
     assert "window 3-4" in held["T1_C"]["detail"]
+    # the methods that held, and only those
+    assert held["T1_C"]["action"] == ("ratio computes nothing from this sensor in these "
+                                      "windows and holds what it corrects")
+    assert "<td>T1_C</td><td>correction_held</td><td>2 windows</td><td>180–300</td>" in \
+        (tmp_path / "out" / "report.html").read_text()
+    # no method that holds a correction ran: nothing was held
+    result = replay(path, out=tmp_path / "none", methods="open_loop,estimator")
+    assert result.exit_code == 0, result.output
+    findings = json.loads((tmp_path / "none" / "gap" / "quality.json").read_text())["findings"]
+    assert [f for f in findings if f["kind"] == HELD_CORRECTION] == []
+    assert {f["kind"] for f in findings} == {
+        f["kind"] for f in json.loads((tmp_path / "out" / "gap" / "quality.json")
+                                      .read_text())["findings"]} - {HELD_CORRECTION}
     clean = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
     assert not [f for f in clean if f["kind"] == HELD_CORRECTION]
 

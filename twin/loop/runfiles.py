@@ -244,7 +244,7 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     plots.start(str(out_dir))
     if snapshots != "none":
         _write_snapshots(out_dir, model, results[primary], snapshots, title=run.name)
-    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run)]),
+    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods)]),
                   out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
