@@ -68,8 +68,7 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
     if quiet:
         return
     for f in data.findings:
-        typer.echo(f"note: {f['file']}, column {f['column']!r}, rows {f['first_row']}–"
-                   f"{f['last_row']}: {f['repair']}", err=True)
+        typer.echo(f"note: {f['where']}: {f['repair']}", err=True)
     for name, why in data.left_out.items():
         typer.echo(f"note: temperature column {name!r} left out: {why}", err=True)
 
