@@ -288,6 +288,7 @@ def test_a_report_tells_what_a_findings_count_counts_in_files_of_any_release():
             "spans_s": [[180.0, 300.0]], "action": "held", "detail": ""}
     assert _finding_row({**held, "count_windows": 2})["count"] == "2 windows"
     assert _finding_row({**held, "count": 2})["count"] == "2 windows"  # an earlier file
+    assert _finding_row({**held, "count_windows": 1})["count"] == "1 window"
     stuck = {**held, "kind": "stuck", "count": 76}
     assert _finding_row(stuck)["count"] == "76"
     assert _finding_row({"kind": "noisy"})["count"] == ""

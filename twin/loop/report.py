@@ -319,8 +319,10 @@ def _finding_row(finding: object) -> dict[str, str]:
     shown = ", ".join(spans[:MAX_SPANS_SHOWN]) + (" …" if len(spans) > MAX_SPANS_SHOWN else "")
     # the column is "samples": a count of anything else says what it counts ("2 windows")
     count, counted = finding_count(finding)
-    count_cell = "" if count is None else str(count) if counted == SAMPLES \
-        else f"{count} {counted}"
+    if count is None or counted == SAMPLES:
+        count_cell = "" if count is None else str(count)
+    else:  # "2 windows", "1 window"
+        count_cell = f"{count} {counted.removesuffix('s') if count == 1 else counted}"
     return {"column": str(finding.get("column", "")), "kind": str(finding.get("kind", "")),
             "count": count_cell, "spans": shown,
             "action": str(finding.get("action", "")), "detail": str(finding.get("detail", ""))}
