@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from twin.errors import InputError, report_errors, run_console_script
+from twin.helptext import PlainHelpCommand
 from twin.io.destinations import check_out_dir, check_out_file
 from twin.log import send_warnings_to_log
 from twin.paths import check_input_file, regular_file_info
@@ -49,7 +50,7 @@ def _options(
     pass
 
 
-@app.command("run")
+@app.command("run", cls=PlainHelpCommand)
 @report_errors
 def run(
     deck: Path = typer.Argument(..., metavar="DECK", help="The APDL deck (.inp, .mac, "
@@ -126,7 +127,7 @@ def _spindle_session(base_dir: Path, strict: bool) -> Session:
     return session
 
 
-@app.command("export-cdb")
+@app.command("export-cdb", cls=PlainHelpCommand)
 @report_errors
 def export_cdb(
     out: Path = typer.Option(..., "--out", help="The archive to write (.cdb)."),

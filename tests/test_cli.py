@@ -849,3 +849,46 @@ def test_a_bad_option_value_the_command_finds_ends_as_clicks_own(tmp_path, args,
     from twin.errors import InputError, _help_hint
 
     assert _help_hint(InputError("beyond the run", file="run.csv", column="--time")) == ""
+
+
+@pytest.mark.parametrize("usage, command", list(_leaf_commands()),
+                         ids=[usage for usage, _ in _leaf_commands()])
+def test_help_names_arguments_plainly_at_80_columns(usage, command):
+    # typer 0.2x wrote `Usage: twin report [OPTIONS] {DIR}`, listed `RUN <list[Path]>` and
+    # `DIR <path>` under Arguments, and `--time <float range>`: a Python type where
+    # DESIGN.md names the argument
+    import re
+
+    from apdl_like.cli import app as apdl_app
+
+    prog, *path = usage.split()
+    root = apdl_app if prog == "apdl-like" else app
+    result = CliRunner().invoke(root, [*path, "--help"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    text = result.output
+    assert not re.search(r"[{}]|<list\[| range>|\[Path\]", text), text
+    assert max(len(line) for line in text.splitlines()) <= 80
+    usage_line = " ".join(text.split("\n\n")[0].split())
+    assert "<" not in usage_line, usage_line
+    arguments = text.split("Arguments:\n")[1].split("\n\n")[0] if "Arguments:" in text else ""
+    # each argument row starts with its bare name: no type after it
+    for row in arguments.splitlines():
+        if row.startswith("  ") and not row.startswith("   "):
+            assert re.match(r"  [A-Z]+(\.\.\.)?  +\S", row) and "<" not in row.split("  ")[1], row
+
+
+@pytest.mark.parametrize("path, usage, rows", [
+    (["replay"], "twin replay [OPTIONS] [RUN]...", ["  RUN...  recorded runs"]),
+    (["report"], "twin report [OPTIONS] DIR", ["  DIR  a replay output folder"]),
+    (["train"], "twin train [OPTIONS] RUN...", ["  RUN...  Recorded runs", "--gate-runs RUN "]),
+    (["snapshot"], "twin snapshot [OPTIONS] RUN", ["  --time <float> "]),
+    (["drift", "predict"], "twin drift predict [OPTIONS] MODEL DATA",
+     ["  MODEL  Drift model file.", "  DATA   Data file"]),
+    (["drift", "report"], "twin drift report [OPTIONS] MODEL DATA...", ["  DATA...  Data"]),
+])
+def test_help_shows_arguments_as_design_names_them(path, usage, rows):
+    result = CliRunner().invoke(app, [*path, "--help"], env={"COLUMNS": "80"})
+    assert result.exit_code == 0, result.output
+    assert f"Usage: {usage}\n" in result.output, result.output
+    for row in rows:
+        assert row in result.output, (row, result.output)

@@ -263,7 +263,7 @@ def test_a_file_too_short_for_a_validation_block_is_bad_input(tmp_path):
     result = run("fit", str(first), str(second), "--target", "drift_um", "--out", str(out),
                  "--method", "ridge_dynamic")
     assert result.exit_code == 2, result.output
-    assert (f"{second}, column 'drift_um': only 1 row holds every target; need at least 20 "
+    assert (f"{second}, column 'drift_um': only 1 sample holds every target; need at least 20 "
             "in every file") in " ".join(result.output.split())
     assert "Traceback" not in result.output and not out.exists()
 
@@ -312,7 +312,7 @@ def test_an_empty_speed_column_is_no_speed_column(tmp_path):
     assert result.exit_code == 0, result.output
     assert "ridge_lagged" in result.output and "ridge_dynamic" not in result.output
     message = " ".join(result.output.split())
-    assert (f"note: {second}, column 'speed_rpm', rows 2–241: no value in any row: read as "
+    assert (f"note: {second}, lines 2–241, column 'speed_rpm': no value at all: read as "
             "no speed column") in message
     pred = tmp_path / "p.csv"
     assert run("predict", str(out), str(second), "--out", str(pred)).exit_code == 0
@@ -395,7 +395,7 @@ def test_a_temperature_column_that_never_changes_is_no_sensor(tmp_path):
         result = run("fit", str(data), "--target", "drift_um", "--out", str(out),
                      "--method", "ridge_dynamic", "--sensors", sensors)
         assert result.exit_code == 0, result.output
-        assert ("note: temperature column 'K_C' left out: reads 21 in every row (tells "
+        assert ("note: temperature column 'K_C' left out: reads 21 in every sample (tells "
                 "nothing)") in " ".join(result.output.split())
         assert "K_C" not in result.output.split("sensors:")[1]
     result = run("select", str(data), "--target", "drift_um")
@@ -438,3 +438,43 @@ def test_predictions_keep_a_unix_time_as_read(machine, tmp_path):
     result = run("predict", str(model), str(data), "--out", str(pred))
     assert result.exit_code == 2 and "time 1700000090.25 s repeats that of line 8" in (
         " ".join(result.output.split()))
+
+
+def test_notes_name_file_line_and_column_as_the_error_messages_do(machine, tmp_path):
+    # the notes said "column 'A_C', rows 22–27" of a CSV file's lines, in the reverse order
+    # of an error ("data.csv, line 4, column 'time_s': ..."), and a gap at the start told
+    # "the rows before it" beside those line numbers
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    _, _, model = machine
+    columns = synthetic_columns(hours=0.5)
+    columns["A_C"][20:26] = np.nan  # samples 21-26: lines 22-27 under the header
+    columns["A_C"][:1] = np.nan
+    again = {k: np.concatenate([v[:60], v[50:60], v[60:]]) for k, v in columns.items()}
+    data = tmp_path / "gaps.csv"
+    write_csv(data, again)
+    pred = tmp_path / "p.csv"
+    result = run("predict", str(model), str(data), "--out", str(pred))
+    assert result.exit_code == 0, result.output
+    notes = [line for line in result.output.splitlines() if line.startswith("note:")]
+    assert notes == [
+        f"note: {data}, lines 62–71, column 'time_s': exact copies of earlier lines: dropped",
+        f"note: {data}, line 2, column 'A_C': leading gap: first reading used for the "
+        "samples before it",
+        f"note: {data}, lines 22–27, column 'A_C': gap bridged causally: last reading held",
+    ]
+    # a Parquet file's place is its data row, as in its errors
+    parquet = tmp_path / "gaps.parquet"
+    pq.write_table(pa.table(columns), parquet)
+    result = run("predict", str(model), str(parquet), "--out", str(pred))
+    assert result.exit_code == 0, result.output
+    assert f"note: {parquet}, rows 21–26, column 'A_C': gap bridged causally" in result.output
+    # the report's data findings say the same
+    report = tmp_path / "report"
+    assert run("report", str(model), str(data), "--out", str(report)).exit_code == 0
+    page = (report / "report.html").read_text()
+    assert f"{data}, lines 22–27, column &#39;A_C&#39;: gap bridged causally" in page
+    metrics = json.loads((report / "metrics.json").read_text())
+    found = metrics["data_findings"][-1]
+    assert (found["first_row"], found["last_row"], found["row_unit"]) == (22, 27, "line")

@@ -285,6 +285,69 @@ def test_resume_skips_finished_runs_and_redoes_interrupted_ones(runs_dir, tmp_pa
 
 
 
+def test_resume_replays_a_run_that_other_code_replayed(runs_dir, tmp_path, monkeypatch):
+    """The resume token names the code: a folder whose token an earlier release wrote
+    (input, methods and model only, as before 2026-11-27) or that code with other sources
+    wrote is replayed again, not kept silently with results the methods no longer give;
+    one the same code wrote is kept."""
+    from twin.loop import runfiles
+    from twin.loop.batch import replay_batch
+
+    out = tmp_path / "out"
+    run = runs_dir / "hot_9000.csv"
+    assert replay(run, out=out, methods="open_loop").exit_code == 0
+    done = out / "hot_9000" / ".done.json"
+    token = json.loads(done.read_text())
+    assert token["code"] == runfiles.code_identity()
+    assert len(token["code"]["sources_sha256"]) == 64
+
+    def resumed() -> list[str]:
+        return replay_batch([run], out, ["open_loop"], None, resume=True).skipped
+
+    assert resumed() == ["hot_9000"]
+    # the token the code before this one wrote
+    done.write_text(json.dumps({"input_sha256": token["input_sha256"],
+                                "methods": ["open_loop"]}))
+    assert resumed() == []
+    assert json.loads(done.read_text()) == token  # written anew by this code
+    # other sources, same version string
+    other = {**token["code"], "sources_sha256": "0" * 64}
+    monkeypatch.setattr(runfiles, "code_identity", lambda: other)
+    assert resumed() == []
+    assert json.loads(done.read_text())["code"] == other
+    assert resumed() == ["hot_9000"]
+
+
+def test_the_sources_digest_follows_the_bytes_not_the_place(tmp_path):
+    from twin.version import sources_digest
+
+    def package(where):  # noqa: ANN001, ANN202
+        root = where / "twin"
+        (root / "loop" / "__pycache__").mkdir(parents=True)
+        (root / "data" / "meshes").mkdir(parents=True)
+        (root / "__init__.py").write_text("")
+        (root / "loop" / "replay.py").write_text("HOLD = True\n")
+        (root / "loop" / "__pycache__" / "replay.cpython-311.pyc").write_bytes(b"\0")
+        (root / "data" / "meshes" / "spindle.toml").write_text("[spindle]\n")
+        (root / "data" / "runs.csv").write_text("time_s\n")
+        return root
+
+    a, b = package(tmp_path / "a"), package(tmp_path / "b")
+    digest = sources_digest({"twin": a})
+    assert digest == sources_digest({"twin": b})  # another install of the same code
+    (b / "loop" / "__pycache__" / "replay.cpython-311.pyc").write_bytes(b"\1")
+    (b / "data" / "runs.csv").write_text("time_s,x\n")  # no source, no mesh
+    assert sources_digest({"twin": b}) == digest
+    (b / "loop" / "replay.py").write_text("HOLD = False\n")
+    assert sources_digest({"twin": b}) != digest
+    (b / "loop" / "replay.py").write_text("HOLD = True\n")
+    (b / "data" / "meshes" / "spindle.toml").write_text("[spindle]\nr = 1\n")
+    assert sources_digest({"twin": b}) != digest
+    (b / "data" / "meshes" / "spindle.toml").write_text("[spindle]\n")
+    (b / "loop" / "replay.py").rename(b / "loop" / "other.py")  # a module's name counts
+    assert sources_digest({"twin": b}) != digest
+
+
 def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path):
     # `--resume --snapshots every` after a `--snapshots none` batch skipped every run and
     # left it without a single picture
@@ -375,6 +438,56 @@ def test_ctrl_c_stops_the_worker_processes_and_their_queued_runs(runs_dir, tmp_p
     assert [p.name for p in out.iterdir() if p.name.startswith(".")] == []
     assert all(p.name in done for p in out.iterdir() if p.is_dir())
 
+def _batch_clients(cluster, earlier: set) -> list[str]:  # noqa: ANN001 - a LocalCluster
+    """The clients a batch left connected to the cluster's scheduler: those beside
+    `earlier` but the workers' own (a run's stop `Event` opens one in its worker)."""
+    return [c for c in cluster.scheduler.clients
+            if c not in earlier and not c.startswith("Client-worker-")]
+
+
+class _FakeClient:
+    """Stands in for a connected dask client where a batch stops before it runs a job."""
+
+    def __init__(self) -> None:
+        self.closed = 0
+
+    def close(self) -> None:
+        self.closed += 1
+
+    def __enter__(self) -> _FakeClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+@pytest.mark.parametrize("stop", ["out is a file", "ctrl-c while planning"])
+def test_a_dask_batch_that_stops_before_its_runs_closes_its_client(runs_dir, tmp_path,
+                                                                   monkeypatch, stop):
+    # the client's lifetime was split: replay_batch closed it when the set-up failed,
+    # _execute after the runs; one owner (`dask_session`) closes it once on every path
+    import twin.loop.batch as batch
+
+    client = _FakeClient()
+    monkeypatch.setattr(batch, "dask_client", lambda address: client)
+    out = tmp_path / "out"
+    if stop == "out is a file":
+        out.write_text("")
+        expected: type[BaseException] = FileExistsError
+    else:
+        def interrupted(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(batch, "_finished", interrupted)
+        expected = KeyboardInterrupt
+    with pytest.raises(expected):
+        batch.replay_batch([runs_dir / "hot_9000.csv"], out, ["open_loop"], None,
+                           dask_address="tcp://127.0.0.1:8786", resume=True)
+    assert client.closed == 1
+    # nothing was replayed, so nothing was cleaned up (no lock file made)
+    assert out.is_file() or sorted(p.name for p in out.iterdir()) == []
+
+
 @pytest.mark.slow
 def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
     from dask.distributed import Client, LocalCluster
@@ -394,9 +507,11 @@ def test_local_processes_and_dask_give_the_same_results(runs_dir, tmp_path):
         ) as cluster,
         Client(cluster),
     ):
+        clients = set(cluster.scheduler.clients)
         dsk = replay_batch(
             runs, tmp_path / "dask", ["ratio"], None, dask_address=cluster.scheduler_address
         )
+        assert _batch_clients(cluster, clients) == []  # the batch closed its client
     assert not seq.failed and not par.failed and not dsk.failed
     # deterministic: the same inputs give the same numbers whichever way they ran
     assert seq.accuracies == par.accuracies == dsk.accuracies
@@ -428,9 +543,11 @@ def test_ctrl_c_of_a_dask_batch_ends_the_runs_the_cluster_had_started(runs_dir, 
                      dashboard_address=None) as cluster,
         Client(cluster) as client,
     ):
+        clients = set(cluster.scheduler.clients)
         with pytest.raises(KeyboardInterrupt):
             replay_batch(runs, out, ["open_loop", "ratio"], None, fields="none",
                          dask_address=cluster.scheduler_address, progress=ctrl_c)
+        assert _batch_clients(cluster, clients) == []
         deadline = time.monotonic() + 60
         while any(client.processing().values()) and time.monotonic() < deadline:
             time.sleep(0.2)
@@ -760,8 +877,24 @@ def test_a_logger_gap_holds_ratio_and_bpnn_and_quality_json_says_which_windows(
     findings = json.loads((tmp_path / "out" / "gap" / "quality.json").read_text())["findings"]
     held = {f["column"]: f for f in findings if f["kind"] == HELD_CORRECTION}
     assert sorted(held) == ["T1_C", "T2_C", "T3_C", "T4_C"]
-    assert all(f["spans_s"] == [[180.0, 300.0]] and f["count"] == 2 for f in held.values())
+    # two windows, told as windows: every other finding's `count` is of samples
+    assert all(f["spans_s"] == [[180.0, 300.0]] and f["count_windows"] == 2
+               and "count" not in f for f in held.values())
+    assert all("count" in f for f in findings if f["kind"] != HELD_CORRECTION)
     assert "window 3-4" in held["T1_C"]["detail"]
+    # the methods that held, and only those
+    assert held["T1_C"]["action"] == ("ratio computes nothing from this sensor in these "
+                                      "windows and holds what it corrects")
+    assert "<td>T1_C</td><td>correction_held</td><td>2 windows</td><td>180–300</td>" in \
+        (tmp_path / "out" / "report.html").read_text()
+    # no method that holds a correction ran: nothing was held
+    result = replay(path, out=tmp_path / "none", methods="open_loop,estimator")
+    assert result.exit_code == 0, result.output
+    findings = json.loads((tmp_path / "none" / "gap" / "quality.json").read_text())["findings"]
+    assert [f for f in findings if f["kind"] == HELD_CORRECTION] == []
+    assert {f["kind"] for f in findings} == {
+        f["kind"] for f in json.loads((tmp_path / "out" / "gap" / "quality.json")
+                                      .read_text())["findings"]} - {HELD_CORRECTION}
     clean = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
     assert not [f for f in clean if f["kind"] == HELD_CORRECTION]
 

@@ -95,8 +95,9 @@ def test_resume_replays_a_run_whose_fields_were_not_written(run, tmp_path):
     assert (folder / "accuracy.json").stat().st_mtime_ns == stamp
 
 
-def test_a_resume_token_of_the_default_is_the_one_earlier_releases_wrote(run):
-    # folders replayed before --fields existed (every field written) stay resumable
+def test_a_resume_token_of_the_default_fields_says_nothing_of_them(run):
+    # the default --fields adds nothing to the token, as before --fields existed (those
+    # folders are replayed again all the same: their token names no code)
     from twin.loop.runfiles import resume_token
 
     assert "fields" not in resume_token(run, ["ratio"], None)

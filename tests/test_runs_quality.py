@@ -277,3 +277,18 @@ def test_running_median_is_scipys_median_filter(size):
         v[n // 2] += 50.0  # a spike
         np.testing.assert_array_equal(running_median(v, size),
                                       median_filter(v, size=size, mode="nearest"))
+
+
+def test_a_report_tells_what_a_findings_count_counts_in_files_of_any_release():
+    # correction_held counted windows under `count`, shown in the report's "samples"
+    # column; it is `count_windows` now, and a quality.json written before still reads so
+    from twin.loop.report import _finding_row
+
+    held = {"column": "T1_C", "kind": "correction_held", "rows": [],
+            "spans_s": [[180.0, 300.0]], "action": "held", "detail": ""}
+    assert _finding_row({**held, "count_windows": 2})["count"] == "2 windows"
+    assert _finding_row({**held, "count": 2})["count"] == "2 windows"  # an earlier file
+    assert _finding_row({**held, "count_windows": 1})["count"] == "1 window"
+    stuck = {**held, "kind": "stuck", "count": 76}
+    assert _finding_row(stuck)["count"] == "76"
+    assert _finding_row({"kind": "noisy"})["count"] == ""

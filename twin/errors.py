@@ -61,15 +61,8 @@ class InputError(ValueError):
         Parquet file's `data.parquet, row 3, column 'T_C'`), or ''.
         A command-line option in the column's place is called one (`RUN.csv, option
         '--time'`): a user reading "column '--out'" looked for it in a file."""
-        where = []
-        if self.file is not None:
-            where.append(str(self.file))
-        if self.row is not None:
-            where.append(f"{self.row_unit} {self.row}")
-        if self.column is not None:
-            kind = "option" if self.column.startswith("--") else self.COLUMN
-            where.append(f"{kind} {self.column!r}")
-        return ", ".join(where)
+        return place(self.file, self.row, self.column, row_unit=self.row_unit,
+                     column_word=self.COLUMN)
 
     def located(self, file: str | None = None, row: int | None = None,
                 column: str | None = None, row_unit: str | None = None) -> Self:
@@ -104,6 +97,27 @@ class InputError(ValueError):
         elif first["type"] == "extra_forbidden":
             message = cls.UNKNOWN
         return tuple(first["loc"]), message
+
+
+def place(file: str | None = None, row: int | None = None, column: str | None = None, *,
+          row_unit: str = InputError.ROW, column_word: str = InputError.COLUMN,
+          last_row: int | None = None) -> str:
+    """A place in an input as every message tells it: `data.csv, line 3, column 'T_C'`
+    (`row_unit` "line" for a text file's line, "row" for a Parquet file's data row), a
+    stretch `data.csv, lines 3–9, column 'T_C'` up to `last_row`, a command-line option
+    in the column's place `option '--time'`; '' for none."""
+    where = []
+    if file is not None:
+        where.append(str(file))
+    if row is not None:
+        if last_row is not None and last_row != row:
+            where.append(f"{row_unit}s {row}–{last_row}")
+        else:
+            where.append(f"{row_unit} {row}")
+    if column is not None:
+        kind = "option" if column.startswith("--") else column_word
+        where.append(f"{kind} {column!r}")
+    return ", ".join(where)
 
 
 def key_path(loc: Sequence[object]) -> str:

@@ -24,6 +24,7 @@ from twin.cli.snapshot import snapshot
 from twin.cli.synth import synth
 from twin.cli.train import train
 from twin.errors import report_errors, run_console_script
+from twin.helptext import PlainHelpCommand
 from twin.log import send_warnings_to_log
 from twin.version import version_option
 
@@ -64,7 +65,7 @@ def build_app() -> typer.Typer:
     )
     app.callback()(_options)
     for name, function in COMMANDS:
-        app.command(name)(report_errors(function))
+        app.command(name, cls=PlainHelpCommand)(report_errors(function))
     # a command group: its sub-commands carry report_errors themselves
     app.add_typer(drift_app, name="drift")
     return app

@@ -15,6 +15,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED
 from twin.errors import InputError, report_errors
+from twin.helptext import PlainHelpCommand
 from twin.io.destinations import check_out_dir, check_out_file
 
 if TYPE_CHECKING:
@@ -67,13 +68,12 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
     if quiet:
         return
     for f in data.findings:
-        typer.echo(f"note: {f['file']}, column {f['column']!r}, rows {f['first_row']}–"
-                   f"{f['last_row']}: {f['repair']}", err=True)
+        typer.echo(f"note: {f['where']}: {f['repair']}", err=True)
     for name, why in data.left_out.items():
         typer.echo(f"note: temperature column {name!r} left out: {why}", err=True)
 
 
-@drift_app.command("fit")
+@drift_app.command("fit", cls=PlainHelpCommand)
 @report_errors
 def fit(
     data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet): "
@@ -127,7 +127,7 @@ def fit(
         typer.echo(f"wrote {out}")
 
 
-@drift_app.command("predict")
+@drift_app.command("predict", cls=PlainHelpCommand)
 @report_errors
 def predict(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
@@ -155,7 +155,7 @@ def predict(
         typer.echo(f"wrote {out} ({rows} row{'s' * (rows != 1)})")
 
 
-@drift_app.command("report")
+@drift_app.command("report", cls=PlainHelpCommand)
 @report_errors
 def report(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
@@ -184,7 +184,7 @@ def report(
         typer.echo(f"wrote {metrics_path} and {html_path}")
 
 
-@drift_app.command("select")
+@drift_app.command("select", cls=PlainHelpCommand)
 @report_errors
 def select(
     data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet)."),

@@ -43,7 +43,7 @@ def replay(
         "(end), or none; about 220 kB a window of the default spindle",
     ),
     resume: bool = typer.Option(
-        False, "--resume", help="skip runs already finished (same input, methods, model, "
+        False, "--resume", help="skip runs already finished (same input, methods, model, code, "
         "--fields); a skipped run gets the --snapshots it lacks, drawn from its field files"),
     quiet: bool = typer.Option(False, "--quiet", help="no progress output"),
     drift_assimilation: bool = typer.Option(

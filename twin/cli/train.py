@@ -39,7 +39,7 @@ def train(
         "fitted curves of a ratio-corrected simulation).",
     ),
     gate_runs: list[Path] = typer.Option(
-        None, "--gate-runs",
+        None, "--gate-runs", metavar="RUN",
         help="A recorded run (or a folder of runs) that the closed-loop check of the "
         "default networks replays besides the held-out runs; never trained on (repeat the "
         "option for more).",

@@ -11,7 +11,10 @@ Rows repeating an earlier row exactly are dropped, as a run's are (`twin.runs.qu
 gaps (NaN) in temperatures and speed are bridged causally — the last reading holds — and
 reported; a sensor that starts with a gap takes its first reading for the rows before it
 (the one place a value is taken from later rows, reported as such).  Targets keep their
-NaN: those rows are left out of fitting and metrics.
+NaN: those rows are left out of fitting and metrics.  A finding (`findings`) names its
+place as the error messages do (`where`: `data.csv, lines 12–40, column 'T3_C'`, a
+Parquet file's rows), and the words it is told in count samples, not a file's rows or
+lines.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from twin.errors import InputError
+from twin.errors import InputError, place
 from twin.runs import read_table
 from twin.runs.quality import drop_repeated_rows, true_runs
 from twin.runs.schema import SPEED, TIME
@@ -109,12 +112,19 @@ def bridge_gaps(values: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
 
 def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
                   repair: str | None = None) -> list[dict]:
+    """A finding per gap (first, last index into the table's samples): its place in the
+    file (`first_row`, `last_row` in `row_unit`s: a CSV file's lines, a Parquet file's
+    data rows; `where` as the messages tell it), the samples it spans, the repair."""
     out = []
     for a, b in gaps:
-        how = repair or ("leading gap: first reading used for the rows before it" if a == 0
+        how = repair or ("leading gap: first reading used for the samples before it" if a == 0
                          else "gap bridged causally: last reading held")
-        out.append({"file": table.file, "column": name, "first_row": int(table.rows[a]),
-                    "last_row": int(table.rows[b]), "n_rows": b - a + 1, "repair": how})
+        first, last = int(table.rows[a]), int(table.rows[b])
+        out.append({"file": table.file, "column": name, "first_row": first,
+                    "last_row": last, "row_unit": table.row_unit, "n_rows": b - a + 1,
+                    "where": place(table.file, first, name, row_unit=table.row_unit,
+                                   last_row=last),
+                    "repair": how})
     return out
 
 
@@ -126,7 +136,7 @@ def _without_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
         return table, []
     dropped = ~np.isin(table.rows, kept.rows)
     return kept, _gap_findings(table, TIME, true_runs(dropped),
-                               "exact copies of earlier rows: dropped")
+                               f"exact copies of earlier {table.row_unit}s: dropped")
 
 
 def _check_temperatures(table: RawTable) -> list[str]:
@@ -164,7 +174,7 @@ def usable_temperatures(tables: Sequence[RawTable]) -> tuple[list[str], dict[str
         raise InputError(f"every temperature column ({', '.join(common)}) reads one value "
                          "throughout: no sensor tells how the machine warms (--sensors LIST "
                          "uses them anyway)", file=files)
-    left_out.update({n: f"reads {v:g} in every row (tells nothing)"
+    left_out.update({n: f"reads {v:g} in every sample (tells nothing)"
                      for n, v in constant.items()})
     return [n for n in common if n not in constant], left_out
 
@@ -215,7 +225,7 @@ def drift_data(
             speeds.append(speed)
         elif SPEED in table.columns and not _has_values(table, SPEED):
             findings += _gap_findings(table, SPEED, [(0, t.size - 1)],
-                                      "no value in any row: read as no speed column")
+                                      "no value at all: read as no speed column")
         if targets and all(name in table.columns for name in targets):
             # predict reads no target: a column left blank for the drift to come is none
             drifts.append(np.stack([column_with_values(table, name) if require_targets

@@ -111,7 +111,7 @@ def sensor_ranking(data: DriftData) -> SensorRanking:
     targets = {t: data.targets_um[rows, j] for j, t in enumerate(data.targets)}
     for name, values in targets.items():
         if np.ptp(values) == 0:  # no grade, no correlation, no fit: every grade was NaN
-            raise InputError(f"never changes (every row {values[0]:g} µm): a probe that does "
+            raise InputError(f"never changes (every sample {values[0]:g} µm): a probe that does "
                              "not move leaves nothing to model", file=", ".join(data.files),
                              column=name)
     return rank_sensors(data.sensors, data.T_C[rows], targets)
@@ -134,7 +134,7 @@ def measured_rows(data: DriftData, every_file: bool = False) -> np.ndarray:
                                                                   strict=True)]
     for file, count, where in counts:
         if count < MIN_MEASURED_ROWS:
-            rows_hold = "1 row holds" if count == 1 else f"{count} rows hold"
+            rows_hold = "1 sample holds" if count == 1 else f"{count} samples hold"
             raise InputError(f"only {rows_hold} every target; need at least "
                              f"{MIN_MEASURED_ROWS}{where}", file=file,
                              column=",".join(data.targets))

@@ -2,8 +2,8 @@
 
 One failing run never stops the others: its error is recorded in summary.json
 ("failed") and the batch goes on.  A finished run folder carries a `.done.json` token
-(input and model digests, methods), written last; --resume skips runs whose token
-matches.
+(input and model digests, methods, the code's version and source digest), written last;
+--resume skips runs whose token matches.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import signal
 import uuid
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import closing
+from contextlib import closing, contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -153,50 +153,59 @@ def replay_batch(
     check_distinct_names(named)  # refused before anything is written
     named = [(path, name) for path, name in named
              if not _refused_folder(out_root / name, path, result)]
-    # reached before anything is written: an unreachable scheduler (a 20 s wait) left an
-    # empty DIR behind; _execute closes it
-    client = dask_client(dask_address) if dask_address else None
-    todo: list[ReplayJob] = []
+    planned = False  # a Ctrl-C before the batch is planned has nothing to clean up
     try:
-        out_root.mkdir(parents=True, exist_ok=True)
-        remove_orphans(out_root)
-        for path, name in named:
-            if resume:
-                finished = _finished(out_root / name, path, methods, model_path,
-                                     assimilate_drift, fields, snapshots)
-                if finished is not None:
-                    result.accuracies.append(finished)
-                    result.skipped.append(name)
-                    if progress:
-                        progress(name, "skipped")
-                    continue
-            todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
-                                  assimilate_drift, fields))
-    except BaseException:
-        if client is not None:
-            client.close()
-        raise
-
-    try:
-        # closed on leaving: a Ctrl-C here ends the worker processes before they go on
-        with closing(_execute(todo, jobs, client, progress, plotter,
-                              on_window)) as outcomes:
-            for outcome in outcomes:
-                if "ok" in outcome:
-                    result.accuracies.append(outcome["ok"])
-                else:
-                    result.failed.append(outcome)
+        # reached before anything is written: an unreachable scheduler (a 20 s wait) left
+        # an empty DIR behind; closed on leaving, whatever happens inside
+        with dask_session(dask_address) as client:
+            todo = _plan(named, out_root, methods, model_path, snapshots, resume, progress,
+                         assimilate_drift, fields, result)
+            planned = True
+            # closed on leaving: a Ctrl-C here ends the worker processes before they go on
+            with closing(_execute(todo, jobs, client, progress, plotter,
+                                  on_window)) as outcomes:
+                for outcome in outcomes:
+                    if "ok" in outcome:
+                        result.accuracies.append(outcome["ok"])
+                    else:
+                        result.failed.append(outcome)
     except KeyboardInterrupt:
-        remove_orphans(out_root)  # the staging folders of the runs the workers were on
-        # A worker ended inside its turn of the folder lock left the lock's file (the lock
-        # itself ended with it); the next turn removes it, so take one now.
-        with folder_lock(out_root):
-            pass
+        if planned:
+            remove_orphans(out_root)  # the staging folders of the runs the workers were on
+            # A worker ended inside its turn of the folder lock left the lock's file (the
+            # lock itself ended with it); the next turn removes it, so take one now.
+            with folder_lock(out_root):
+                pass
         raise
     order = {n: i for i, n in enumerate(names)}
     result.accuracies.sort(key=lambda a: order.get(a["run"], len(order)))
     write_summary(out_root, result.failed, attempted=names)
     return result
+
+
+def _plan(named: list[tuple[str, str]], out_root: Path, methods: Sequence[str],
+          model_path: str | None, snapshots: str, resume: bool,
+          progress: Callable[[str, str], None] | None, assimilate_drift: bool, fields: str,
+          result: BatchResult) -> list[ReplayJob]:
+    """Make `out_root` (temporary files of killed batches removed) and the jobs to run:
+    every (path, run name) of `named` but, with `resume`, the runs already finished,
+    whose accuracy goes to `result` as skipped."""
+    out_root.mkdir(parents=True, exist_ok=True)
+    remove_orphans(out_root)
+    todo: list[ReplayJob] = []
+    for path, name in named:
+        if resume:
+            finished = _finished(out_root / name, path, methods, model_path,
+                                 assimilate_drift, fields, snapshots)
+            if finished is not None:
+                result.accuracies.append(finished)
+                result.skipped.append(name)
+                if progress:
+                    progress(name, "skipped")
+                continue
+        todo.append(ReplayJob(path, str(out_root), tuple(methods), model_path, snapshots,
+                              assimilate_drift, fields))
+    return todo
 
 
 def _refused_folder(folder: Path, path: str, result: BatchResult) -> bool:
@@ -235,6 +244,18 @@ def _finished(out_dir: Path, path: str, methods: Sequence[str],
     return accuracy
 
 
+@contextmanager
+def dask_session(address: str | None) -> Iterator[Client | None]:
+    """The batch's dask client: connected to the scheduler at `address` on entering
+    (InputError naming --dask if it cannot be), closed on leaving, after the runs or on
+    whatever stopped them; None without an address (local runs)."""
+    if address is None:
+        yield None
+        return
+    with dask_client(address) as client:
+        yield client
+
+
 def dask_client(address: str) -> Client:
     """A client of the dask scheduler at `address`, or InputError naming --dask."""
     from dask.distributed import Client
@@ -251,25 +272,24 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
              plotter: ForkedTask | None,
              on_window: Callable[[str, str, int, int], None] | None = None,
              ) -> Iterator[dict]:
-    """Each job's outcome as it comes: on `client` (a connected dask client, closed here),
-    in `jobs` worker processes, or in this process."""
+    """Each job's outcome as it comes: on `client` (a connected dask client; its
+    `dask_session` closes it), in `jobs` worker processes, or in this process."""
     if client is not None:
         from dask.distributed import Event
         from dask.distributed import as_completed as dask_completed
 
-        with client:
-            stop = Event(f"twin-replay-stop-{uuid.uuid4().hex}", client=client)
-            futures = client.map(run_job, [replace(j, stop_event=stop.name) for j in todo],
-                                 pure=False)
-            try:
-                for fut in dask_completed(futures):
-                    outcome = fut.result()
-                    _tell(progress, outcome)
-                    yield outcome
-            except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
-                client.cancel(futures)  # the queued runs; the started ones ask `stop`
-                stop.set()
-                raise
+        stop = Event(f"twin-replay-stop-{uuid.uuid4().hex}", client=client)
+        futures = client.map(run_job, [replace(j, stop_event=stop.name) for j in todo],
+                             pure=False)
+        try:
+            for fut in dask_completed(futures):
+                outcome = fut.result()
+                _tell(progress, outcome)
+                yield outcome
+        except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
+            client.cancel(futures)  # the queued runs; the started ones ask `stop`
+            stop.set()
+            raise
         return
     # a worker process or a dask task builds its own spindle per run (about 0.5 s of a
     # run's replay); in this process one model serves every run, and the run's forked
@@ -287,11 +307,13 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
             _tell(progress, outcome)
             yield outcome
         return
+    import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed  # --jobs only
 
     # the workers leave Ctrl-C (sent to the whole process group) to this process, which
     # ends them: interrupted on their own, a worker between runs died with a traceback, and
     # the others went on with the queued runs while the pool's shutdown waited for them
+    earlier = set(multiprocessing.active_children())
     with ProcessPoolExecutor(max_workers=min(jobs, len(todo)),
                              initializer=_ignore_interrupts) as pool:
         try:
@@ -302,8 +324,12 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
                 _tell(progress, outcome)
                 yield outcome
         except BaseException:  # Ctrl-C, or the caller stopped reading (GeneratorExit)
-            # ProcessPoolExecutor has no public way to end its workers before Python 3.14
-            for worker in list(pool._processes.values()):
+            # the pool's workers: the children started since it was made (it starts them
+            # in `submit`, all at the first under fork, as needed otherwise; nothing else
+            # here starts one).  ProcessPoolExecutor has no public way to end its workers
+            # before Python 3.14 (`terminate_workers`); `multiprocessing.active_children`
+            # is public and names them
+            for worker in set(multiprocessing.active_children()) - earlier:
                 worker.terminate()
             pool.shutdown(wait=True, cancel_futures=True)
             raise

@@ -59,7 +59,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -267,16 +267,29 @@ def check_field_time(run: RecordedRun, time_s: float) -> None:
 
 HELD_CORRECTION = "correction_held"
 """quality.json kind of `held_correction_findings`."""
+HOLDING_METHODS = ("ratio", "bpnn")
+"""The methods that hold what a thermocouple corrects through windows it was not measured
+in (`WindowFeatures.without_dead_sensors`)."""
 
 
-def held_correction_findings(run: RecordedRun) -> list[dict]:
+def held_correction_findings(run: RecordedRun, methods: Sequence[str]) -> list[dict]:
     """quality.json findings (`twin.runs.quality.finding`): per ring and sleeve
     thermocouple (T1..T4, what `ratio` and `bpnn` correct by), the windows whose correction
     finds it not measured through the 60 s before the window starts
     (`WindowFeatures.seen_in_last_window`: a logger gap, a long dropout, a stuck sensor).
     They compute nothing from it there and hold what it corrects; the estimator leaves
     its unobserved bins out of its update.  Spans are the held windows' [start, end) in
-    run time."""
+    run time; the count is of windows (`count_windows`), where the quality check's
+    findings count samples.  None unless one of `HOLDING_METHODS` is among `methods`:
+    nothing held a correction then."""
+    holding = [m for m in HOLDING_METHODS if m in methods]
+    if not holding:
+        return []
+    action = (f"{' and '.join(holding)} compute{'s' if len(holding) == 1 else ''} nothing "
+              f"from this sensor in these windows and hold{'s' if len(holding) == 1 else ''} "
+              "what it corrects")
+    if "estimator" in methods:
+        action += "; the estimator leaves its unobserved bins out"
     measured = run.T_valid_C
     ends = WINDOW_S * np.arange(1, n_windows(run))  # window k's correction reads up to 60k s
     lo = np.searchsorted(run.time_s, ends - WINDOW_S - 1e-9, side="right")
@@ -290,11 +303,9 @@ def held_correction_findings(run: RecordedRun) -> list[dict]:
             continue
         windows = ", ".join(f"{a + 1}" if a == b else f"{a + 1}-{b + 1}" for a, b in stretches)
         found.append(finding(
-            TEMPERATURES[column], HELD_CORRECTION,
-            "ratio and bpnn compute nothing from this sensor in these windows and hold what "
-            "it corrects; the estimator leaves its unobserved bins out",
+            TEMPERATURES[column], HELD_CORRECTION, action,
             spans_s=[(ends[a], ends[b] + WINDOW_S) for a, b in stretches],
-            count=int(unseen[:, column].sum()),
+            count=int(unseen[:, column].sum()), counted="windows",
             detail=f"fewer than {MIN_BIN_SAMPLES} valid samples (1 where the logger writes "
                    f"fewer than {2 * MIN_BIN_SAMPLES} rows in it) in a "
                    f"{WINDOW_S / OBSERVATION_BINS:g} s bin of the {WINDOW_S:g} s before the "

@@ -47,6 +47,7 @@ from twin.loop.replay import (
     method_replay_to_json,
     replay_method,
 )
+from twin.version import code_identity
 
 if TYPE_CHECKING:
     from twin.correction.result import Corrector
@@ -98,8 +99,12 @@ def resume_token(path: str | Path, methods: Sequence[str], model_path: str | Non
                  assimilate_drift: bool = True, fields: str = "every") -> dict:
     """What must match for a finished run folder to be reused by --resume.  `fields` is
     part of it unless it is the default: a folder replayed with `--fields none` lacks the
-    files `--fields every` asks for (and a folder of earlier releases had every field)."""
-    token = {"input_sha256": file_digest(path), "methods": list(methods)}
+    files `--fields every` asks for (and a folder of earlier releases had every field).
+    `code` is the code that replays (`twin.version.code_identity`): a folder replayed by
+    other code (a method that behaves otherwise) is replayed again, as is one whose token
+    predates it and so cannot say what code wrote it."""
+    token = {"input_sha256": file_digest(path), "methods": list(methods),
+             "code": code_identity()}
     if fields != "every":
         token["fields"] = fields
     if "estimator" in methods:
@@ -239,7 +244,7 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     plots.start(str(out_dir))
     if snapshots != "none":
         _write_snapshots(out_dir, model, results[primary], snapshots, title=run.name)
-    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run)]),
+    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods)]),
                   out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name

@@ -13,7 +13,9 @@ finding is a plain JSON-serialisable dict:
      "spans_s": [[0.0, 1799.0]], "action": "excluded from metrics", "detail": "..."}
 
 `rows` are 1-based file lines (CSV) or data rows (Parquet), at most `MAX_LISTED` of them;
-`count` is the number of samples concerned; `spans_s` are time spans in run time.
+`count` is the number of samples concerned; `spans_s` are time spans in run time.  A
+finding that counts something else names it in the key instead of `count`: a replay's
+`correction_held` (`twin.loop.replay.held_correction_findings`) has `count_windows`.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ from twin.runs.schema import AMBIENT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
 
 MAX_LISTED = 20
+SAMPLES = "samples"
+"""What a finding's `count` counts (see `finding`)."""
 
 
 @dataclass(frozen=True)
@@ -66,13 +70,28 @@ class Repaired:
 
 def finding(column: str, kind: str, action: str, *, rows: np.ndarray | None = None,
             spans_s: list[tuple[float, float]] | None = None, count: int | None = None,
-            detail: str = "") -> dict:
-    """One data-quality finding as a JSON-serialisable dict."""
+            detail: str = "", counted: str = SAMPLES) -> dict:
+    """One data-quality finding as a JSON-serialisable dict.  `count` is of samples (by
+    default the `rows` given); one of anything else (`counted="windows"`) is told under
+    `count_<counted>`, so that no reader takes it for samples."""
     rows_list = [] if rows is None else [int(r) for r in np.asarray(rows)[:MAX_LISTED]]
     spans = [[round(float(a), 3), round(float(b), 3)] for a, b in (spans_s or [])[:MAX_LISTED]]
+    key = "count" if counted == SAMPLES else f"count_{counted}"
     return {"column": column, "kind": kind,
-            "count": int(count if count is not None else (0 if rows is None else len(rows))),
+            key: int(count if count is not None else (0 if rows is None else len(rows))),
             "rows": rows_list, "spans_s": spans, "action": action, "detail": detail}
+
+
+def finding_count(found: dict) -> tuple[object, str]:
+    """(count, what it counts) of a finding of any release: `count` is of samples,
+    `count_<what>` of what its key says; a `correction_held` written before 2026-11-27
+    counted windows under `count`.  (None, "samples") where it holds no count."""
+    for key, value in found.items():
+        if isinstance(key, str) and key.startswith("count_"):
+            return value, key.removeprefix("count_")
+    if found.get("kind") == "correction_held":
+        return found.get("count"), "windows"
+    return found.get("count"), SAMPLES
 
 
 def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
