@@ -333,6 +333,22 @@ def test_msg_warn_and_error_go_on_fatal_stops_at_its_line():
             run(deck)
 
 
+def test_msg_writes_to_the_current_output_as_mapdl_does():
+    # MAPDL's message subroutine writes to the current output: after /OUT,report,txt the
+    # message (heading and text) is in report.txt, not in the log; /OUT alone sends the next
+    # one back to the log.  A *CFOPEN command file is no output: it gets no message.
+    s = run("/OUT,report,txt\n*MSG,WARN,7\n%I hot spots\n*MSG,INFO,2.5\nk = %G\n"
+            "*CFOPEN,cmds,mac\n*MSG,NOTE\nstill the report\n*CFCLOS\n/OUT\n"
+            "*MSG,INFO\nback in the log\n")
+    assert s.state.listing.files["report.txt"] == [
+        " *** WARNING ***", "        7 hot spots", "k =   2.50000000    ",
+        " *** NOTE ***", "still the report"]
+    assert s.state.listing.files["cmds.mac"] == []
+    assert s.log == ["back in the log"]
+    # the warning is still told (stderr) with its place
+    assert s.state.listing.warnings == ["warning: deck.inp:2: *MSG: 7 hot spots"]
+
+
 def test_file_size_limit(tmp_path, monkeypatch):
     import apdl_like.parser as parser
 

@@ -244,9 +244,9 @@ MSG_HEADINGS = {"INFO": "", "NOTE": "NOTE", "UI": "NOTE", "WARN": "WARNING", "ER
 
 @command("*MSG", ANY, 9)
 def star_msg(s: SessionState, c: Call) -> None:
-    """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message in the log under its
-    heading.  WARN and ERROR are told on stderr too and ERROR counted (the run goes on, as
-    in MAPDL batch); FATAL stops the run here."""
+    """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message under its heading in the
+    current output (the /OUT file, else the log).  WARN and ERROR are told on stderr too
+    and ERROR counted (the run goes on, as in MAPDL batch); FATAL stops the run here."""
     from apdl_like.fortran_format import c_descriptors, format_c_line
 
     label = c.label(1, "INFO")
@@ -276,10 +276,12 @@ def star_msg(s: SessionState, c: Call) -> None:
     one_line = " ".join(" ".join(lines).split())  # for stderr and the error
     if label == "FATAL":
         raise ApdlError(f"FATAL: {one_line}")
-    log = s.listing.log
+    # MAPDL's message subroutine writes to the current output: the /OUT file when one is
+    # open, else the log (a *CFOPEN command file takes *VWRITE and *CFWRITE lines only)
     if heading:
-        log.append(f" *** {heading} ***")
-    log.extend(lines)
+        s.say(f" *** {heading} ***")
+    for line in lines:
+        s.say(line)
     if label in ("WARN", "ERROR"):
         st = c.statement
         if label == "ERROR":
