@@ -514,6 +514,29 @@ def test_results_table_idiom_writes_fortran_formatted_rows():
     assert s.params["_T2"] == -0.6712
 
 
+def test_integer_edits_round_halves_away_from_zero_as_fortran_nint():
+    # MAPDL's values are double precision and its integer descriptors take Fortran's NINT
+    # (*MSG's documentation; *VWRITE's C formats are *MSG's): 2.5 -> 3, -2.5 -> -3,
+    # 3.5 -> 4, 0.5 -> 1, -0.5 -> -1, 1.49999 -> 1 (Python's round() gave 2, -2, 4, 0, 0)
+    s = run("*DIM,V,ARRAY,6\n*VFILL,V(1),DATA,2.5,-2.5,3.5,0.5,-0.5,1.49999\n"
+            "/OUT,ints,txt\n*VWRITE,V(1),V(1)\n(I4,1X,I3)\n*VWRITE,V(1),V(1),V(1)\n"
+            "%I|%5I|%-4I|\n/OUT\n*MSG,INFO,-2.5,2.5\n%4I and %I\n")
+    assert s.state.listing.files["ints.txt"] == [
+        "   3   3", "  -3  -3", "   4   4", "   1   1", "  -1  -1", "   1   1",
+        "3|    3|3   |", "-3|   -3|-3  |", "4|    4|4   |", "1|    1|1   |",
+        "-1|   -1|-1  |", "1|    1|1   |"]
+    assert s.log == ["  -3 and         3"]
+
+
+def test_integer_edit_of_a_value_that_is_no_number():
+    from apdl_like.fortran_format import format_c_line, format_line, integer, parse_format
+
+    assert [integer(v) for v in (float("nan"), float("inf"), -float("inf"), -0.4)] == [
+        "NaN", "Inf", "-Inf", "0"]
+    assert format_line(parse_format("(I2)"), [float("nan")]) == ["**"]
+    assert format_c_line("%5I", [float("inf")]) == ["  Inf"]
+
+
 def test_a_command_spelled_error_is_an_unknown_command_not_a_crash():
     # found by the arbitrary-text fuzz: a deck line `ERROR` used to index the fields of the
     # parser's own bad-line statement (IndexError, exit 1)
