@@ -18,6 +18,29 @@ def run(text: str) -> Session:
     return s
 
 
+# ------------------------------------------------------------------- *VOPER
+def test_voper_operates_down_the_columns():
+    s = run("*DIM,A,ARRAY,4\n*DIM,B,ARRAY,4\n*DIM,R,ARRAY,4,2\n"
+            "*VFILL,A(1),DATA,1,2,3,4\n*VFILL,B(1),DATA,8,4,2,1\n"
+            "*VOPER,R(1,1),A(1),DIV,B(1)\n*VOPER,R(2,2),A(2),MULT,10\n"
+            "*DIM,M,ARRAY,4\n*VOPER,M(1),A(1),MAX,2.5\n*DIM,G,ARRAY,4\n*VOPER,G(1),A(1),GT,B(1)\n"
+            "*DIM,S,ARRAY,4\n*VOPER,S(1),A(1),SUB,B(1)\n")
+    p = s.params
+    np.testing.assert_array_equal(p["R"][:, 0, 0], [1 / 8, 2 / 4, 3 / 2, 4 / 1])
+    # from row 2 of R and of A: 20, 30, 40 (the rows before are left alone)
+    np.testing.assert_array_equal(p["R"][:, 1, 0], [0.0, 20.0, 30.0, 40.0])
+    np.testing.assert_array_equal(p["M"].ravel(), [2.5, 2.5, 3.0, 4.0])
+    np.testing.assert_array_equal(p["G"].ravel(), [0.0, 0.0, 1.0, 1.0])
+    np.testing.assert_array_equal(p["S"].ravel(), [-7.0, -2.0, 1.0, 3.0])
+    for deck, message in [
+        ("*DIM,A,ARRAY,2\n*DIM,B,ARRAY,2\n*VOPER,A(1),A(1),DIV,B(1)\n", "division by zero"),
+        ("*DIM,A,ARRAY,2\n*VOPER,A(1),A(1),DER1,A(1)\n", "supports ADD, SUB"),
+        ("*VOPER,Q(1),1,ADD,2\n", "Q is not a numeric array"),
+    ]:
+        with pytest.raises(ApdlError, match=message):
+            run(deck)
+
+
 # ------------------------------------------------------------ AATT, two materials
 def test_aatt_gives_each_area_its_material_and_amesh_all_meshes_the_selected():
     # a two-layer plane wall, fixed temperatures on its faces: the interface temperature is

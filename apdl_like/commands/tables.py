@@ -1,4 +1,4 @@
-"""Results tables and listings: *DIM, *VFILL, *VWRITE, *MSG, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
+"""Results tables and listings: *DIM, *VFILL, *VOPER, *VWRITE, *MSG, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
 *LIST, *STATUS, SAVE and RESUME (valid in every processor).
 
 Files the deck writes are kept in memory by name (`SessionState.listing.files`) and written
@@ -127,6 +127,65 @@ def star_vwrite(s: SessionState, c: Call) -> None:
             listing.files[target].append(line)
         else:
             s.say(line)
+
+
+_VOPER = {
+    "ADD": np.add, "SUB": np.subtract, "MULT": np.multiply, "MIN": np.minimum,
+    "MAX": np.maximum,
+    "LT": lambda a, b: (a < b).astype(float), "LE": lambda a, b: (a <= b).astype(float),
+    "EQ": lambda a, b: (a == b).astype(float), "NE": lambda a, b: (a != b).astype(float),
+    "GE": lambda a, b: (a >= b).astype(float), "GT": lambda a, b: (a > b).astype(float),
+}
+
+
+@command("*VOPER", ANY, 6)
+def star_voper(s: SessionState, c: Call) -> None:
+    """*VOPER,ParR(i),Par1(j),Oper,Par2(k): element by element down the columns, ParR =
+    Par1 Oper Par2, for ADD, SUB, MULT, DIV, MIN, MAX and the comparisons LT, LE, EQ, NE,
+    GE, GT (1 true, 0 false).  Par1 and Par2 are array elements (the column from there on)
+    or a scalar parameter or number, used on every row; the rows run from ParR(i) to the end
+    of the shortest column named.  Derivatives, integrals, GATH/SCAT, DOT/CROSS, *VLEN and
+    *VMASK are not supported."""
+    params, funcs = s.params, s.model_functions
+    oper = c.label(3)
+    if oper not in (*_VOPER, "DIV"):
+        raise ApdlError(f"field 3: *VOPER supports ADD, SUB, MULT, DIV, MIN, MAX, LT, LE, EQ, "
+                        f"NE, GE and GT, got {oper or '(empty)'!r}")
+    if c.given(5) or c.given(6):
+        raise ApdlError("fields 5-6 (CON1, CON2) are not supported")
+    name, subs_text = split_target(c.raw(1).strip())
+    result = params.get(name)
+    if not isinstance(result, np.ndarray) or result.dtype == object:
+        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
+    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    operands: list[np.ndarray | float] = []
+    for field in (2, 4):
+        text = c.raw(field).strip()
+        if not text:
+            raise ApdlError(f"field {field} (Par{field // 2}) is required")
+        if _is_reference(text):
+            ref, ref_subs = split_target(text)
+            array = params.get(ref)
+            if isinstance(array, np.ndarray):
+                if array.dtype == object:
+                    raise ApdlError(f"field {field}: {ref} is a character array")
+                operands.append(np.array(column(params, ref, subscripts(
+                    ref_subs, params, funcs) if ref_subs else [1.0]), float))
+                continue
+        operands.append(c.num(field, what=f"Par{field // 2}"))
+    rows = result.shape[0] - element_index(name, result, subs)[0]
+    rows = min([rows, *(len(o) for o in operands if isinstance(o, np.ndarray))])
+    a, b = (o[:rows] if isinstance(o, np.ndarray) else np.full(rows, o) for o in operands)
+    if oper == "DIV":
+        zero = np.nonzero(b == 0.0)[0]
+        if zero.size:
+            raise ApdlError(f"division by zero (row {int(zero[0]) + 1} of Par2)")
+        values = a / b
+    else:
+        values = _VOPER[oper](a, b)
+    if not np.all(np.isfinite(values)):
+        raise ApdlError("the result is not a finite number")
+    store(params, name, subs, [float(v) for v in values])
 
 
 def _is_reference(text: str) -> bool:
@@ -290,7 +349,7 @@ def star_msg(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(star_dim, star_vfill, star_vwrite, star_msg, out, cfopen, cfwrite, cfclos, star_list,
-              star_status, save, resume, star_set_values),
+    *specs_of(star_dim, star_vfill, star_vwrite, star_voper, star_msg, out, cfopen, cfwrite,
+              cfclos, star_list, star_status, save, resume, star_set_values),
     CommandSpec("/OUTPUT", ANY, 4, out),
 )
