@@ -92,3 +92,46 @@ ESEL,S,MAT,,2
     assert 0 < p["NE1"] < p["NE2"] and p["NM2"] == p["NE2"] - p["NE1"]
     with pytest.raises(ApdlError, match="ESYS, SECN"):
         run("/PREP7\nRECTNG,0,1,0,1\nAATT,1,1,1,11\n")
+
+
+# ------------------------------------------- lumped cooling, POST26 VGET of a history
+def test_post26_vget_moves_a_lumped_cooling_history_into_arrays():
+    # a copper square (Bi = h a/(4k) ≈ 1e-4) cooling by a film on its four sides, DELTIM
+    # fixed, the film stepped (KBC,1): backward Euler on the lumped body gives T_n = T_a + (T_0 − T_a)(1 + Δt/τ)^−n,
+    # τ = ρ c a / (4 h)
+    a, k, rho, c, h, T0, Ta = 0.01, 400.0, 8900.0, 385.0, 15.0, 200.0, 20.0
+    tau = rho * c * a / (4 * h)
+    deck = f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,{k}
+MP,DENS,1,{rho}
+MP,C,1,{c}
+BLC4,0,0,{a},{a}
+ESIZE,{a / 2}
+AMESH,ALL
+SFL,ALL,CONV,{h},,{Ta}
+TUNIF,{T0}
+FINISH
+/SOLU
+ANTYPE,TRANS
+KBC,1
+TIME,{tau / 2}
+DELTIM,{tau / 20}
+OUTRES,ALL,ALL
+SOLVE
+FINISH
+/POST26
+NSOL,2,NODE({a / 2},{a / 2},0),TEMP,,TC
+*DIM,TT,ARRAY,12
+*DIM,TC,ARRAY,12
+VGET,TT(1),1
+VGET,TC(2),2,{tau / 10}
+"""
+    p = {k: v.ravel() for k, v in run(deck).params.items() if isinstance(v, np.ndarray)}
+    n = np.arange(1, 11)
+    np.testing.assert_allclose(p["TT"][:10], n * tau / 20, rtol=1e-12)
+    assert list(p["TT"][10:]) == [0.0, 0.0]  # the history has 10 substeps
+    # from t = τ/10 (substep 2) on, written from row 2
+    be = Ta + (T0 - Ta) * (1 + 1 / 20) ** -n[1:]
+    np.testing.assert_allclose(p["TC"][1:10], be, rtol=2e-4)
+    assert p["TC"][0] == 0.0 and list(p["TC"][10:]) == [0.0, 0.0]
