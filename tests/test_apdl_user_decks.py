@@ -5,6 +5,8 @@ against numbers from the code.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -16,6 +18,32 @@ def run(text: str) -> Session:
     s = Session()
     s.run_text(text, "user.inp")
     return s
+
+
+# ------------------------------------------------------------ parameter functions
+def test_hyperbolic_functions_and_afun_degrees():
+    e = math.e
+    s = run("A = SINH(1)\nB = COSH(1)\nC = TANH(1)\n*AFUN,DEG\nD = SIN(30)\nE = COS(60)\n"
+            "F = TAN(45)\nG = ATAN2(1,1)\nH = ACOS(-1)\nI = ASIN(0.5)\nJ = ATAN(1)\n"
+            "*AFUN,RAD\nK = SIN(30)\nL = ACOS(-1)\n")
+    p = s.params
+    assert p["A"] == pytest.approx((e - 1 / e) / 2, rel=1e-15)
+    assert p["B"] == pytest.approx((e + 1 / e) / 2, rel=1e-15)
+    assert p["C"] == pytest.approx((e * e - 1) / (e * e + 1), rel=1e-15)
+    # degrees: the textbook angles
+    for name, value in {"D": 0.5, "E": 0.5, "F": 1.0, "G": 45.0, "H": 180.0, "I": 30.0,
+                        "J": 45.0}.items():
+        assert p[name] == pytest.approx(value, rel=1e-14), name
+    # back to radians: sin(30 rad) = -0.98803..., acos(-1) = π
+    assert p["K"] == pytest.approx(-0.9880316240928618, rel=1e-14)
+    assert p["L"] == pytest.approx(math.pi, rel=1e-15)
+    with pytest.raises(ApdlError, match="RAD, DEG or STAT"):
+        run("*AFUN,GRAD\n")
+
+
+def test_hyperbolic_overflow_is_a_located_error():
+    with pytest.raises(ApdlError, match="user.inp:1: .*COSH overflows"):
+        run("A = COSH(1000)\n")
 
 
 # ------------------------------------------------------------------- *VOPER
@@ -39,6 +67,78 @@ def test_voper_operates_down_the_columns():
     ]:
         with pytest.raises(ApdlError, match=message):
             run(deck)
+
+
+# ------------------------------------------------- a rod heated inside (axisymmetric)
+ROD = """/PREP7
+R_O = 0.025
+LEN = 0.01
+K_R = 15.0
+QGEN = 2.0E6
+H_F = 200.0
+T_F = 30.0
+ET,1,PLANE77,,,1
+MP,KXX,1,K_R
+RECTNG,0,R_O,0,LEN
+LESIZE,1,,,6
+LESIZE,3,,,6
+LESIZE,2,,,1
+LESIZE,4,,,1
+AMESH,ALL
+SFL,2,CONV,H_F,,T_F
+BFE,ALL,HGEN,,QGEN
+FINISH
+/SOLU
+SOLVE
+FINISH
+/POST1
+*GET,NCNT,NODE,0,COUNT
+*GET,NMAX,NODE,0,NUM,MAX
+*DIM,TN,ARRAY,NMAX+2
+*DIM,XN,ARRAY,NMAX+2
+*DIM,SEL,ARRAY,NMAX+2
+*VGET,TN(1),NODE,1,TEMP
+*VGET,XN(1),NODE,1,LOC,X
+NSEL,S,LOC,X,0
+*VGET,SEL(1),NODE,1,NSEL
+ALLSEL
+*DIM,TG,ARRAY,3
+*DO,I,1,3
+*GET,TG(I),NODE,I,TEMP
+*ENDDO
+"""
+
+
+def test_vget_reads_every_node_of_a_rod_with_heat_generation():
+    # T(r) = T_F + q R/(2h) + q (R² − r²)/(4k): quadratic in r, which PLANE77 holds exactly
+    s = run(ROD)
+    p = {k: v.ravel() if isinstance(v, np.ndarray) else v for k, v in s.params.items()}
+    R, q, k, h, Tf = 0.025, 2.0e6, 15.0, 200.0, 30.0
+    n = int(p["NMAX"])
+    x, T = p["XN"][:n], p["TN"][:n]
+    assert p["NCNT"] == n  # nodes 1..n, no gaps
+    exact = Tf + q * R / (2 * h) + q * (R**2 - x**2) / (4 * k)
+    np.testing.assert_allclose(T, exact, rtol=0, atol=1e-9)
+    assert T.max() == pytest.approx(Tf + q * R / (2 * h) + q * R**2 / (4 * k), abs=1e-9)
+    # past the last node: 0, as MAPDL gives for node numbers that do not exist
+    np.testing.assert_array_equal(p["TN"][n:], [0.0, 0.0])
+    # NSEL: 1 selected (the axis), -1 the rest
+    sel = p["SEL"][:n]
+    np.testing.assert_array_equal(sel, np.where(np.isclose(x, 0.0), 1.0, -1.0))
+    # *GET into an array element, in a *DO loop
+    np.testing.assert_array_equal(p["TG"], T[:3])
+
+
+@pytest.mark.parametrize("deck, message", [
+    ("*VGET,TQ(1),NODE,1,TEMP\n", "TQ is not a numeric array"),
+    ("*DIM,TQ,ARRAY,2\n*VGET,TQ(1),KP,1,LOC,X\n", "supports NODE"),
+    ("*DIM,TQ,ARRAY,2\n*VGET,TQ(1),NODE,1,TEMP,,,,1\n", "KLOOP"),
+    ("*GET,1X,NODE,0,COUNT\n", "field 1"),
+    ("*GET,TQ(1),NODE,0,COUNT\n", "TQ is not an array"),
+])
+def test_vget_and_get_refuse_what_they_cannot_do(deck, message):
+    with pytest.raises(ApdlError, match=message):
+        run("/PREP7\nN,1,0,0\n" + deck)
 
 
 # ------------------------------------------------------------ AATT, two materials
