@@ -6,6 +6,8 @@ against numbers from the code.
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -60,6 +62,11 @@ def test_voper_operates_down_the_columns():
     np.testing.assert_array_equal(p["M"].ravel(), [2.5, 2.5, 3.0, 4.0])
     np.testing.assert_array_equal(p["G"].ravel(), [0.0, 0.0, 1.0, 1.0])
     np.testing.assert_array_equal(p["S"].ravel(), [-7.0, -2.0, 1.0, 3.0])
+    # MAPDL: the rows run to the end of the result's column; an input column that ends
+    # before is read as zeros (A(3), A(4), then 0, 0)
+    s = run("*DIM,A,ARRAY,4\n*VFILL,A(1),DATA,1,2,3,4\n*DIM,R,ARRAY,4\n"
+            "*VOPER,R(1),A(3),ADD,0.5\n")
+    np.testing.assert_array_equal(s.params["R"].ravel(), [3.5, 4.5, 0.5, 0.5])
     for deck, message in [
         ("*DIM,A,ARRAY,2\n*DIM,B,ARRAY,2\n*VOPER,A(1),A(1),DIV,B(1)\n", "division by zero"),
         ("*DIM,A,ARRAY,2\n*VOPER,A(1),A(1),DER1,A(1)\n", "supports ADD, SUB"),
@@ -67,6 +74,30 @@ def test_voper_operates_down_the_columns():
     ]:
         with pytest.raises(ApdlError, match=message):
             run(deck)
+
+
+def test_vscfun_reduces_a_column_to_a_scalar():
+    # x = 3, 1, 4, 1, 5 (from row 2 of a 6-row column whose row 1 is 9)
+    s = run("*DIM,X,ARRAY,6\n*VFILL,X(1),DATA,9,3,1,4,1,5\n"
+            + "".join(f"*VSCFUN,V{f},{f},X(2)\n" for f in
+                      ("MAX", "MIN", "SUM", "MEAN", "MEDI", "VARI", "STDV", "RMS", "NUM"))
+            + "*DIM,Y,ARRAY,5\n*VFILL,Y(1),DATA,0,2,7,7,0\n"
+            + "".join(f"*VSCFUN,Y{f},{f},Y(1)\n" for f in ("LMAX", "LMIN", "FIRST", "LAST")))
+    p = s.params
+    mean = 14 / 5
+    vari = ((3 - mean) ** 2 + 2 * (1 - mean) ** 2 + (4 - mean) ** 2 + (5 - mean) ** 2) / 5
+    assert (p["VMAX"], p["VMIN"], p["VSUM"], p["VMEDI"], p["VNUM"]) == (5.0, 1.0, 14.0, 3.0,
+                                                                       5.0)
+    assert p["VMEAN"] == pytest.approx(mean, rel=1e-15)
+    assert p["VVARI"] == pytest.approx(vari, rel=1e-14)  # 2.16, over NUM as MAPDL documents
+    assert p["VSTDV"] == pytest.approx(math.sqrt(vari), rel=1e-14)
+    assert p["VRMS"] == pytest.approx(math.sqrt((9 + 1 + 16 + 1 + 25) / 5), rel=1e-15)
+    # row numbers: the first maximum (row 3), the first minimum (row 1), nonzero 2..4
+    assert (p["YLMAX"], p["YLMIN"], p["YFIRST"], p["YLAST"]) == (3.0, 1.0, 2.0, 4.0)
+    with pytest.raises(ApdlError, match="from a row other than 1"):
+        run("*DIM,X,ARRAY,3\n*VSCFUN,L,LMAX,X(2)\n")
+    with pytest.raises(ApdlError, match="supports MAX"):
+        run("*DIM,X,ARRAY,3\n*VSCFUN,L,KURT,X(1)\n")
 
 
 # ------------------------------------------------- a rod heated inside (axisymmetric)
@@ -197,8 +228,8 @@ ESEL,S,MAT,,2
 # ------------------------------------------- lumped cooling, POST26 VGET of a history
 def test_post26_vget_moves_a_lumped_cooling_history_into_arrays():
     # a copper square (Bi = h a/(4k) ≈ 1e-4) cooling by a film on its four sides, DELTIM
-    # fixed, the film stepped (KBC,1): backward Euler on the lumped body gives T_n = T_a + (T_0 − T_a)(1 + Δt/τ)^−n,
-    # τ = ρ c a / (4 h)
+    # fixed, the film stepped (KBC,1): backward Euler on the lumped body gives
+    # T_n = T_a + (T_0 − T_a)(1 + Δt/τ)^−n, τ = ρ c a / (4 h)
     a, k, rho, c, h, T0, Ta = 0.01, 400.0, 8900.0, 385.0, 15.0, 200.0, 20.0
     tau = rho * c * a / (4 * h)
     deck = f"""/PREP7
@@ -235,3 +266,16 @@ VGET,TC(2),2,{tau / 10}
     be = Ta + (T0 - Ta) * (1 + 1 / 20) ** -n[1:]
     np.testing.assert_allclose(p["TC"][1:10], be, rtol=2e-4)
     assert p["TC"][0] == 0.0 and list(p["TC"][10:]) == [0.0, 0.0]
+
+
+@pytest.mark.parametrize("command", ["*VLEN,2", "*VMASK,M(1)", "*VABS,1", "*VFACT,2",
+                                     "*VCUM,1"])
+def test_vector_controls_are_refused_not_ignored(command, tmp_path):
+    # ignored with a warning, *VLEN,2 would leave the *VOPER after it running over every row
+    deck = tmp_path / "d.inp"
+    deck.write_text(f"*DIM,A,ARRAY,3\n{command}\n*VOPER,A(1),1,ADD,1\n")
+    done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
+                           str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    name = command.split(",")[0]
+    assert f"{deck}:2: {name}: not supported" in done.stderr

@@ -1,5 +1,5 @@
-"""Results tables and listings: *DIM, *VFILL, *VOPER, *VWRITE, *MSG, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
-*LIST, *STATUS, SAVE and RESUME (valid in every processor).
+"""Results tables and listings: *DIM, *VFILL, *VOPER, *VSCFUN, *VWRITE, *MSG, /OUT,
+*CFOPEN/*CFWRITE/*CFCLOS, *LIST, *STATUS, SAVE and RESUME (valid in every processor).
 
 Files the deck writes are kept in memory by name (`SessionState.listing.files`) and written
 by the CLI inside its --out folder only: a name is a plain file name, never a path.  SAVE and
@@ -143,9 +143,10 @@ def star_voper(s: SessionState, c: Call) -> None:
     """*VOPER,ParR(i),Par1(j),Oper,Par2(k): element by element down the columns, ParR =
     Par1 Oper Par2, for ADD, SUB, MULT, DIV, MIN, MAX and the comparisons LT, LE, EQ, NE,
     GE, GT (1 true, 0 false).  Par1 and Par2 are array elements (the column from there on)
-    or a scalar parameter or number, used on every row; the rows run from ParR(i) to the end
-    of the shortest column named.  Derivatives, integrals, GATH/SCAT, DOT/CROSS, *VLEN and
-    *VMASK are not supported."""
+    or a scalar parameter or number, used on every row.  As MAPDL documents, the rows run
+    from ParR(i) to the end of ParR's column, and an input column that ends before is read
+    as zeros.  Derivatives, integrals, GATH/SCAT, DOT/CROSS, *VLEN and *VMASK are not
+    supported."""
     params, funcs = s.params, s.model_functions
     oper = c.label(3)
     if oper not in (*_VOPER, "DIV"):
@@ -174,8 +175,8 @@ def star_voper(s: SessionState, c: Call) -> None:
                 continue
         operands.append(c.num(field, what=f"Par{field // 2}"))
     rows = result.shape[0] - element_index(name, result, subs)[0]
-    rows = min([rows, *(len(o) for o in operands if isinstance(o, np.ndarray))])
-    a, b = (o[:rows] if isinstance(o, np.ndarray) else np.full(rows, o) for o in operands)
+    a, b = (np.pad(o[:rows], (0, max(rows - len(o), 0))) if isinstance(o, np.ndarray)
+            else np.full(rows, o) for o in operands)
     if oper == "DIV":
         zero = np.nonzero(b == 0.0)[0]
         if zero.size:
@@ -186,6 +187,58 @@ def star_voper(s: SessionState, c: Call) -> None:
     if not np.all(np.isfinite(values)):
         raise ApdlError("the result is not a finite number")
     store(params, name, subs, [float(v) for v in values])
+
+
+_VSCFUN = ("MAX", "MIN", "LMAX", "LMIN", "FIRST", "LAST", "SUM", "MEDI", "MEAN", "VARI",
+           "STDV", "RMS", "NUM")
+
+
+@command("*VSCFUN", ANY, 3)
+def star_vscfun(s: SessionState, c: Call) -> None:
+    """*VSCFUN,ParR,Func,Par1(i): a scalar from the column of Par1 from row i to its end:
+    MAX, MIN, SUM, MEAN, MEDI (the middle value; the mean of the two middle ones for an
+    even count), VARI (Σ(x − mean)²/NUM), STDV (its square root), RMS, NUM, and the row
+    numbers LMAX, LMIN, FIRST and LAST (first and last nonzero value; 0 when none), these
+    four from row 1 only.  *VLEN, *VMASK, *VABS, *VFACT and *VCUM are not supported."""
+    params, funcs = s.params, s.model_functions
+    target = c.raw(1).strip().upper()
+    if not is_parameter_name(target):
+        raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
+    func = c.label(2)
+    if func not in _VSCFUN:
+        raise ApdlError(f"field 2: *VSCFUN supports {', '.join(_VSCFUN)}, got "
+                        f"{func or '(empty)'!r}")
+    name, subs_text = split_target(c.raw(3).strip())
+    array = params.get(name)
+    if not isinstance(array, np.ndarray) or array.dtype == object:
+        raise ApdlError(f"field 3: {name} is not a numeric array (define it with *DIM first)")
+    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    start = element_index(name, array, subs)
+    x = np.array(column(params, name, subs), float)
+    if func in ("LMAX", "LMIN", "FIRST", "LAST"):
+        if start[0] != 0:
+            raise ApdlError(f"{func} from a row other than 1 is not supported (is the row "
+                            "counted from row 1 or from the start?)")
+        nonzero = np.nonzero(x)[0]
+        value = float({"LMAX": np.argmax(x) + 1, "LMIN": np.argmin(x) + 1,
+                       "FIRST": nonzero[0] + 1 if nonzero.size else 0,
+                       "LAST": nonzero[-1] + 1 if nonzero.size else 0}[func])
+    else:
+        mean = float(x.mean())
+        value = {"MAX": float(x.max()), "MIN": float(x.min()), "SUM": float(x.sum()),
+                 "MEDI": float(np.median(x)), "MEAN": mean, "NUM": float(x.size),
+                 "VARI": float(((x - mean) ** 2).mean()),
+                 "STDV": float(np.sqrt(((x - mean) ** 2).mean())),
+                 "RMS": float(np.sqrt((x ** 2).mean()))}[func]
+    params[target] = value
+
+
+def _vector_control(s: SessionState, c: Call) -> None:
+    """*VLEN, *VMASK, *VABS, *VFACT, *VCUM: refused rather than ignored, since ignoring one
+    would change what the next *VOPER, *VSCFUN or *VWRITE computes without a word."""
+    raise ApdlError("not supported: *VGET, *VOPER, *VSCFUN and *VWRITE here run over whole "
+                    "columns, with no length, mask, absolute value, scale factor or "
+                    "accumulation")
 
 
 def _is_reference(text: str) -> bool:
@@ -349,7 +402,9 @@ def star_msg(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(star_dim, star_vfill, star_vwrite, star_voper, star_msg, out, cfopen, cfwrite,
-              cfclos, star_list, star_status, save, resume, star_set_values),
+    *specs_of(star_dim, star_vfill, star_vwrite, star_voper, star_vscfun, star_msg, out,
+              cfopen, cfwrite, cfclos, star_list, star_status, save, resume, star_set_values),
     CommandSpec("/OUTPUT", ANY, 4, out),
+    *(CommandSpec(name, ANY, 10, _vector_control)
+      for name in ("*VLEN", "*VMASK", "*VABS", "*VFACT", "*VCUM")),
 )
