@@ -279,3 +279,70 @@ def test_vector_controls_are_refused_not_ignored(command, tmp_path):
     assert done.returncode == 2 and "Traceback" not in done.stderr
     name = command.split(",")[0]
     assert f"{deck}:2: {name}: not supported" in done.stderr
+
+
+# ------------------------------- a held and cooled bar: ENAME, PLNSOL, *DOWHILE, SFCUM
+BAR = """/PREP7
+ET,1,PLANE55
+ET,2,PLANE77
+MP,KXX,1,1
+RECTNG,0,0.1,0,0.01
+ESIZE,0.01
+AMESH,ALL
+ESEL,S,ENAME,,55
+*GET,N55,ELEM,0,COUNT
+ESEL,S,ENAME,,PLANE77
+*GET,N77,ELEM,0,COUNT
+ALLSEL
+NSEL,S,LOC,X,0
+D,ALL,TEMP,100
+NSEL,S,LOC,X,0.1
+SFCUM,CONV,REPL
+SF,ALL,CONV,10,20
+ALLSEL
+/SOLU
+SOLVE
+/POST1
+PLNSOL,TEMP
+*GET,TMAX,PLNSOL,0,MAX
+*GET,TMIN,PLNSOL,0,MIN
+NSEL,S,LOC,X,0.05,0.1
+PLNSOL,TEMP
+*GET,THALF,PLNSOL,0,MAX
+ALLSEL
+N = 0
+LEFT = 3
+*DOWHILE,LEFT
+N = N + 1
+LEFT = LEFT - 1
+*ENDDO
+NEVER = 0
+*DOWHILE,NEVER
+NEVER = 99
+*ENDDO
+"""
+
+
+def test_ename_plnsol_extremes_dowhile_and_sfcum_in_a_cooled_bar():
+    # a bar held at 100 °C at x = 0, a film h = 10 at x = L = 0.1 (k = 1, insulated sides):
+    # T(x) = 100 − 80 (h x/k)/(1 + h L/k), so T(L) = 60 and T(L/2) = 80
+    p = run(BAR).params
+    assert (p["N55"], p["N77"]) == (10.0, 0.0)  # every element is a PLANE55
+    assert p["TMAX"] == pytest.approx(100.0, abs=1e-9)
+    assert p["TMIN"] == pytest.approx(60.0, abs=1e-9)
+    assert p["THALF"] == pytest.approx(80.0, abs=1e-9)  # the max over the nodes selected
+    assert p["N"] == 3.0 and p["LEFT"] == 0.0  # *DOWHILE loops while Par > 0
+    assert p["NEVER"] == 0.0  # Par = 0: the block is skipped
+    # outside /POST1 PLNSOL stays a plot command that changes nothing (as before)
+    assert run("/PREP7\nPLNSOL,TEMP\nA = 1\n").state.listing.warnings == []
+    for deck, message in [
+        ("/PREP7\nSFCUM,CONV,ADD\n", "only SFCUM,,REPL"),
+        ("/PREP7\nN,1\nET,1,PLANE55\n/POST1\n*GET,X,PLNSOL,0,MAX\n", "PLNSOL has not been run"),
+        (BAR + "PLNSOL,TF,SUM\n*GET,X,PLNSOL,0,MAX\n", "PLNSOL,TF,SUM is not supported"),
+        (BAR + "PLNSOL\n*GET,X,PLNSOL,0,MEAN\n", "MAX or MIN"),
+        ("/POST1\nPLNSOL,TEMP\n", "no results yet"),
+        ("I = 0\n*DOWHILE,I\n", "never closed"),
+        ("GO = 1\n*DOWHILE,GO\nX = 1\n*ENDDO\n", "loop iterations"),
+    ]:
+        with pytest.raises(ApdlError, match=message):
+            run(deck)

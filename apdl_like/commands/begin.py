@@ -45,7 +45,7 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
                    "/CONTOUR", "/DSCALE", "/ERASE", "/NOERASE", "/HEADER", "/PAGE", "/FORMAT",
                    "/RGB", "/COLOR", "/PSF", "/PBC", "/PSYMB", "/TRLCY", "/VSCALE", "/GFILE",
                    "/GST", "/GLINE", "/UIS", "/MENU", "/WAIT", "/OUTOPT", "/ZOOM", "/USER",
-                   "EPLOT", "NPLOT", "KPLOT", "LPLOT", "APLOT", "GPLOT", "PLNSOL", "PLESOL",
+                   "EPLOT", "NPLOT", "KPLOT", "LPLOT", "APLOT", "GPLOT", "PLESOL",
                    "PLVECT", "PLDISP", "PLPATH", "PLVAR", "NLIST", "ELIST", "KLIST", "LLIST",
                    "ALIST", "DLIST", "SFLIST", "SFELIST", "BFLIST", "BFELIST", "CPLIST",
                    "MPLIST", "ETLIST", "RLIST", "CMLIST", "PRETAB", "PRESOL", "PRRSOL",
@@ -93,6 +93,16 @@ def _get_value(s: SessionState, c: Call) -> float:
         if s.radiation.average is None:
             raise ApdlError("VFQUERY has not been run")
         return s.radiation.average
+    if entity == "PLNSOL":  # *GET,Par,PLNSOL,0,MAX|MIN of the last PLNSOL
+        if s.plot_extremes is None:
+            raise ApdlError("PLNSOL has not been run (*GET,,PLNSOL reads the last PLNSOL)")
+        shown, extremes = s.plot_extremes
+        if extremes is None:
+            raise ApdlError(f"PLNSOL,{shown} is not supported for *GET,,PLNSOL (its items are "
+                            "NSORT's: TEMP, U,X|Y|SUM, S,X|Y|Z|XY|EQV, LOC,X|Y)")
+        if item not in ("MAX", "MIN"):
+            raise ApdlError(f"field 4: PLNSOL takes MAX or MIN, got {item or '(empty)'!r}")
+        return extremes[0] if item == "MAX" else extremes[1]
     if entity == "SORT":  # *GET,Par,SORT,,MAX|MIN|IMAX|IMIN of the last NSORT
         return sort_extreme(s, item)
     if entity == "ACTIVE":
@@ -102,8 +112,8 @@ def _get_value(s: SessionState, c: Call) -> float:
         res = s.result()
         return float(res.time if sub == "TIME" else res.load_step)
     if entity not in ("NODE", "ELEM"):
-        raise ApdlError(f"field 2: entity must be NODE, ELEM, ACTIVE, FSUM, SSUM, VARI, RAD or "
-                        f"SORT, got {entity or '(empty)'!r}")
+        raise ApdlError(f"field 2: entity must be NODE, ELEM, ACTIVE, FSUM, SSUM, VARI, RAD, "
+                        f"SORT or PLNSOL, got {entity or '(empty)'!r}")
     if item == "COUNT":  # MAPDL's spelling: *GET,Par,NODE,0,COUNT
         item, sub = "NUM", "COUNT"
     if item == "NUM":
