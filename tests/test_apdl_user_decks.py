@@ -346,3 +346,19 @@ def test_ename_plnsol_extremes_dowhile_and_sfcum_in_a_cooled_bar():
     ]:
         with pytest.raises(ApdlError, match=message):
             run(deck)
+
+
+@pytest.mark.parametrize("props, nonlinear", [
+    ("MPTEMP,1,0,500\nMPDATA,C,1,1,1000,1000\n", False),  # a constant written as a table
+    ("MPTEMP,1,20\nMPDATA,KXX,1,1,5\n", False),  # one point
+    ("MP,KXX,1,5,0,0\n", False),  # C1.. of zero
+    ("MPTEMP,1,0,500\nMPDATA,C,1,1,1000,1100\n", True),
+    ("MP,KXX,1,5,0.01\n", True),
+])
+def test_a_constant_property_table_solves_linearly(props, nonlinear):
+    # a slab's c given as a two-point table of one value iterated every substep (140 s for
+    # a deck that takes 10 s with MP,C)
+    from apdl_like.plane_solve import _is_nonlinear
+
+    s = run("/PREP7\nMP,DENS,1,1\nMP,KXX,1,1\nMP,C,1,1\n" + props)
+    assert _is_nonlinear(s.db, [1]) is nonlinear
