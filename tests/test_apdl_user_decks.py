@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -362,3 +363,99 @@ def test_a_constant_property_table_solves_linearly(props, nonlinear):
 
     s = run("/PREP7\nMP,DENS,1,1\nMP,KXX,1,1\nMP,C,1,1\n" + props)
     assert _is_nonlinear(s.db, [1]) is nonlinear
+
+
+# ------------------------------------------ whole decks a thermal engineer brings along
+USER_DECKS = Path(__file__).parent / "data" / "user_decks"
+
+
+def run_deck(name: str) -> dict:
+    s = Session()
+    s.run_file(USER_DECKS / name)
+    assert s.state.listing.warnings == [], name  # every command of these decks is known
+    assert s.state.listing.files, name  # each writes its results table
+    return {k: v.ravel() if isinstance(v, np.ndarray) else v for k, v in s.params.items()}
+
+
+def test_user_deck_plane_wall_with_two_films():
+    # series resistances 1/h_i + L/k + 1/h_o; linear elements hold the linear field exactly
+    p = run_deck("wall.inp")
+    q = (20.0 - -10.0) / (1 / 10.0 + 0.2 / 1.4 + 1 / 25.0)
+    assert p["T_SI"] == pytest.approx(20.0 - q / 10.0, abs=1e-9)
+    assert p["T_SO"] == pytest.approx(-10.0 + q / 25.0, abs=1e-9)
+
+
+def test_user_deck_rod_with_heat_generation_every_node():
+    # T(r) = T_f + q R/(2h) + q (R² − r²)/(4k): PLANE77 holds the quadratic exactly
+    p = run_deck("rod_hgen.inp")
+    R, q, k, h, Tf = 0.025, 2.0e6, 15.0, 200.0, 30.0
+    assert p["TS"] == pytest.approx(Tf + q * R / (2 * h), abs=1e-9)  # 155
+    assert p["TC"] == pytest.approx(Tf + q * R / (2 * h) + q * R**2 / (4 * k), abs=1e-9)
+    assert p["NCNT"] == 85.0 and p["ERRMAX"] < 1e-9  # every node, read by *VGET
+
+
+def test_user_deck_lumped_cooling_in_a_do_loop_of_load_steps():
+    # τ = ρ c a/(4h); five load steps of τ/2 with Δt = τ/200 (backward Euler):
+    # T = T_a + (T_0 − T_a)(1 + 1/200)^−100 i; Bi ≈ 1e-4 leaves the centre 1e-4 warmer
+    p = run_deck("lumped.inp")
+    i = np.arange(1, 6)
+    euler = 20.0 + 180.0 * (1 + 1 / 200) ** (-100.0 * i)
+    np.testing.assert_allclose(p["TNUM"], euler, rtol=2e-4)
+    exact = 20.0 + 180.0 * np.exp(-i / 2)  # the time step's own error: under 0.3 %
+    np.testing.assert_allclose(p["TNUM"], exact, rtol=3e-3)
+    assert p["TMIN"] == pytest.approx(p["TNUM"][-1], rel=1e-12)  # POST26, the same node
+
+
+def test_user_deck_fin_with_tip_convection():
+    # 1-D fin, P = 2 per unit depth: q = M (sinh mL + (h/mk) cosh mL)/(cosh mL + (h/mk)
+    # sinh mL), θ_tip/θ_b = 1/(cosh mL + (h/mk) sinh mL); Bi = h t/(2k) ≈ 2e-4
+    p = run_deck("fin.inp")
+    L, t, k, h, Tb, Ta = 0.05, 0.002, 180.0, 40.0, 100.0, 25.0
+    m = math.sqrt(2 * h / (k * t))
+    a = h / (m * k)
+    M = math.sqrt(2 * h * k * t) * (Tb - Ta)
+    denominator = math.cosh(m * L) + a * math.sinh(m * L)
+    assert p["QNUM"] == pytest.approx(M * (math.sinh(m * L) + a * math.cosh(m * L))
+                                      / denominator, rel=1e-4)  # 258.09 W/m
+    assert p["TTIP"] == pytest.approx(Ta + (Tb - Ta) / denominator, rel=1e-5)
+
+
+def test_user_deck_slab_with_a_step_surface_temperature():
+    # θ/θ_i at the mid-plane = Σ 2(−1)^n/λ_n exp(−λ_n² Fo), λ_n = (2n + 1)π/2, Fo = 0.2
+    p = run_deck("slab.inp")
+    lam = (2 * np.arange(30) + 1) * math.pi / 2
+    series = float(np.sum(2 * (-1.0) ** np.arange(30) / lam * np.exp(-lam**2 * 0.2)))
+    assert p["TC_END"] == pytest.approx(120.0 - 100.0 * series, rel=1e-3)  # 42.77 °C
+
+
+def test_user_deck_insulated_pipe_with_conductivity_rising_with_temperature():
+    # steel wall (k = 45) inside insulation with k = 0.04 + 1e-4 T (the MPDATA points lie on
+    # it, so the interpolation is exact): the Kirchhoff transform of the insulation, with
+    # the film at R3, solved for the heat per metre by bisection
+    p = run_deck("pipe.inp")
+    r1, r2, r3, h = 0.050, 0.055, 0.105, 8.0
+    k0, b = 0.04, 1e-4
+
+    def temperatures(q: float) -> tuple[float, float, float]:
+        t2 = 250.0 - q * math.log(r2 / r1) / (2 * math.pi * 45.0)
+        c = k0 * t2 + b / 2 * t2**2 - q * math.log(r3 / r2) / (2 * math.pi)
+        t3 = (-k0 + math.sqrt(k0**2 + 2 * b * c)) / b
+        return t2, t3, q - h * 2 * math.pi * r3 * (t3 - 20.0)
+
+    lo, hi = 0.0, 300.0
+    for _ in range(100):
+        mid = (lo + hi) / 2
+        lo, hi = (lo, mid) if temperatures(mid)[2] > 0 else (mid, hi)
+    t2, t3, _ = temperatures(lo)
+    assert p["T2"] == pytest.approx(t2, rel=1e-5)
+    assert p["T3"] == pytest.approx(t3, rel=5e-4)  # 40.99 °C
+    assert abs(p["Q_PER_M"]) == pytest.approx(lo, rel=5e-4)  # 110.76 W/m
+
+
+def test_user_deck_film_sweep_in_a_do_loop_of_analyses():
+    # an insulated-tip bar cooled on one face: θ_tip/θ_b = 1/cosh(mL), m = √(h/(k t))
+    p = run_deck("study.inp")
+    h = np.array([5.0, 10.0, 20.0, 40.0])
+    exact = 20.0 + 60.0 / np.cosh(np.sqrt(h / (200.0 * 0.004)) * 0.1)
+    np.testing.assert_allclose(p["TTIP"], exact, rtol=2e-4)
+    assert p["RMAX"] == pytest.approx(float(np.max(p["TTIP"] / exact)), rel=1e-12)
