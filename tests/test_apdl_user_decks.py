@@ -224,6 +224,7 @@ ESEL,S,MAT,,2
     assert 0 < p["NE1"] < p["NE2"] and p["NM2"] == p["NE2"] - p["NE1"]
     with pytest.raises(ApdlError, match="ESYS, SECN"):
         run("/PREP7\nRECTNG,0,1,0,1\nAATT,1,1,1,11\n")
+    run("/PREP7\nRECTNG,0,1,0,1\nAATT,1,1,1,0,0\n")  # the defaults, written out
 
 
 # ------------------------------------------- lumped cooling, POST26 VGET of a history

@@ -223,9 +223,10 @@ def _range_of(c: Call, table: dict, what: str, field: str) -> list[int]:
 @command("AATT", PREP7, 5)
 def aatt(s: SessionState, c: Call) -> None:
     """AATT,MAT,REAL,TYPE: the attributes AMESH gives the elements of the selected areas
-    (blank fields: 1, as MAPDL's defaults); ESYS and SECN (fields 4, 5) are not supported."""
-    if c.given(4) or c.given(5):
-        raise ApdlError("fields 4-5 (ESYS, SECN) are not supported")
+    (blank fields: 1, as MAPDL's defaults); ESYS and SECN (fields 4, 5) other than 0 are
+    not supported."""
+    if c.num(4, 0.0, what="ESYS") != 0.0 or c.num(5, 0.0, what="SECN") != 0.0:
+        raise ApdlError("fields 4-5 (ESYS, SECN) other than 0 are not supported")
     db = s.db
     chosen = [num for num in sorted(db.areas) if num not in db.unselected_areas]
     if not chosen:
