@@ -111,7 +111,7 @@ def run(
         raise stopped
     if not quiet:
         errors = session.state.listing.errors
-        told = f"; {errors} *MSG,ERROR message(s) in log.txt" if errors else ""
+        told = f"; {errors} *MSG,ERROR message(s), told on stderr" if errors else ""
         typer.echo(f"{deck}: {len(session.results)} load step(s) solved; wrote "
                    f"{len(written)} files to {out}{told}")
 

@@ -75,6 +75,9 @@ BUILTINS: dict[str, tuple[Callable[..., float], int, int]] = {
     "ACOS": (math.acos, 1, 1),
     "ATAN": (math.atan, 1, 1),
     "ATAN2": (math.atan2, 2, 2),
+    "SINH": (math.sinh, 1, 1),
+    "COSH": (math.cosh, 1, 1),
+    "TANH": (math.tanh, 1, 1),
     "MIN": (min, 1, 20),
     "MAX": (max, 1, 20),
     "SIGN": (_sign, 2, 2),
@@ -363,10 +366,25 @@ def _binary(op: str, left: Evaluator, right: Evaluator) -> Evaluator:
     return binop
 
 
+# *AFUN,DEG: the model-function mapping holds this key, a function giving the radians in
+# one unit of angle (π/180); the trig functions take their argument, and the inverse ones
+# give their result, in that unit.  Without it they are in radians, MAPDL's default.
+ANGLE_UNIT = "*AFUN"
+_ANGLE_ARGUMENT = ("SIN", "COS", "TAN")
+_ANGLE_RESULT = ("ASIN", "ACOS", "ATAN", "ATAN2")
+
+
 def _builtin_call(name: str, func: Callable[..., float], args: list[Evaluator]) -> Evaluator:
+    angle_in, angle_out = name in _ANGLE_ARGUMENT, name in _ANGLE_RESULT
+
     def call(params: Mapping[str, float], funcs: Mapping[str, ModelFunction]) -> float:
         values = [a(params, funcs) for a in args]
+        unit = funcs.get(ANGLE_UNIT) if angle_in or angle_out else None
         try:
+            if unit is not None:
+                if angle_in:
+                    return float(func(values[0] * unit()))
+                return float(func(*values)) / unit()
             return float(func(*values))
         except (ValueError, ZeroDivisionError):
             shown = ", ".join(repr(v) for v in values)

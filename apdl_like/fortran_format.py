@@ -5,7 +5,8 @@ Edit descriptors: `Aw` (text, right-justified in w, or its first w characters), 
 `2(A8,F8.3)`).  A number too wide for its field prints as w asterisks, as Fortran does.
 Output stops at the first data descriptor with no value left.  A C-style line
 (`%14.5G %I %C`) is accepted too; *MSG's lines are C-style, their bare `%I`, `%G`, `%C` the
-Fortran `I9` (NINT), `1PG16.9` and `A8` MAPDL documents for them.
+Fortran `I9` (NINT), `1PG16.9` and `A8` MAPDL documents for them.  Every integer edit
+(`Iw`, `%I`, `%wI`) takes the nearest integer, halves away from zero (`integer`).
 """
 
 from __future__ import annotations
@@ -114,8 +115,19 @@ def general(value: float, width: int, decimals: int, scale: int = 0) -> str:
     return exponential(value, width, decimals)
 
 
+def integer(value: float) -> str:
+    """The digits an integer edit (`Iw`, `%I`, `%wI`) writes for a real value: MAPDL's
+    values are all double precision and it forms the integer with Fortran's NINT (*MSG's
+    documentation, which *VWRITE's C formats refer to), halves away from zero: 2.5 -> 3,
+    -2.5 -> -3, 3.5 -> 4 (Python's round() gives 2, -2, 4).  NaN and Inf are written as
+    such, as F editing writes them."""
+    if not math.isfinite(value):
+        return "NaN" if math.isnan(value) else ("Inf" if value > 0 else "-Inf")
+    return str(int(nint(value)))
+
+
 # *MSG's bare descriptors as the Fortran edits MAPDL names for them
-_MSG_BARE = {"I": lambda v: _stars(str(int(nint(v))), 9),
+_MSG_BARE = {"I": lambda v: _stars(integer(v), 9),
              "G": lambda v: general(v, 16, 9, scale=1)}
 
 
@@ -149,7 +161,7 @@ def format_line(items: Sequence[tuple[str, int, int, str]],
         elif kind == "G":
             current += general(value, width, decimals)
         else:  # I
-            current += _stars(str(int(round(value))), width)
+            current += _stars(integer(value), width)
     lines.append(current)
     return lines
 
@@ -199,9 +211,8 @@ def format_c_line(line: str, values: Sequence[float | str],
         if isinstance(value, str):
             raise ApdlError(f"%{kind}: {value!r} is text, a number is needed")
         d = int(decimals) if decimals is not None else 6
-        spec = {"I": "d", "G": "g", "E": "E", "F": "f"}[kind]
-        number = int(round(value)) if kind == "I" else value
-        body = f"{number:{'' if kind == 'I' else '.' + str(d)}{spec}}".upper()
+        spec = {"G": "g", "E": "E", "F": "f"}.get(kind, "")
+        body = integer(value) if kind == "I" else f"{value:.{d}{spec}}".upper()
         out[-1] += body.ljust(abs(w)) if width.startswith("-") else body.rjust(w)
     out[-1] += line[pos:]
     return out

@@ -34,8 +34,8 @@ IF_OPERATORS = ("EQ", "NE", "LT", "GT", "LE", "GE", "ABLT", "ABGT")
 EQ_TOLERANCE = 1e-10  # APDL compares *IF values with this absolute tolerance
 # statements `execute` runs itself (assignments, control flow, /INPUT, *REPEAT, bad lines);
 # every other name is a command for `_dispatch`
-_CONTROL = frozenset((BAD_LINE, "=", "*DO", "*ENDDO", "*IF", "*ELSEIF", "*ELSE", "*ENDIF",
-                      "*EXIT", "*CYCLE", "/INPUT", "*REPEAT", "*USE", "/EOF"))
+_CONTROL = frozenset((BAD_LINE, "=", "*DO", "*DOWHILE", "*ENDDO", "*IF", "*ELSEIF", "*ELSE",
+                      "*ENDIF", "*EXIT", "*CYCLE", "/INPUT", "*REPEAT", "*USE", "/EOF"))
 # a macro's local parameters, in MAPDL's spelling: ARG1..ARG9, then AR10..AR19
 MACRO_ARGUMENTS = tuple(f"ARG{k}" for k in range(1, 10)) + tuple(f"AR{k}" for k in range(10, 20))
 MACRO_EXTENSION = "mac"
@@ -148,6 +148,14 @@ def execute(session: SessionState, program: Program, depth: int = 0) -> None:
             elif name == "*DO":
                 i = _start_loop(session, program, st, i, loops)
                 continue
+            elif name == "*DOWHILE":
+                if _value(session, st, 1, "Par") > 0.0:
+                    loops[i] = [0.0, 0.0, 0.0]
+                    _count_iteration(session, st)
+                    i += 1
+                else:
+                    i = program.block_end[i] + 1
+                continue
             elif name == "*ENDDO":
                 i = _next_iteration(session, program, i, loops)
                 continue
@@ -249,12 +257,18 @@ def _next_iteration(session: SessionState, program: Program, end: int,
                     loops: dict[int, list[float]]) -> int:
     do_index = next(j for j, e in program.block_end.items() if e == end)
     state = loops.get(do_index)
+    do_st = program.statements[do_index]
+    if do_st.name == "*DOWHILE":  # again while Par > 0, as MAPDL
+        if state is not None and _value(session, do_st, 1, "Par") > 0.0:
+            _count_iteration(session, do_st)
+            return do_index + 1
+        loops.pop(do_index, None)
+        return end + 1
     if state is None or state[2] <= 0:
         loops.pop(do_index, None)
         return end + 1
     state[0] += state[1]
     state[2] -= 1
-    do_st = program.statements[do_index]
     session.params[do_st.fields[0].upper()] = state[0]
     _count_iteration(session, do_st)
     return do_index + 1

@@ -533,6 +533,8 @@ class Database:
     esize_divisions: int | None = None  # ESIZE,,NDIV: divisions of lines without LESIZE
     mesh_triangles: bool = False  # MSHAPE,1
     meshed_areas: set[int] = field(default_factory=set)
+    # AATT: area -> (MAT, REAL, TYPE) its elements get from AMESH (else the active ones)
+    area_attributes: dict[int, tuple[int, int, int]] = field(default_factory=dict)
     area_elements: dict[int, np.ndarray] = field(default_factory=dict)  # AMESH: area -> elements
     line_elements: dict[int, np.ndarray] = field(default_factory=dict)  # LMESH: line -> elements
     keypoint_hgen: dict[int, float] = field(default_factory=dict)  # BFK,,HGEN, W/m³

@@ -10,8 +10,8 @@ an expression or a character value.  `*VWRITE`/`*MWRITE` carry their format line
 
 A line that cannot be lexed becomes a `BAD_LINE` statement holding the message, so a bad line
 stops the deck where it stands, not before the lines ahead of it have run.  Blocks
-(`*DO/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) are matched up front; a block that does not close
-truncates the program at its opening line, with the error raised there.
+(`*DO/*ENDDO`, `*DOWHILE/*ENDDO`, `*IF/*ELSEIF/*ELSE/*ENDIF`) are matched up front; a block
+that does not close truncates the program at its opening line, with the error raised there.
 """
 
 from __future__ import annotations
@@ -177,7 +177,7 @@ def _match_blocks(program: Program) -> None:
     stack: list[tuple[str, int]] = []  # ("DO"|"IF", index)
     for i, st in enumerate(program.statements):
         name = st.name
-        if name == "*DO":
+        if name in ("*DO", "*DOWHILE"):
             stack.append(("DO", i))
         elif name == "*IF" and _if_is_block(st):
             stack.append(("IF", i))
@@ -275,7 +275,7 @@ def parse_deck(text: str, file: str = "<deck>") -> Program:
             continue
         if st.name == "/EOF" and open_blocks <= 0:
             break  # the file ends here; what follows is never read
-        if st.name == "*DO" or (st.name == "*IF" and _if_is_block(st)):
+        if st.name in ("*DO", "*DOWHILE") or (st.name == "*IF" and _if_is_block(st)):
             open_blocks += 1
         elif st.name in ("*ENDDO", "*ENDIF"):
             open_blocks -= 1

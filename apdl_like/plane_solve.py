@@ -222,9 +222,17 @@ def material_property(db: Database, mat: int, label: str, why: str,
 
 
 def _is_nonlinear(db: Database, mats: list[int]) -> bool:
+    """Whether a property of these materials changes with temperature (Picard iteration).
+    An MPTEMP/MPDATA table of one value throughout, or C1..C4 of zero, is constant: a deck
+    that writes its constant c as a table solves linearly (it iterated every substep, 10×
+    the time)."""
     for mat in mats:
         m = db.materials.get(mat)
-        if m is not None and (m.tables or any(len(c) > 1 for c in m.coefficients.values())):
+        if m is None:
+            continue
+        if any(np.ptp(values) > 0.0 for _, values in m.tables.values()):
+            return True
+        if any(any(c[1:]) for c in m.coefficients.values()):
             return True
     return False
 

@@ -194,6 +194,9 @@ class SessionState:
     element_sums: dict[str, float] = field(default_factory=dict)
     # NSORT's last sort: node numbers and sort keys in sorted order (*GET,,SORT reads it)
     node_sort: tuple[np.ndarray, np.ndarray] | None = None
+    # PLNSOL's item and its (max, min) over the selected nodes (*GET,,PLNSOL reads it);
+    # (item, None) for an item PLNSOL cannot give here
+    plot_extremes: tuple[str, tuple[float, float] | None] | None = None
     radiation: Radiation = field(default_factory=Radiation)
     load_steps: dict[int, dict] = field(default_factory=dict)  # LSWRITE, in memory
     record_only: bool = False  # SOLVE records what it would solve instead of solving

@@ -333,6 +333,22 @@ def test_msg_warn_and_error_go_on_fatal_stops_at_its_line():
             run(deck)
 
 
+def test_msg_writes_to_the_current_output_as_mapdl_does():
+    # MAPDL's message subroutine writes to the current output: after /OUT,report,txt the
+    # message (heading and text) is in report.txt, not in the log; /OUT alone sends the next
+    # one back to the log.  A *CFOPEN command file is no output: it gets no message.
+    s = run("/OUT,report,txt\n*MSG,WARN,7\n%I hot spots\n*MSG,INFO,2.5\nk = %G\n"
+            "*CFOPEN,cmds,mac\n*MSG,NOTE\nstill the report\n*CFCLOS\n/OUT\n"
+            "*MSG,INFO\nback in the log\n")
+    assert s.state.listing.files["report.txt"] == [
+        " *** WARNING ***", "        7 hot spots", "k =   2.50000000    ",
+        " *** NOTE ***", "still the report"]
+    assert s.state.listing.files["cmds.mac"] == []
+    assert s.log == ["back in the log"]
+    # the warning is still told (stderr) with its place
+    assert s.state.listing.warnings == ["warning: deck.inp:2: *MSG: 7 hot spots"]
+
+
 def test_file_size_limit(tmp_path, monkeypatch):
     import apdl_like.parser as parser
 
@@ -496,6 +512,29 @@ def test_results_table_idiom_writes_fortran_formatted_rows():
     assert s.log[-4:] == rows  # *LIST copies the file into the output
     assert "header line" in s.log[0]
     assert s.params["_T2"] == -0.6712
+
+
+def test_integer_edits_round_halves_away_from_zero_as_fortran_nint():
+    # MAPDL's values are double precision and its integer descriptors take Fortran's NINT
+    # (*MSG's documentation; *VWRITE's C formats are *MSG's): 2.5 -> 3, -2.5 -> -3,
+    # 3.5 -> 4, 0.5 -> 1, -0.5 -> -1, 1.49999 -> 1 (Python's round() gave 2, -2, 4, 0, 0)
+    s = run("*DIM,V,ARRAY,6\n*VFILL,V(1),DATA,2.5,-2.5,3.5,0.5,-0.5,1.49999\n"
+            "/OUT,ints,txt\n*VWRITE,V(1),V(1)\n(I4,1X,I3)\n*VWRITE,V(1),V(1),V(1)\n"
+            "%I|%5I|%-4I|\n/OUT\n*MSG,INFO,-2.5,2.5\n%4I and %I\n")
+    assert s.state.listing.files["ints.txt"] == [
+        "   3   3", "  -3  -3", "   4   4", "   1   1", "  -1  -1", "   1   1",
+        "3|    3|3   |", "-3|   -3|-3  |", "4|    4|4   |", "1|    1|1   |",
+        "-1|   -1|-1  |", "1|    1|1   |"]
+    assert s.log == ["  -3 and         3"]
+
+
+def test_integer_edit_of_a_value_that_is_no_number():
+    from apdl_like.fortran_format import format_c_line, format_line, integer, parse_format
+
+    assert [integer(v) for v in (float("nan"), float("inf"), -float("inf"), -0.4)] == [
+        "NaN", "Inf", "-Inf", "0"]
+    assert format_line(parse_format("(I2)"), [float("nan")]) == ["**"]
+    assert format_c_line("%5I", [float("inf")]) == ["  Inf"]
 
 
 def test_a_command_spelled_error_is_an_unknown_command_not_a_crash():

@@ -312,7 +312,7 @@ def test_cli_counts_msg_errors_and_runs_on(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stderr.splitlines() == [f"error: {deck}:1: *MSG: 3 bad rows",
                                         f"warning: {deck}:3: *MSG: check"]
-    assert done.stdout.rstrip().endswith("; 1 *MSG,ERROR message(s) in log.txt")
+    assert done.stdout.rstrip().endswith("; 1 *MSG,ERROR message(s), told on stderr")
     log = (tmp_path / "o" / "log.txt").read_text().splitlines()
     assert log[:2] == [" *** ERROR ***", "        3 bad rows"]
     assert json.loads((tmp_path / "o" / "params.json").read_text())["B"] == 1.0

@@ -518,7 +518,19 @@ def tref(s: SessionState, c: Call) -> None:
     s.db.settings.tref = c.num(1, 0.0, what="TREF")
 
 
+@command("SFCUM", LOADS, 4)
+def sfcum(s: SessionState, c: Call) -> None:
+    """SFCUM,Lab,Oper,FACT,FACT2: REPL (the default: a new surface load replaces the old
+    one) with factors 1 is what SF, SFE and SFL do here; ADD, IGNO and factors are refused
+    rather than ignored."""
+    oper = c.label(2, "REPL")
+    factors = [c.num(i, 1.0, what=name) for i, name in ((3, "FACT"), (4, "FACT2"))]
+    if oper != "REPL" or factors != [1.0, 1.0]:
+        raise ApdlError("only SFCUM,,REPL with factors 1 is supported (surface loads "
+                        "replace the ones before them)")
+
+
 COMMANDS = (
-    *specs_of(d, ddele, f_load, fdele, dk, dl, sf, sfl, sfdele, sfe, bf, bfe, bfk, bfa, bfedele,
-              ic, tunif, bfunif, tref),
+    *specs_of(d, ddele, f_load, fdele, dk, dl, sf, sfl, sfdele, sfe, sfcum, bf, bfe, bfk, bfa,
+              bfedele, ic, tunif, bfunif, tref),
 )

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from apdl_like.call import POST, Call, command, specs_of
+from apdl_like.call import ANY, POST, Call, command, specs_of
 from apdl_like.commands.post26 import thermal_history
 from apdl_like.errors import ApdlError
 from apdl_like.state import StepResult
@@ -114,6 +114,29 @@ def _nodal_values(s: SessionState, item: str, comp: str) -> np.ndarray:
                     f"{','.join(k for k in (item, comp) if k) or '(empty)'!r}")
 
 
+@command("PLNSOL", ANY, 5)
+def plnsol(s: SessionState, c: Call) -> None:
+    """PLNSOL,Item,Comp: no plot is drawn; in /POST1 the largest and smallest value over the
+    selected nodes are kept for *GET,Par,PLNSOL,0,MAX|MIN, as MAPDL keeps them from its plot
+    (NSORT's items; another item is accepted, as a plot command, and *GET then says it has
+    none).  Elsewhere it is ignored, as before (a plot command)."""
+    if s.processor != "POST1":
+        return
+    item, comp = c.label(1, "TEMP"), c.label(2)
+    name = ",".join(k for k in (item, comp) if k)
+    s.result()  # no results: said as such, not as an item PLNSOL cannot give
+    try:
+        values = _nodal_values(s, item, comp)
+    except ApdlError:
+        s.plot_extremes = (name, None)
+        return
+    nodes = s.db.nodes
+    shown = values[nodes.selected & np.isfinite(values)]
+    if shown.size == 0:
+        raise ApdlError("no selected node has the item to plot")
+    s.plot_extremes = (name, (float(shown.max()), float(shown.min())))
+
+
 @command("NSORT", POST, 6)
 def nsort(s: SessionState, c: Call) -> None:
     """NSORT,Item,Comp,ORDER,KABS,NUMB,SEL: the selected nodes sorted by a nodal value
@@ -165,5 +188,5 @@ def sort_extreme(s: SessionState, item: str) -> float:
 
 
 COMMANDS = (
-    *specs_of(set_, prnsol, nsort, nusort),
+    *specs_of(set_, prnsol, plnsol, nsort, nusort),
 )

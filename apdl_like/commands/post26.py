@@ -16,6 +16,8 @@ import numpy as np
 
 from apdl_like.call import POST, POST26, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.errors import ApdlError
+from apdl_like.expressions import element_index
+from apdl_like.params import split_target, store, subscripts
 
 if TYPE_CHECKING:
     from apdl_like.plane_thermal import PlaneThermal, ThermalInputs
@@ -169,6 +171,32 @@ def prvar(s: SessionState, c: Call) -> None:
         s.say(f"{t:12.5G}" + "".join(f"{s.variables[n][2][k]:16.6E}" for n in chosen))
 
 
+@command("VGET", POST26, 4)
+def vget(s: SessionState, c: Call) -> None:
+    """VGET,Par(i),IR,TSTRT: variable IR (1: TIME) from its first stored time at or after
+    TSTRT (default the first), down the column of the *DIM array Par from row i, until the
+    variable or the column ends."""
+    if c.given(4):
+        raise ApdlError("field 4 (KCPLX) is not supported: variables here are real")
+    name, subs_text = split_target(c.raw(1).strip())
+    array = s.params.get(name)
+    if not isinstance(array, np.ndarray) or array.dtype == object:
+        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
+    n = c.int(2, what="IR")
+    if n == 1:
+        times = thermal_history(s)[0]
+        values = times
+    elif n in s.variables:
+        _, times, values = s.variables[n]
+    else:
+        raise ApdlError(f"variable {n} is not defined (NSOL or ESOL first)")
+    start = int(np.searchsorted(times, c.num(3, float(times[0]), what="TSTRT") -
+                                1e-9 * max(abs(float(times[-1])), 1.0)))
+    subs = subscripts(subs_text, s.params, s.model_functions) if subs_text else [1.0]
+    rows = array.shape[0] - element_index(name, array, subs)[0]
+    store(s.params, name, subs, [float(v) for v in values[start:start + rows]])
+
+
 def get_variable(s: SessionState, n: int, what: str, sub: str) -> float:
     """*GET,Par,VARI,n,EXTREM,VMAX|VMIN|TMAX|TMIN|VLAST."""
     if n not in s.variables:
@@ -239,6 +267,6 @@ def fsum(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(nsol, esol, int1, prvar, prnld, fsum),
+    *specs_of(nsol, esol, int1, prvar, vget, prnld, fsum),
     CommandSpec("STORE", POST26, 2, ignored),  # variables are computed when defined
 )

@@ -70,6 +70,15 @@ def _elements_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
     if item in ("TYPE", "MAT", "REAL"):
         values = {"TYPE": el.type, "MAT": el.mat, "REAL": el.real}[item]
         return number_range(values, *_range(c))
+    if item == "ENAME":  # ESEL,S,ENAME,,55: by the element type's name number
+        numbers = {num: int(m.group(1)) if (m := re.search(r"(\d+)$", et.name)) else 0
+                   for num, et in s.db.element_types.items()}
+        values = np.array([numbers.get(int(t), 0) for t in el.type], dtype=float)
+        named = re.fullmatch(r"[A-Z]+(\d+)", c.label(4))  # ESEL,S,ENAME,,PLANE55 too
+        if named:
+            number = float(named.group(1))
+            return number_range(values, number, number, 1.0)
+        return number_range(values, *_range(c))
     if item == "CENT" or item == "LOC":
         comp = c.label(3)
         if comp not in ("X", "Y"):
@@ -77,7 +86,8 @@ def _elements_picked(s: SessionState, c: Call, item: str) -> np.ndarray:
         vmin = c.num(4, what="VMIN")
         vmax = c.num(5, vmin, what="VMAX")
         return in_range(_centroids(s)[:, "XY".index(comp)], vmin, vmax)
-    raise ApdlError(f"field 2: item must be ELEM, TYPE, MAT, REAL or CENT, got {item!r}")
+    raise ApdlError(f"field 2: item must be ELEM, TYPE, ENAME, MAT, REAL or CENT, got "
+                    f"{item!r}")
 
 
 def _table_selection(table: str, default_item: str,

@@ -220,31 +220,59 @@ def _range_of(c: Call, table: dict, what: str, field: str) -> list[int]:
     return existing(list(range(first, last + 1, step)), table, what)
 
 
+@command("AATT", PREP7, 5)
+def aatt(s: SessionState, c: Call) -> None:
+    """AATT,MAT,REAL,TYPE: the attributes AMESH gives the elements of the selected areas
+    (blank fields: 1, as MAPDL's defaults); ESYS and SECN (fields 4, 5) other than 0 are
+    not supported."""
+    if c.num(4, 0.0, what="ESYS") != 0.0 or c.num(5, 0.0, what="SECN") != 0.0:
+        raise ApdlError("fields 4-5 (ESYS, SECN) other than 0 are not supported")
+    db = s.db
+    chosen = [num for num in sorted(db.areas) if num not in db.unselected_areas]
+    if not chosen:
+        raise ApdlError("no area is selected")
+    attrs = (c.int(1, 1, what="MAT"), c.int(2, 1, what="REAL"), c.int(3, 1, what="TYPE"))
+    for num in chosen:
+        db.area_attributes[num] = attrs
+
+
 @command("AMESH", PREP7, 3)
 def amesh(s: SessionState, c: Call) -> None:
+    """AMESH,NA1,NA2,NINC or AMESH,ALL (the selected areas, as MAPDL); each area's elements
+    take its AATT attributes, else the active TYPE, MAT and REAL."""
     from apdl_like.meshing import mapped_grid, mesh_areas, mesh_mapped  # loaded when used
 
-    areas = s.db.areas
+    db = s.db
+    areas = db.areas
     chosen = _range_of(c, areas, "area", "NA")
-    chosen = [num for num in chosen if num not in s.db.meshed_areas]
+    if c.label(1, "ALL") == "ALL":
+        chosen = [num for num in chosen if num not in db.unselected_areas]
+    chosen = [num for num in chosen if num not in db.meshed_areas]
     if not chosen:
         raise ApdlError("no unmeshed areas to mesh")
-    db = s.db
-    et = db.element_types.get(db.active_type)
-    if et is None:
-        raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE)")
-    free = []
-    for num in chosen:
-        pts = np.array([db.keypoints[p] for p in areas[num]], float)
-        extent = float(np.ptp(pts, axis=0).max())
-        size = db.esize if db.esize is not None else extent / 10.0
-        grid = None if db.mesh_triangles or et.triangle6 else mapped_grid(s, num, size)
-        if grid is None:
-            free.append(num)
-        else:
-            s.say(f"AMESH: area {num} mapped, {mesh_mapped(s, num, grid)} elements")
-    if free:
-        mesh_areas(s, free)
+    active = (db.active_mat, db.active_real, db.active_type)
+    try:
+        free: dict[tuple[int, int, int], list[int]] = {}
+        for num in chosen:
+            attrs = db.area_attributes.get(num, active)
+            db.active_mat, db.active_real, db.active_type = attrs
+            et = db.element_types.get(db.active_type)
+            if et is None:
+                raise ApdlError(f"element type {db.active_type} is not defined (ET, then TYPE"
+                                f"{' or AATT' if num in db.area_attributes else ''})")
+            pts = np.array([db.keypoints[p] for p in areas[num]], float)
+            extent = float(np.ptp(pts, axis=0).max())
+            size = db.esize if db.esize is not None else extent / 10.0
+            grid = None if db.mesh_triangles or et.triangle6 else mapped_grid(s, num, size)
+            if grid is None:
+                free.setdefault(attrs, []).append(num)
+            else:
+                s.say(f"AMESH: area {num} mapped, {mesh_mapped(s, num, grid)} elements")
+        for attrs, nums in free.items():
+            db.active_mat, db.active_real, db.active_type = attrs
+            mesh_areas(s, nums)
+    finally:
+        db.active_mat, db.active_real, db.active_type = active
     db.meshed_areas.update(chosen)
 
 
@@ -296,7 +324,7 @@ def lmesh(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(k, kgen, line, lesize, area, area_lines, rectng, blc4, esize, mshape, amesh,
+    *specs_of(aatt, k, kgen, line, lesize, area, area_lines, rectng, blc4, esize, mshape, amesh,
               lmesh),
     CommandSpec("MSHKEY", PREP7, 1, ignored),  # mapped wherever the area allows
 )

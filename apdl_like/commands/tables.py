@@ -1,5 +1,5 @@
-"""Results tables and listings: *DIM, *VFILL, *VWRITE, *MSG, /OUT, *CFOPEN/*CFWRITE/*CFCLOS,
-*LIST, *STATUS, SAVE and RESUME (valid in every processor).
+"""Results tables and listings: *DIM, *VFILL, *VOPER, *VSCFUN, *VWRITE, *MSG, /OUT,
+*CFOPEN/*CFWRITE/*CFCLOS, *LIST, *STATUS, SAVE and RESUME (valid in every processor).
 
 Files the deck writes are kept in memory by name (`SessionState.listing.files`) and written
 by the CLI inside its --out folder only: a name is a plain file name, never a path.  SAVE and
@@ -129,6 +129,118 @@ def star_vwrite(s: SessionState, c: Call) -> None:
             s.say(line)
 
 
+_VOPER = {
+    "ADD": np.add, "SUB": np.subtract, "MULT": np.multiply, "MIN": np.minimum,
+    "MAX": np.maximum,
+    "LT": lambda a, b: (a < b).astype(float), "LE": lambda a, b: (a <= b).astype(float),
+    "EQ": lambda a, b: (a == b).astype(float), "NE": lambda a, b: (a != b).astype(float),
+    "GE": lambda a, b: (a >= b).astype(float), "GT": lambda a, b: (a > b).astype(float),
+}
+
+
+@command("*VOPER", ANY, 6)
+def star_voper(s: SessionState, c: Call) -> None:
+    """*VOPER,ParR(i),Par1(j),Oper,Par2(k): element by element down the columns, ParR =
+    Par1 Oper Par2, for ADD, SUB, MULT, DIV, MIN, MAX and the comparisons LT, LE, EQ, NE,
+    GE, GT (1 true, 0 false).  Par1 and Par2 are array elements (the column from there on)
+    or a scalar parameter or number, used on every row.  As MAPDL documents, the rows run
+    from ParR(i) to the end of ParR's column, and an input column that ends before is read
+    as zeros.  Derivatives, integrals, GATH/SCAT, DOT/CROSS, *VLEN and *VMASK are not
+    supported."""
+    params, funcs = s.params, s.model_functions
+    oper = c.label(3)
+    if oper not in (*_VOPER, "DIV"):
+        raise ApdlError(f"field 3: *VOPER supports ADD, SUB, MULT, DIV, MIN, MAX, LT, LE, EQ, "
+                        f"NE, GE and GT, got {oper or '(empty)'!r}")
+    if c.given(5) or c.given(6):
+        raise ApdlError("fields 5-6 (CON1, CON2) are not supported")
+    name, subs_text = split_target(c.raw(1).strip())
+    result = params.get(name)
+    if not isinstance(result, np.ndarray) or result.dtype == object:
+        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
+    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    operands: list[np.ndarray | float] = []
+    for field in (2, 4):
+        text = c.raw(field).strip()
+        if not text:
+            raise ApdlError(f"field {field} (Par{field // 2}) is required")
+        if _is_reference(text):
+            ref, ref_subs = split_target(text)
+            array = params.get(ref)
+            if isinstance(array, np.ndarray):
+                if array.dtype == object:
+                    raise ApdlError(f"field {field}: {ref} is a character array")
+                operands.append(np.array(column(params, ref, subscripts(
+                    ref_subs, params, funcs) if ref_subs else [1.0]), float))
+                continue
+        operands.append(c.num(field, what=f"Par{field // 2}"))
+    rows = result.shape[0] - element_index(name, result, subs)[0]
+    a, b = (np.pad(o[:rows], (0, max(rows - len(o), 0))) if isinstance(o, np.ndarray)
+            else np.full(rows, o) for o in operands)
+    if oper == "DIV":
+        zero = np.nonzero(b == 0.0)[0]
+        if zero.size:
+            raise ApdlError(f"division by zero (row {int(zero[0]) + 1} of Par2)")
+        values = a / b
+    else:
+        values = _VOPER[oper](a, b)
+    if not np.all(np.isfinite(values)):
+        raise ApdlError("the result is not a finite number")
+    store(params, name, subs, [float(v) for v in values])
+
+
+_VSCFUN = ("MAX", "MIN", "LMAX", "LMIN", "FIRST", "LAST", "SUM", "MEDI", "MEAN", "VARI",
+           "STDV", "RMS", "NUM")
+
+
+@command("*VSCFUN", ANY, 3)
+def star_vscfun(s: SessionState, c: Call) -> None:
+    """*VSCFUN,ParR,Func,Par1(i): a scalar from the column of Par1 from row i to its end:
+    MAX, MIN, SUM, MEAN, MEDI (the middle value; the mean of the two middle ones for an
+    even count), VARI (Σ(x − mean)²/NUM), STDV (its square root), RMS, NUM, and the row
+    numbers LMAX, LMIN, FIRST and LAST (first and last nonzero value; 0 when none), these
+    four from row 1 only.  *VLEN, *VMASK, *VABS, *VFACT and *VCUM are not supported."""
+    params, funcs = s.params, s.model_functions
+    target = c.raw(1).strip().upper()
+    if not is_parameter_name(target):
+        raise ApdlError(f"field 1: {c.raw(1)!r} is not a valid parameter name")
+    func = c.label(2)
+    if func not in _VSCFUN:
+        raise ApdlError(f"field 2: *VSCFUN supports {', '.join(_VSCFUN)}, got "
+                        f"{func or '(empty)'!r}")
+    name, subs_text = split_target(c.raw(3).strip())
+    array = params.get(name)
+    if not isinstance(array, np.ndarray) or array.dtype == object:
+        raise ApdlError(f"field 3: {name} is not a numeric array (define it with *DIM first)")
+    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    start = element_index(name, array, subs)
+    x = np.array(column(params, name, subs), float)
+    if func in ("LMAX", "LMIN", "FIRST", "LAST"):
+        if start[0] != 0:
+            raise ApdlError(f"{func} from a row other than 1 is not supported (is the row "
+                            "counted from row 1 or from the start?)")
+        nonzero = np.nonzero(x)[0]
+        value = float({"LMAX": np.argmax(x) + 1, "LMIN": np.argmin(x) + 1,
+                       "FIRST": nonzero[0] + 1 if nonzero.size else 0,
+                       "LAST": nonzero[-1] + 1 if nonzero.size else 0}[func])
+    else:
+        mean = float(x.mean())
+        value = {"MAX": float(x.max()), "MIN": float(x.min()), "SUM": float(x.sum()),
+                 "MEDI": float(np.median(x)), "MEAN": mean, "NUM": float(x.size),
+                 "VARI": float(((x - mean) ** 2).mean()),
+                 "STDV": float(np.sqrt(((x - mean) ** 2).mean())),
+                 "RMS": float(np.sqrt((x ** 2).mean()))}[func]
+    params[target] = value
+
+
+def _vector_control(s: SessionState, c: Call) -> None:
+    """*VLEN, *VMASK, *VABS, *VFACT, *VCUM: refused rather than ignored, since ignoring one
+    would change what the next *VOPER, *VSCFUN or *VWRITE computes without a word."""
+    raise ApdlError("not supported: *VGET, *VOPER, *VSCFUN and *VWRITE here run over whole "
+                    "columns, with no length, mask, absolute value, scale factor or "
+                    "accumulation")
+
+
 def _is_reference(text: str) -> bool:
     return bool(re.match(r"\s*[A-Za-z_][A-Za-z0-9_]*\s*(\(.*\))?\s*\Z", text, re.S))
 
@@ -244,9 +356,9 @@ MSG_HEADINGS = {"INFO": "", "NOTE": "NOTE", "UI": "NOTE", "WARN": "WARNING", "ER
 
 @command("*MSG", ANY, 9)
 def star_msg(s: SessionState, c: Call) -> None:
-    """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message in the log under its
-    heading.  WARN and ERROR are told on stderr too and ERROR counted (the run goes on, as
-    in MAPDL batch); FATAL stops the run here."""
+    """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message under its heading in the
+    current output (the /OUT file, else the log).  WARN and ERROR are told on stderr too
+    and ERROR counted (the run goes on, as in MAPDL batch); FATAL stops the run here."""
     from apdl_like.fortran_format import c_descriptors, format_c_line
 
     label = c.label(1, "INFO")
@@ -276,10 +388,12 @@ def star_msg(s: SessionState, c: Call) -> None:
     one_line = " ".join(" ".join(lines).split())  # for stderr and the error
     if label == "FATAL":
         raise ApdlError(f"FATAL: {one_line}")
-    log = s.listing.log
+    # MAPDL's message subroutine writes to the current output: the /OUT file when one is
+    # open, else the log (a *CFOPEN command file takes *VWRITE and *CFWRITE lines only)
     if heading:
-        log.append(f" *** {heading} ***")
-    log.extend(lines)
+        s.say(f" *** {heading} ***")
+    for line in lines:
+        s.say(line)
     if label in ("WARN", "ERROR"):
         st = c.statement
         if label == "ERROR":
@@ -288,7 +402,9 @@ def star_msg(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(star_dim, star_vfill, star_vwrite, star_msg, out, cfopen, cfwrite, cfclos, star_list,
-              star_status, save, resume, star_set_values),
+    *specs_of(star_dim, star_vfill, star_vwrite, star_voper, star_vscfun, star_msg, out,
+              cfopen, cfwrite, cfclos, star_list, star_status, save, resume, star_set_values),
     CommandSpec("/OUTPUT", ANY, 4, out),
+    *(CommandSpec(name, ANY, 10, _vector_control)
+      for name in ("*VLEN", "*VMASK", "*VABS", "*VFACT", "*VCUM")),
 )
