@@ -3,7 +3,10 @@
 Edit descriptors: `Aw` (text, right-justified in w, or its first w characters), `Fw.d`,
 `Ew.d`, `Gw.d`, `Iw`, `nX` (blanks), quoted literals, `/` (new line), repeat counts (`3F10.2`,
 `2(A8,F8.3)`).  A number too wide for its field prints as w asterisks, as Fortran does.
-Output stops at the first data descriptor with no value left.  A C-style line
+Output stops at the first data descriptor with no value left.  Values left when the format
+ends are written by Fortran's format reversion: a new record (line), the format taken up again
+from the start of its last top-level parenthesized group, repeat count included (`(1X,'T=',
+F5.1,2(1X,F4.1))`), or from its start when it has no group.  A C-style line
 (`%14.5G %I %C`) is accepted too; *MSG's lines are C-style, their bare `%I`, `%G`, `%C` the
 Fortran `I9` (NINT), `1PG16.9` and `A8` MAPDL documents for them.  Every integer edit
 (`Iw`, `%I`, `%wI`) takes the nearest integer, halves away from zero (`integer`).
@@ -14,12 +17,14 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import nint
 from apdl_like.parser import split_fields
 
 Item = tuple[str, int, int]  # (kind, width, decimals): kind in A F E G I X ' /
+DATA_KINDS = "AFEGI"  # the data edit descriptors: each takes one value
 
 _DESCRIPTOR = re.compile(r"(\d*)([AFEGIXD])(\d*)(?:\.(\d+))?\Z", re.I)
 _C_SPEC = re.compile(r"%(-?\d*)(?:\.(\d+))?([IGEFCSX/%])", re.I)
@@ -30,15 +35,28 @@ def _split_top(text: str) -> list[str]:
     return [p.strip() for p in split_fields(text, ",/", "/") if p.strip()]
 
 
-def parse_format(line: str) -> list[tuple[str, int, int, str]]:
-    """A format line -> items (kind, width, decimals, literal text)."""
+@dataclass(frozen=True)
+class FortranFormat:
+    """A parsed format: its items (kind, width, decimals, literal text), groups expanded,
+    and `revert`, the index of the item format reversion goes back to (the first item of
+    the last top-level group's repetitions, 0 when there is no group)."""
+
+    items: list[tuple[str, int, int, str]]
+    revert: int = 0
+
+
+def parse_format(line: str) -> FortranFormat:
+    """A format line -> its items and reversion point."""
     text = line.strip()
     if not (text.startswith("(") and text.endswith(")")):
         raise ApdlError(f"format line must be a Fortran format in parentheses, got {text!r}")
-    return _items(text[1:-1])
+    revert: list[int] = [0]
+    items = _items(text[1:-1], revert)
+    return FortranFormat(items, revert[0])
 
 
-def _items(body: str) -> list[tuple[str, int, int, str]]:
+def _items(body: str, revert: list[int] | None = None) -> list[tuple[str, int, int, str]]:
+    """The items of a format body; `revert[0]` is set to where its last group starts."""
     out: list[tuple[str, int, int, str]] = []
     for part in _split_top(body):
         if part == "/":
@@ -49,6 +67,8 @@ def _items(body: str) -> list[tuple[str, int, int, str]]:
             m = re.match(r"(\d*)\((.*)\)\Z", part, re.S)
             if m is None:
                 raise ApdlError(f"format item {part!r} is not understood")
+            if revert is not None:
+                revert[0] = len(out)
             out += _items(m.group(2)) * int(m.group(1) or 1)
         else:
             m = _DESCRIPTOR.match(part)
@@ -131,11 +151,22 @@ _MSG_BARE = {"I": lambda v: _stars(integer(v), 9),
              "G": lambda v: general(v, 16, 9, scale=1)}
 
 
-def format_line(items: Sequence[tuple[str, int, int, str]],
-                values: Sequence[float | str]) -> list[str]:
-    """One record written by `items` with `values` (several lines if the format has `/`)."""
-    lines, current, k = [], "", 0
-    for kind, width, decimals, literal in items:
+def format_line(fmt: FortranFormat, values: Sequence[float | str]) -> list[str]:
+    """The record(s) written by `fmt` with `values`: several lines if the format has `/`,
+    or when values are left at its end (format reversion: a new line, the format again
+    from `fmt.revert`).  A format whose reverted part has no data descriptor writes the
+    values it has descriptors for, once."""
+    items = fmt.items
+    reusable = any(kind in DATA_KINDS for kind, *_ in items[fmt.revert:])
+    lines, current, k, i = [], "", 0, 0
+    while True:
+        if i == len(items):
+            if k >= len(values) or not reusable:
+                break
+            lines.append(current)
+            current, i = "", fmt.revert
+        kind, width, decimals, literal = items[i]
+        i += 1
         if kind == "'":
             current += literal
             continue
@@ -147,28 +178,38 @@ def format_line(items: Sequence[tuple[str, int, int, str]],
             break
         value = values[k]
         k += 1
-        if kind == "A":
-            text = str(value)
-            current += text if width == 0 else (text[:width] if len(text) >= width
-                                                  else text.rjust(width))
-            continue
-        if isinstance(value, str):
-            raise ApdlError(f"format item {kind}{width}: {value!r} is text, a number is needed")
-        if kind == "F":
-            current += fixed(value, width, decimals)
-        elif kind == "E":
-            current += exponential(value, width, decimals)
-        elif kind == "G":
-            current += general(value, width, decimals)
-        else:  # I
-            current += _stars(integer(value), width)
+        current += _edit(kind, width, decimals, value)
     lines.append(current)
     return lines
+
+
+def _edit(kind: str, width: int, decimals: int, value: float | str) -> str:
+    """One value by one data edit descriptor (A, F, E, G, I)."""
+    if kind == "A":
+        text = str(value)
+        return text if width == 0 else (text[:width] if len(text) >= width
+                                        else text.rjust(width))
+    if isinstance(value, str):
+        raise ApdlError(f"format item {kind}{width}: {value!r} is text, a number is needed")
+    if kind == "F":
+        return fixed(value, width, decimals)
+    if kind == "E":
+        return exponential(value, width, decimals)
+    if kind == "G":
+        return general(value, width, decimals)
+    return _stars(integer(value), width)  # I
 
 
 def c_descriptors(line: str) -> int:
     """How many values a C-style line reads (its %I, %G, %E, %F, %C and %S)."""
     return sum(m.group(3).upper() in "IGEFCS" for m in _C_SPEC.finditer(line))
+
+
+def normal_descriptors(line: str) -> bool:
+    """Whether a *MSG format holds only MAPDL's normal descriptors (%I, %G, %C with no
+    width, %/), or none: no enhanced one (a width or precision, %E, %F, %S, %X, %%)."""
+    return all(m.group(3).upper() in "IGC/" and not m.group(1) and m.group(2) is None
+               for m in _C_SPEC.finditer(line))
 
 
 def format_c_line(line: str, values: Sequence[float | str],

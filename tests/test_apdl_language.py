@@ -300,13 +300,17 @@ def test_msg_writes_its_format_with_mapdls_fortran_descriptors():
     # MAPDL documents %I, %G, %C as Fortran I9 (of NINT), 1PG16.9 and A8: 'Inner' is
     # right-justified in 8 columns (after the format's own blank), 1.2 is F editing with 9
     # significant digits and 4 blanks after, 148.5 rounds half away from zero to 149 (and
-    # -2.5 to -3); a G value past 1e9 takes the 1P E form, one digit before the point
+    # -2.5 to -3); a G value past 1e9 takes the 1P E form, one digit before the point.
+    # With only these normal descriptors "consecutive blanks are condensed into one blank
+    # upon output, and a period is appended" (MAPDL's *MSG notes): 'Radius (    Inner) =
+    #        25, Thick =   1.20000000    , Length =       149' is printed as below; a
+    # format with an enhanced descriptor (%8.3F) is written as formatted
     s = run("R = 25\n*MSG,INFO,'Inner',R,1.2,148.5\n"
             "Radius ( %C) = %I, Thick = %G, Length = %I\n"
             "*MSG,NOTE,-2.5,1.23456789012e10,99.5\nhalf %I big %G &\n"
             " and %8.3F%% done%/next line\nAFTER = 1\n")
     assert s.log == [
-        "Radius (    Inner) =        25, Thick =   1.20000000    , Length =       149",
+        "Radius ( Inner) = 25, Thick = 1.20000000 , Length = 149.",
         " *** NOTE ***",
         "half        -3 big  1.234567890E+10  and   99.500% done",  # joined as written
         "next line",
@@ -318,13 +322,13 @@ def test_msg_warn_and_error_go_on_fatal_stops_at_its_line():
     s = run("*MSG,WARN,3\n%I nodes left\n*MSG,ERROR\nbad input\n*MSG,ERROR\nagain\nZ = 5\n")
     assert s.params["Z"] == 5.0  # ERROR counts, the batch run goes on
     assert s.state.listing.errors == 2
-    assert s.state.listing.warnings == ["warning: deck.inp:1: *MSG: 3 nodes left",
-                                        "error: deck.inp:3: *MSG: bad input",
-                                        "error: deck.inp:5: *MSG: again"]
-    assert s.log[:2] == [" *** WARNING ***", "        3 nodes left"]
+    assert s.state.listing.warnings == ["warning: deck.inp:1: *MSG: 3 nodes left.",
+                                        "error: deck.inp:3: *MSG: bad input.",
+                                        "error: deck.inp:5: *MSG: again."]
+    assert s.log[:2] == [" *** WARNING ***", " 3 nodes left."]
     with pytest.raises(ApdlError) as info:
         run("T = 412\n*MSG,FATAL,T\nT = %I exceeds the limit\nZ = 5\n")
-    assert str(info.value) == "deck.inp:2: *MSG: FATAL: T = 412 exceeds the limit"
+    assert str(info.value) == "deck.inp:2: *MSG: FATAL: T = 412 exceeds the limit."
     for deck, message in [("*MSG,INFO,1,2\nonly %I\n", "1 data descriptor(s) (%I, %G, %C, "
                            "...) for 2 value(s)"),
                           ("*MSG,LOUD\ntext\n", "Lab) must be one of INFO"),
@@ -341,12 +345,12 @@ def test_msg_writes_to_the_current_output_as_mapdl_does():
             "*CFOPEN,cmds,mac\n*MSG,NOTE\nstill the report\n*CFCLOS\n/OUT\n"
             "*MSG,INFO\nback in the log\n")
     assert s.state.listing.files["report.txt"] == [
-        " *** WARNING ***", "        7 hot spots", "k =   2.50000000    ",
-        " *** NOTE ***", "still the report"]
+        " *** WARNING ***", " 7 hot spots.", "k = 2.50000000.",
+        " *** NOTE ***", "still the report."]
     assert s.state.listing.files["cmds.mac"] == []
-    assert s.log == ["back in the log"]
+    assert s.log == ["back in the log."]
     # the warning is still told (stderr) with its place
-    assert s.state.listing.warnings == ["warning: deck.inp:2: *MSG: 7 hot spots"]
+    assert s.state.listing.warnings == ["warning: deck.inp:2: *MSG: 7 hot spots."]
 
 
 def test_file_size_limit(tmp_path, monkeypatch):
@@ -535,6 +539,30 @@ def test_integer_edit_of_a_value_that_is_no_number():
         "NaN", "Inf", "-Inf", "0"]
     assert format_line(parse_format("(I2)"), [float("nan")]) == ["**"]
     assert format_c_line("%5I", [float("inf")]) == ["  Inf"]
+
+
+def test_vwrite_fortran_format_reversion_when_values_outlast_the_format():
+    # Fortran's format reversion: values left at the format's end start a new record and
+    # the format is taken up again from its last top-level group, repeat count included,
+    # or from its start when it has none.  Written by hand from the edit descriptors:
+    #   (F6.2,F6.2) of 1..5: no group, back to the start each line
+    #   (1X,'T=',F5.1,2(1X,F4.1)) of 1..7: back to 2(1X,F4.1), two values a line
+    #   (A4,2(F4.1),'|',I3) of 'ab',1,2,3,4,5,6: back to 2(F4.1): the literal '|' and I3
+    #   take the 4th and 7th values; output stops at I3 with no value left
+    # Before, the values past the format's end were dropped (one line each).
+    s = run("*DIM,V,ARRAY,1,7\n*VFILL,V(1,1),DATA,1\n*VFILL,V(1,2),DATA,2\n"
+            "*VFILL,V(1,3),DATA,3\n*VFILL,V(1,4),DATA,4\n*VFILL,V(1,5),DATA,5\n"
+            "*VFILL,V(1,6),DATA,6\n*VFILL,V(1,7),DATA,7\n/OUT,rev,txt\n"
+            "*VWRITE,V(1,1),V(1,2),V(1,3),V(1,4),V(1,5)\n(F6.2,F6.2)\n"
+            "*VWRITE,V(1,1),V(1,2),V(1,3),V(1,4),V(1,5),V(1,6),V(1,7)\n"
+            "(1X,'T=',F5.1,2(1X,F4.1))\n"
+            "*VWRITE,'ab',V(1,1),V(1,2),V(1,3),V(1,4),V(1,5),V(1,6)\n"
+            "(A4,2(F4.1),'|',I3)\n/OUT\n")
+    assert s.state.listing.files["rev.txt"] == [
+        "  1.00  2.00", "  3.00  4.00", "  5.00",
+        " T=  1.0  2.0  3.0", "  4.0  5.0", "  6.0  7.0",
+        "  ab 1.0 2.0|  3", " 4.0 5.0|  6"]
+    assert s.state.listing.warnings == []
 
 
 def test_a_command_spelled_error_is_an_unknown_command_not_a_crash():

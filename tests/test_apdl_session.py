@@ -290,7 +290,7 @@ PRNSOL,TEMP
     ("/PREP7\nN,1,0,0\nET,1,PLANE55\nMP,KXX,1,-1\n", "d.inp:4: MP"),
     ("/SOLU\nSOLVE\n", "d.inp:2: SOLVE"),
     ("A = 1/0\n", "d.inp:1: A = 1/0: division by zero"),
-    ("*MSG,FATAL,7\nstop: %I\nB = 1\n", "d.inp:1: *MSG: FATAL: stop: 7"),
+    ("*MSG,FATAL,7\nstop: %I\nB = 1\n", "d.inp:1: *MSG: FATAL: stop: 7."),
 ])
 def test_cli_bad_deck_exits_2_without_traceback(tmp_path, text, where):
     deck = tmp_path / "d.inp"
@@ -310,11 +310,11 @@ def test_cli_counts_msg_errors_and_runs_on(tmp_path):
     done = subprocess.run([sys.executable, "-m", "apdl_like", "run", str(deck), "--out",
                            str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
-    assert done.stderr.splitlines() == [f"error: {deck}:1: *MSG: 3 bad rows",
-                                        f"warning: {deck}:3: *MSG: check"]
+    assert done.stderr.splitlines() == [f"error: {deck}:1: *MSG: 3 bad rows.",
+                                        f"warning: {deck}:3: *MSG: check."]
     assert done.stdout.rstrip().endswith("; 1 *MSG,ERROR message(s), told on stderr")
     log = (tmp_path / "o" / "log.txt").read_text().splitlines()
-    assert log[:2] == [" *** ERROR ***", "        3 bad rows"]
+    assert log[:2] == [" *** ERROR ***", " 3 bad rows."]
     assert json.loads((tmp_path / "o" / "params.json").read_text())["B"] == 1.0
 
 

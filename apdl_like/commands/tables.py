@@ -359,7 +359,7 @@ def star_msg(s: SessionState, c: Call) -> None:
     """*MSG,Lab,VAL1,...,VAL8 and its format line(s): the message under its heading in the
     current output (the /OUT file, else the log).  WARN and ERROR are told on stderr too
     and ERROR counted (the run goes on, as in MAPDL batch); FATAL stops the run here."""
-    from apdl_like.fortran_format import c_descriptors, format_c_line
+    from apdl_like.fortran_format import c_descriptors, format_c_line, normal_descriptors
 
     label = c.label(1, "INFO")
     if label not in MSG_HEADINGS:
@@ -384,6 +384,12 @@ def star_msg(s: SessionState, c: Call) -> None:
         raise ApdlError(f"the format has {wanted} data descriptor(s) (%I, %G, %C, ...) for "
                         f"{len(values)} value(s)")
     lines = format_c_line(fmt, values, bare_fortran=True)
+    if normal_descriptors(fmt):
+        # MAPDL: "If normal descriptions are used, then consecutive blanks are condensed
+        # into one blank upon output, and a period is appended" (the message's last line;
+        # after its last non-blank character)
+        lines = [re.sub(" {2,}", " ", line) for line in lines]
+        lines[-1] = lines[-1].rstrip() + "."
     heading = MSG_HEADINGS[label]
     one_line = " ".join(" ".join(lines).split())  # for stderr and the error
     if label == "FATAL":
