@@ -530,6 +530,24 @@ class PlaneThermal:
                                                                ky * g[cells, 1]])
         return grad, flux
 
+    def element_volume(self, n_elements: int) -> np.ndarray:
+        """Per element of the deck's table (n_elements rows) its volume, MAPDL's ETABLE item
+        VOLU: the area times unit thickness in a planar model, ∫ 2πr dA (the full 360°) in
+        an axisymmetric one; A·L of a LINK32/33 bar (its area is on the full 360° already);
+        NaN for the elements without one (LINK31/34, MASS71, SURF151)."""
+        volume = np.full(n_elements, np.nan)
+        for part in self.mesh.parts:
+            b = part.basis
+            dx = np.asarray(b.dx)  # |det J| × weights: (cells, quadrature points)
+            if self.mesh.axisymmetric:
+                dx = dx * 2.0 * np.pi * np.asarray(b.global_coordinates().value[0])
+            volume[part.elements] = dx.sum(axis=1)
+        links = self.links
+        if links is not None:
+            bars = links.kind == "conduction"
+            volume[links.elements[bars]] = links.area[bars] * links.length[bars]
+        return volume
+
     def film_heat(self, inputs: ThermalInputs, T: np.ndarray, keys: np.ndarray) -> np.ndarray:
         """Per exterior face (node-pair key) the heat its film takes out of the model,
         ∫ h (T − T_bulk) dA (W; consistent integral, 2πr in an axisymmetric model); 0 on a

@@ -192,8 +192,12 @@ class SessionState:
     # ETABLE columns (per element of the table) and SSUM's last totals
     element_table: dict[str, np.ndarray] = field(default_factory=dict)
     element_sums: dict[str, float] = field(default_factory=dict)
-    # NSORT's last sort: node numbers and sort keys in sorted order (*GET,,SORT reads it)
-    node_sort: tuple[np.ndarray, np.ndarray] | None = None
+    # the last sort, NSORT's or ESORT's: its command, the node or element numbers and the
+    # sort keys in sorted order (*GET,,SORT reads it); ESORT's element order (indices of
+    # the element table, sorted first) for PRETAB, None after EUSORT
+    last_sort: tuple[str, np.ndarray, np.ndarray] | None = None
+    element_order: np.ndarray | None = None
+    told: set[str] = field(default_factory=set)  # warnings given once a run (PRESOL)
     # PLNSOL's item and its (max, min) over the selected nodes (*GET,,PLNSOL reads it);
     # (item, None) for an item PLNSOL cannot give here
     plot_extremes: tuple[str, tuple[float, float] | None] | None = None

@@ -79,7 +79,7 @@ def test_nsort_sorts_the_selected_nodes_and_selects_the_first_numb():
 
 
 @pytest.mark.parametrize("post, message", [
-    ("*GET,A,SORT,,MAX\n", "no NSORT has been run"),
+    ("*GET,A,SORT,,MAX\n", "no NSORT or ESORT has been run"),
     ("NSORT,U,X\n", "needs a structural result"),
     ("NSORT,HEAT\n", "NSORT supports TEMP"),
     ("NSORT,TEMP\n*GET,A,SORT,,AVG\n", "SORT supports MAX, MIN, IMAX and IMIN"),

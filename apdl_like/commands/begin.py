@@ -48,7 +48,7 @@ OUTPUT_CONTROLS = ("/NOPR", "/GOPR", "/NOLIST", "/GO", "/UNITS", "/BATCH", "/VER
                    "EPLOT", "NPLOT", "KPLOT", "LPLOT", "APLOT", "GPLOT", "PLESOL",
                    "PLVECT", "PLDISP", "PLPATH", "PLVAR", "NLIST", "ELIST", "KLIST", "LLIST",
                    "ALIST", "DLIST", "SFLIST", "SFELIST", "BFLIST", "BFELIST", "CPLIST",
-                   "MPLIST", "ETLIST", "RLIST", "CMLIST", "PRETAB", "PRESOL", "PRRSOL",
+                   "MPLIST", "ETLIST", "RLIST", "CMLIST",
                    "PRERR", "ANTIME", "ANIM", "SMRTSIZE", "/PMACRO", "/MSTART", "PATH",
                    "PPATH", "PDEF", "PRPATH", "/CLABEL", "CMPL", "PRTIME")
 

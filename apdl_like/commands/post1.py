@@ -145,18 +145,11 @@ def nsort(s: SessionState, c: Call) -> None:
     nodes = s.db.nodes
     selected = nodes.selected  # first: it merges the nodes just added into the arrays
     values = _nodal_values(s, c.label(1), c.label(2))
-    order = c.int_in(3, 0, 1, 0, "ORDER")
-    by_abs = c.int_in(4, 0, 1, 0, "KABS")
     rows = np.nonzero(selected & np.isfinite(values))[0]
     if rows.size == 0:
         raise ApdlError("no selected node has the item to sort")
-    # stable on ascending node numbers: equal values keep the lower node first
-    rows = rows[np.argsort(nodes.ids[rows], kind="stable")]
-    keys = np.abs(values[rows]) if by_abs else values[rows]
-    ranked = np.argsort(keys if order else -keys, kind="stable")
-    count = c.int_in(5, 1, rows.size, rows.size, "NUMB") if c.given(5) else rows.size
-    rows, keys = rows[ranked][:count], keys[ranked][:count]
-    s.node_sort = (nodes.ids[rows].astype(float), keys.astype(float))
+    rows, keys = sorted_rows(c, nodes.ids, rows, values)
+    s.last_sort = ("NSORT", nodes.ids[rows].astype(float), keys.astype(float))
     selection = c.label(6)
     if selection == "SELECT":
         mask = np.zeros_like(nodes.selected)
@@ -164,6 +157,20 @@ def nsort(s: SessionState, c: Call) -> None:
         nodes.selected = mask
     elif selection:
         raise ApdlError(f"field 6 (SEL) must be SELECT or blank, got {selection!r}")
+
+
+def sorted_rows(c: Call, ids: np.ndarray, rows: np.ndarray, values: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """NSORT's and ESORT's sort of `rows` (indices into `ids` and `values`) by fields 3..5:
+    ORDER (0 descending, 1 ascending), KABS (1: by |value|), NUMB (the first NUMB kept);
+    equal keys keep the lower number first.  The rows and their keys, in sorted order."""
+    order = c.int_in(3, 0, 1, 0, "ORDER")
+    by_abs = c.int_in(4, 0, 1, 0, "KABS")
+    rows = rows[np.argsort(ids[rows], kind="stable")]
+    keys = np.abs(values[rows]) if by_abs else values[rows]
+    ranked = np.argsort(keys if order else -keys, kind="stable")
+    count = c.int_in(5, 1, rows.size, rows.size, "NUMB") if c.given(5) else rows.size
+    return rows[ranked][:count], keys[ranked][:count]
 
 
 @command("NUSORT", POST, 0)
@@ -174,10 +181,11 @@ def nusort(s: SessionState, c: Call) -> None:
 
 def sort_extreme(s: SessionState, item: str) -> float:
     """*GET,Par,SORT,,MAX|MIN|IMAX|IMIN: the largest or smallest sort key of the last
-    NSORT (|value| with KABS = 1), or the node holding it (the lower number on a tie)."""
-    if s.node_sort is None:
-        raise ApdlError("no NSORT has been run (*GET,,SORT reads the last sort)")
-    ids, keys = s.node_sort
+    NSORT or ESORT (|value| with KABS = 1), or the node or element holding it (the lower
+    number on a tie)."""
+    if s.last_sort is None:
+        raise ApdlError("no NSORT or ESORT has been run (*GET,,SORT reads the last sort)")
+    _, ids, keys = s.last_sort
     if item not in ("MAX", "MIN", "IMAX", "IMIN"):
         raise ApdlError(f"field 4: SORT supports MAX, MIN, IMAX and IMIN, got "
                         f"{item or '(empty)'!r}")

@@ -1,5 +1,5 @@
 """/POST26 time-history variables (NSOL, ESOL, STORE, PRVAR, *GET,,VARI) and reaction heat
-in /POST1 (PRNLD, FSUM).
+in /POST1 (PRNLD, PRRSOL, FSUM).
 
 A variable is a nodal temperature (NSOL,,,TEMP) or an element's nodal heat flow
 (ESOL,,,,HEAT) at every stored time of the last thermal analysis: the substeps of its last
@@ -230,6 +230,21 @@ def prnld(s: SessionState, c: Call) -> None:
     """PRNLD,HEAT: reaction heat at the selected nodes with a fixed temperature."""
     if c.label(1, "HEAT") not in ("HEAT", "ALL"):
         raise ApdlError(f"field 1: PRNLD supports HEAT, got {c.label(1)!r}")
+    _print_reactions(s)
+
+
+@command("PRRSOL", POST, 1)
+def prrsol(s: SessionState, c: Call) -> None:
+    """PRRSOL,HEAT (or blank in a thermal analysis): the reaction heat flow at each selected
+    node with a fixed temperature and their total, positive into the model (the heat the
+    constraint supplies, K·T less the applied loads, as PRNLD prints it here)."""
+    if c.label(1, "HEAT") != "HEAT":
+        raise ApdlError(f"field 1: PRRSOL supports HEAT (the reaction heat flow of a thermal "
+                        f"result), got {c.label(1)!r}")
+    _print_reactions(s)
+
+
+def _print_reactions(s: SessionState) -> None:
     nodes, heat = reactions(s)
     selected = s.db.nodes.selected[nodes]
     s.say("    NODE            HEAT")
@@ -267,6 +282,6 @@ def fsum(s: SessionState, c: Call) -> None:
 
 
 COMMANDS = (
-    *specs_of(nsol, esol, int1, prvar, vget, prnld, fsum),
+    *specs_of(nsol, esol, int1, prvar, vget, prnld, prrsol, fsum),
     CommandSpec("STORE", POST26, 2, ignored),  # variables are computed when defined
 )
