@@ -160,6 +160,7 @@ class NodeTable(_NumberedTable):
         "d_temp_table": -1,  # D,,TEMP,%table%: its slot in Database.load_tables (-1: none)
         "f_heat": np.nan,  # F,,HEAT: heat flow into the node, W (axisymmetric: 360°)
         "f_heat_table": -1,
+        "bf_hgen": np.nan,  # BF,,HGEN at the node, W/m³ (see apdl_like.plane_thermal)
     }
     DTYPES = {"selected": bool, "d_temp_table": np.int64, "f_heat_table": np.int64}
 

@@ -321,13 +321,15 @@ class _LoadState:
     hflux: np.ndarray
     d_temp: np.ndarray  # per node (NaN: free)
     f_heat: np.ndarray  # per node, W (NaN: none)
+    bf_hgen: np.ndarray  # per node, W/m³ (NaN: none)
 
     @classmethod
     def of(cls, db: Database) -> _LoadState:
         f = db.faces
         nodes = db.nodes.arrays
         return cls(db.elements.arrays["hgen"].copy(), f.conv_h.copy(), f.conv_bulk.copy(),
-                   f.hflux.copy(), nodes["d_temp"].copy(), nodes["f_heat"].copy())
+                   f.hflux.copy(), nodes["d_temp"].copy(), nodes["f_heat"].copy(),
+                   nodes["bf_hgen"].copy())
 
     def none(self) -> _LoadState:
         """No load anywhere (NaN): where the ramps of a first load step start."""
@@ -400,9 +402,15 @@ def _inputs(db: Database, mesh: PlaneMesh, faces: FaceTable, props: dict,
     heat = ramp(now.f_heat, None if before is None else before.f_heat, 0.0)
     heated = np.nonzero(~np.isnan(heat) & (heat != 0.0) & (mesh.node_dof >= 0))[0]
     nodal_heat = (mesh.node_dof[heated], heat[heated]) if heated.size else None
+    nodal_hgen = None
+    rate = ramp(now.bf_hgen, None if before is None else before.bf_hgen, 0.0)
+    generating = np.nonzero(~np.isnan(rate) & (rate != 0.0) & (mesh.node_dof >= 0))[0]
+    if generating.size:
+        nodal_hgen = np.zeros(mesh.n_dofs)
+        nodal_hgen[mesh.node_dof[generating]] = rate[generating]
     enthalpy = props["enthalpy"] if any(h is not None for h in props["enthalpy"]) else None
     return ThermalInputs(props["kxx"], props["kyy"], props["rho_c"], hgen, films, fluxes, fixed,
-                         enthalpy, props["hf"], props["specific_heat"], nodal_heat)
+                         enthalpy, props["hf"], props["specific_heat"], nodal_heat, nodal_hgen)
 
 
 def _split_by(idx: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
@@ -458,6 +466,7 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
         sol.previous_loads = None
         sol.history_times, sol.history_temperatures = [], []
     now = _LoadState.of(db)
+    _check_nodal_hgen(db, mesh, links, now)
     tables = _tabular(s, faces)
     varying = tables is not None
     T0 = sol.temperature
@@ -500,6 +509,32 @@ def solve_plane_thermal(s: SessionState) -> StepResult:
     s.fem.plane_inputs = steady_inputs if transient else inputs
     return StepResult(len(sol.results) + 1, sol.time, "thermal", sol.temperature,
                       nodal_temperature=mesh.nodal(sol.temperature))
+
+
+def _check_nodal_hgen(db: Database, mesh: PlaneMesh, links: ThermalLinks | None,
+                      now: _LoadState) -> None:
+    """Nodal HGEN (BF,Node,HGEN) where its documented rule is pinned down here: on linear
+    plane elements (PLANE55), whose weighted nodal volumes ∫ N_n dV are positive shares of
+    the element; not on quadratic ones (their corner shares are zero or negative), not at
+    the nodes of links and masses, and not on an element that has BFE,,HGEN as well (which
+    of the two MAPDL applies there is not documented)."""
+    nodes = np.nonzero(~np.isnan(now.bf_hgen) & (mesh.node_dof >= 0))[0]
+    if not nodes.size:
+        return
+    first = int(db.nodes.ids[nodes[0]])
+    if not mesh.lumped:
+        raise ApdlError(f"nodal HGEN (BF at node {first}) on quadratic elements (PLANE77, "
+                        "PLANE35) is not supported: use BFE,,HGEN")
+    if links is not None:
+        at_links = np.isin(mesh.node_dof[nodes], np.concatenate([links.i, links.j]))
+        if np.any(at_links):
+            raise ApdlError(f"nodal HGEN (BF) at node {int(db.nodes.ids[nodes[at_links][0]])}"
+                            ", a node of a link or mass element, is not supported: use BFE")
+    corners = corners_and_midside(db)[0]
+    both = ~np.isnan(now.hgen) & np.any(np.isin(corners, nodes), axis=1)
+    if np.any(both):
+        raise ApdlError(f"element {int(db.elements.ids[np.argmax(both)])} has both BFE,,HGEN "
+                        "and nodal HGEN (BF) at its nodes: give one of them")
 
 
 def _substeps(settings: SolutionSettings, span: float) -> tuple[float, bool, float, float]:

@@ -272,6 +272,11 @@ class ThermalInputs:
     fluxes           (face keys, q W/m²) groups
     fixed            (dofs, values °C)
     nodal_heat       (dofs, heat flows W) of F,,HEAT, or None
+    nodal_hgen       per dof the nodal heat generation rate of BF,Node,HGEN (W/m³; 0:
+                     none), or None.  As MAPDL documents it, the rate "is multiplied by
+                     the weighted nodal volume of each element adjacent to that node": the
+                     node's load is q_n · Σ_e ∫_e N_n dV (N_n its shape function; 2πr dA in
+                     an axisymmetric model), so a uniform rate loads as BFE does
     hf, specific_heat  per material MP,HF and MP,C callables (or None), for the links
     enthalpy         per material H(T) J/m³ (MPDATA,ENTH) or None: a transient step's
                      capacity is then the secant (H(T1) − H(T0)) / (T1 − T0), so a step
@@ -289,6 +294,12 @@ class ThermalInputs:
     hf: list[Property | None] | None = None
     specific_heat: list[Property | None] | None = None
     nodal_heat: tuple[np.ndarray, np.ndarray] | None = None
+    nodal_hgen: np.ndarray | None = None
+
+
+def weighted_nodal_volume(b: Basis, axisymmetric: bool) -> np.ndarray:
+    """∫ N_i dV over the cells of `b`, per local dof (the weights of a nodal HGEN)."""
+    return load.assemble(b, g=np.ones((b.nelems, b.X.shape[-1])), axisymmetric=axisymmetric)
 
 
 class PlaneThermal:
@@ -371,6 +382,8 @@ class PlaneThermal:
             if np.any(q):
                 qq = np.repeat(q[:, None], b.X.shape[-1], axis=1)
                 f = f + S @ load.assemble(b, g=qq, axisymmetric=ax)
+            if inputs.nodal_hgen is not None:
+                f = f + S @ (weighted_nodal_volume(b, ax) * inputs.nodal_hgen[part.local_dofs])
             for keys, h, tb in inputs.films:
                 fb = self._facet_basis(k, keys)
                 if fb is not None:
@@ -492,6 +505,8 @@ class PlaneThermal:
         if np.any(q):
             r = r - load.assemble(b, g=np.repeat(q[:, None], b.X.shape[-1], axis=1),
                                     axisymmetric=ax)
+        if inputs.nodal_hgen is not None:
+            r = r - weighted_nodal_volume(b, ax) * inputs.nodal_hgen[part.local_dofs]
         own = part.basis.mesh.t2f[:, cells].ravel()
         for keys, h, tb in inputs.films:
             facets = own[np.isin(part.facet_keys[own], keys)]

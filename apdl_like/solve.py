@@ -35,7 +35,7 @@ _PLACEHOLDER = 1.0  # ρ, c of a steady analysis: unused, but Material wants pos
 
 
 def refuse_deck_mesh_loads(session: SessionState, done: str) -> None:
-    """Tabular loads and F,,HEAT are solved on a deck's own mesh only
+    """Tabular loads, F,,HEAT and nodal HGEN are solved on a deck's own mesh only
     (`apdl_like.plane_solve`), not on twin.fem's spindle."""
     db = session.db
     if in_use(db):
@@ -44,6 +44,9 @@ def refuse_deck_mesh_loads(session: SessionState, done: str) -> None:
     if np.any(~np.isnan(db.nodes.arrays["f_heat"])):
         raise ApdlError(f"nodal heat flows (F,,HEAT) are {done} on a deck's own mesh only, not "
                         "on the spindle session's")
+    if np.any(~np.isnan(db.nodes.arrays["bf_hgen"])):
+        raise ApdlError(f"nodal heat generation (BF,Node,HGEN) is {done} on a deck's own mesh "
+                        "only, not on the spindle session's: use BFE")
 
 
 def fem_model(session: SessionState) -> FemModel:

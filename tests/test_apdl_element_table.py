@@ -1,6 +1,6 @@
-"""ETABLE VOLU and HEAT, ESORT with *GET,,SORT, PRETAB, PRRSOL and PRESOL, each checked
-against a volume, a heat balance or a closed form worked out here by hand, never against
-numbers from the code.
+"""ETABLE VOLU and HEAT, ESORT with *GET,,SORT, PRETAB, PRRSOL and PRESOL, and nodal HGEN
+(BF,Node,HGEN), each checked against a volume, a heat balance or a closed form worked out
+here by hand, never against numbers from the code.
 
 The two-element model: PLANE55 quads 1 (1 ≤ x ≤ 2) and 2 (2 ≤ x ≤ 4), 0 ≤ y ≤ 0.5, and a
 LINK32 bar 3 (area 0.01) from node 1 (x = 1) to node 3 (x = 4), held at 100 °C at x = 1
@@ -152,3 +152,135 @@ def test_presol_says_once_that_its_printout_is_not_produced():
     with pytest.raises(ApdlError, match="PRESOL.*--strict"):
         s = Session(strict=True)
         s.run_text("/POST1\nPRESOL,TG\n", "strict.inp")
+
+
+# ------------------------------------------------------------------ nodal HGEN
+def strip(loads: str, post: str, element: str = "PLANE55", keyopt3: int = 0) -> Session:
+    """A PLANE55 strip 0 ≤ x ≤ 1, 0 ≤ y ≤ 0.1 of four elements (nodes 1..5 at the bottom,
+    6..10 above them), k = 2, held at 0 °C at both ends."""
+    s = Session()
+    s.run_text(f"""/PREP7
+ET,1,{element},,,{keyopt3}
+MP,KXX,1,2
+*DO,I,1,5
+N,I,(I-1)*0.25,0
+N,I+5,(I-1)*0.25,0.1
+*ENDDO
+*DO,I,1,4
+E,I,I+1,I+6,I+5
+*ENDDO
+NSEL,S,LOC,X,0
+NSEL,A,LOC,X,1
+D,ALL,TEMP,0
+NSEL,ALL
+{loads}
+{SOLVE_THEN_POST}
+FSUM
+*GET,QF,FSUM,,ITEM,HEAT
+*GET,T2,NODE,2,TEMP
+*GET,T3,NODE,3,TEMP
+*GET,T4,NODE,4,TEMP
+{post}
+""", "strip.inp")
+    return s
+
+
+def test_nodal_hgen_varying_linearly_gives_the_exact_slab_temperatures():
+    # BF,n,HGEN,q0·x at every node: MAPDL multiplies a nodal rate "by the weighted nodal
+    # volume of each element adjacent to that node", ∫ N_n dV.  For q = q0·x/L in a slab
+    # held at 0 at x = 0 and L, T = q0 (L² x − x³) / (6 k L); on this uniform mesh the
+    # nodal loads q_n·h·H equal the consistent ∫ q N dV, so linear elements are exact at
+    # the nodes, and all the heat, q0 L H / 2, leaves through the held ends.  Before: BF
+    # with HGEN at nodes was refused.
+    q0, k, L, H = 1000.0, 2.0, 1.0, 0.1
+    p = strip("*DO,I,1,10\nBF,I,HGEN,1000*NX(I)\n*ENDDO", "").params
+    for name, x in (("T2", 0.25), ("T3", 0.5), ("T4", 0.75)):
+        assert p[name] == pytest.approx(q0 * (L * L * x - x**3) / (6 * k * L), rel=1e-12)
+    assert p["QF"] == pytest.approx(q0 * L * H / 2, rel=1e-12)
+
+
+def test_uniform_nodal_hgen_in_an_axisymmetric_rod_generates_q_times_the_volume():
+    # BF,ALL,HGEN,q on a solid rod (axisymmetric strip 0 ≤ r ≤ 1, height 0.1, held at 0 at
+    # r = 1; the r = 0 "held" nodes lie on the axis and take no heat): the weights ∫ N_n dV
+    # add up to the rod's volume π R² H, so the heat leaving is q π R² H exactly, and the
+    # centre temperature approaches q R² / (4k) = 125 °C (four linear rings: 129.4, 3.5 %
+    # high; the same as BFE,ALL,HGEN,q gives, a uniform nodal rate loading as BFE does)
+    q, k, R, H = 1000.0, 2.0, 1.0, 0.1
+    s = strip("BF,ALL,HGEN,1000\nDDELE,1,TEMP\nDDELE,6,TEMP", "*GET,T1,NODE,1,TEMP",
+              keyopt3=1)
+    p = s.params
+    assert p["QF"] == pytest.approx(q * math.pi * R**2 * H, rel=1e-12)
+    assert p["T1"] == pytest.approx(q * R**2 / (4 * k), rel=0.04)
+    same = strip("BFE,ALL,HGEN,,1000\nDDELE,1,TEMP\nDDELE,6,TEMP", "*GET,T1,NODE,1,TEMP",
+                 keyopt3=1).params
+    assert (same["T1"], same["QF"]) == pytest.approx((p["T1"], p["QF"]), rel=1e-12)
+
+
+@pytest.mark.parametrize("loads, message", [
+    ("BF,ALL,HGEN,5\nBFE,1,HGEN,,5", "element 1 has both BFE,,HGEN and nodal HGEN"),
+    ("*DIM,Q,TABLE,2,1,1,TIME\nBF,ALL,HGEN,%Q%", "nodal HGEN from a table"),
+])
+def test_nodal_hgen_refusals(loads, message):
+    with pytest.raises(ApdlError, match=message):
+        strip(loads, "")
+
+
+def test_nodal_hgen_on_quadratic_elements_is_refused():
+    s = Session()
+    with pytest.raises(ApdlError, match="quadratic elements"):
+        s.run_text("""/PREP7
+ET,1,PLANE77
+MP,KXX,1,2
+N,1,0,0
+N,2,2,0
+N,3,2,1
+N,4,0,1
+N,5,1,0
+N,6,2,0.5
+N,7,1,1
+N,8,0,0.5
+E,1,2,3,4,5,6,7,8
+D,1,TEMP,0
+BF,ALL,HGEN,10
+FINISH
+/SOLU
+SOLVE
+""", "q8.inp")
+
+
+@pytest.mark.parametrize("kbc, expected", [(1, 4.0 * 10.0), (0, 4.0 * sum(range(1, 11)) / 10)])
+def test_nodal_hgen_heats_an_insulated_block_at_q_over_rho_c(kbc, expected):
+    # an insulated block with a uniform nodal rate q: every node's load q·∫N_n dV meets its
+    # lumped capacity ρc·∫N_n dV, so T rises at q/ρc everywhere (4 °C/s here): 40 °C in
+    # 10 s stepped (KBC,1).  Ramped from zero (KBC,0) the rate is q·t/10; backward Euler
+    # (θ = 1) in 1 s substeps takes each substep's end value: 4·(1 + 2 + ... + 10)/10 = 22
+    # (the exact ramp would give 20)
+    q, rho_c = 4.0e6, 1.0e6
+    s = Session()
+    s.run_text(f"""/PREP7
+ET,1,PLANE55
+MP,KXX,1,5
+MP,DENS,1,1000
+MP,C,1,1000
+RECTNG,0,0.02,0,0.01
+ESIZE,0.005
+AMESH,ALL
+TUNIF,0
+FINISH
+/SOLU
+ANTYPE,TRANS
+KBC,{kbc}
+TIME,10
+DELTIM,1
+BF,ALL,HGEN,{q}
+SOLVE
+FINISH
+/POST1
+*GET,TA,NODE,1,TEMP
+NSORT,TEMP
+*GET,TMAX,SORT,,MAX
+*GET,TMIN,SORT,,MIN
+""", "block.inp")
+    p = s.params
+    assert q / rho_c == 4.0
+    assert (p["TMIN"], p["TMAX"]) == pytest.approx((expected, expected), rel=1e-9)

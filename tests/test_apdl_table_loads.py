@@ -371,3 +371,7 @@ def test_the_spindle_session_refuses_tabular_loads():
                                         "deck's own mesh only"):
         Session.from_mesh(mesh, {"body": steel}).run_text(
             deck.replace("D,ALL,TEMP,%TB%", "F,ALL,HEAT,5"), "deck.inp")
+    with pytest.raises(ApdlError, match=r"SOLVE: nodal heat generation \(BF,Node,HGEN\) is "
+                                        "solved on a deck's own mesh only"):
+        Session.from_mesh(mesh, {"body": steel}).run_text(
+            deck.replace("D,ALL,TEMP,%TB%", "BF,ALL,HGEN,5"), "deck.inp")

@@ -398,14 +398,20 @@ def bf(s: SessionState, c: Call) -> None:
         idx = node_targets(s, c, 1)
         s.db.nodes.arrays["bf_temp"][idx] = value
     elif lab == "HGEN":
-        name = c.label(1)
-        comp = s.db.components.get(name)
-        if comp is None or comp.entity != "ELEM":
-            raise ApdlError("HGEN by BF needs an element component; use BFE,ALL,HGEN,,value "
-                            "for selected elements")
+        comp = s.db.components.get(c.label(1))
         slot = table_slot(s, c, 3)
-        _set_hgen(s, element_targets(s, c, 1), 0.0 if slot is not None else
-                  c.num(3, what="VAL1"), slot)
+        if comp is not None and comp.entity == "ELEM":
+            _set_hgen(s, element_targets(s, c, 1), 0.0 if slot is not None else
+                      c.num(3, what="VAL1"), slot)
+        elif slot is not None:
+            raise ApdlError("nodal HGEN from a table (BF,Node,HGEN,%table%) is not supported: "
+                            "use BFE,ALL,HGEN,,%table% on the selected elements")
+        else:
+            # MAPDL: the nodal rate "multiplied by the weighted nodal volume of each element
+            # adjacent to that node" (apdl_like.plane_thermal, `nodal_hgen`)
+            value = c.num(3, what="VAL1")
+            idx = node_targets(s, c, 1)
+            s.db.nodes.arrays["bf_hgen"][idx] = value
     else:
         raise ApdlError(f"field 2: body load must be TEMP or HGEN, got {lab or '(empty)'!r}")
     s.note_load(c)
