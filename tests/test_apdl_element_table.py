@@ -136,10 +136,12 @@ def test_esort_sorts_the_element_table_for_get_sort():
 
 
 def test_pretab_lists_columns_in_esort_order_and_eusort_restores_it():
+    # (MAPDL: "Changing the selected element set [ESEL] also restores the original element
+    # order", as EUSORT does)
     s = two_quads(False, "", VOLUMES + "ETABLE,G,TG,X\nESORT,ETAB,V\nPRETAB,V,G\nEUSORT\n"
-                  "PRETAB\n")
+                  "PRETAB\nESORT,ETAB,V\nESEL,ALL\nPRETAB,V\n")
     rows = [line.split() for line in s.log if line[:8].strip().isdigit()]
-    assert [r[0] for r in rows] == ["2", "1", "3", "1", "2", "3"]
+    assert [r[0] for r in rows] == ["2", "1", "3", "1", "2", "3", "1", "2", "3"]
     assert [float(r[1]) for r in rows[:3]] == pytest.approx([1.0, 0.5, 0.03])
     assert float(rows[0][2]) == pytest.approx(-100.0 / 3.0)
     assert len(rows[3]) == 3  # blank: the stored columns, V and G

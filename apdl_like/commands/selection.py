@@ -103,7 +103,16 @@ def _table_selection(table: str, default_item: str,
 
 
 nsel = command("NSEL", _ANY_OR_BEGIN, 7)(_table_selection("nodes", "NODE", _nodes_picked))
-esel = command("ESEL", _ANY_OR_BEGIN, 7)(_table_selection("elements", "ELEM", _elements_picked))
+_select_elements = _table_selection("elements", "ELEM", _elements_picked)
+
+
+@command("ESEL", _ANY_OR_BEGIN, 7)
+def esel(s: SessionState, c: Call) -> None:
+    """ESEL: a new element selection; as MAPDL documents for ESORT, it also restores the
+    elements' original order (PRETAB lists by number again; *GET,,SORT still reads the
+    last sort)."""
+    s.element_order = None
+    _select_elements(s, c)
 
 
 def _centroids(s: SessionState) -> np.ndarray:
