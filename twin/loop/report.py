@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
+from twin.contract import SENSOR_LOCATIONS, SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.errors import InputError
 from twin.io.atomic import write_bytes, write_json, write_text
 from twin.io.figures import load_matplotlib, new_figure, png_bytes
@@ -84,9 +84,13 @@ def _read_csv(path: Path) -> _Columns:
 PLOTS = ("temperatures.png", "drift_corrections.png")
 
 
+def _layout(fig: Figure, top: float = 0.9, right: float = 0.99) -> None:
+    """Fixed margins: a "tight" bounding box draws the figure twice (a third of a replay).
+    top and right leave room for a title line and a legend beside the axes."""
+    fig.subplots_adjust(left=0.05, right=right, bottom=0.17, top=top, wspace=0.25)
+
+
 def _png(fig: Figure) -> bytes:
-    # fixed margins: a "tight" bounding box draws the figure twice (a third of a replay)
-    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.17, top=0.9, wspace=0.25)
     return png_bytes(fig, dpi=80)
 
 
@@ -113,28 +117,103 @@ def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
         return []
     corr = _read_csv(run_dir / "corrections.csv")
     paths = [run_dir / "plots" / name for name in PLOTS]
+    name = run_dir.name
 
     def draw_drift(_: str) -> None:
-        write_bytes(paths[1], _drift_figure(kp, corr))
+        write_bytes(paths[1], _png(drift_figure(kp, corr, name)))
 
     with ForkedTask(draw_drift, fork=split) as drift:
         drift.start()
-        write_bytes(paths[0], _temperature_figure(kp))
+        write_bytes(paths[0], _png(temperature_figure(kp, corr, name)))
         drift.join()
     return paths
 
 
-def _temperature_figure(kp: _Columns) -> bytes:
-    """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11)."""
+Segment = tuple[float, float, float]
+"""(start_s, end_s, speed_rpm) of a stretch of windows the twin ran at one speed."""
+
+MAX_SPEED_CHANGES_MARKED = 40
+"""Speed changes a figure marks with a line; a run changing speed more often (a recorded
+cutting cycle) gets its stops shaded only: a line a minute hid the curves."""
+
+
+def speed_segments(corr: _Columns) -> list[Segment]:
+    """The speeds the twin ran (corrections.csv: one per window, the first method's rows;
+    window k from 60 k s) as stretches of one speed, in time order; [] without them."""
+    if not corr:
+        return []
+    first = np.array(corr["method"]) == corr["method"][0]
+    start = corr.numbers("window")[first] * WINDOW_S
+    if "speed_rpm" not in corr:
+        return []
+    speed = corr.numbers("speed_rpm")[first]
+    order = np.argsort(start, kind="stable")
+    segments: list[Segment] = []
+    for a, rpm in zip(start[order], speed[order], strict=True):
+        if not (np.isfinite(a) and np.isfinite(rpm)):
+            continue
+        if segments and segments[-1][2] == rpm:
+            segments[-1] = (segments[-1][0], float(a) + WINDOW_S, float(rpm))
+        else:
+            segments.append((float(a), float(a) + WINDOW_S, float(rpm)))
+    return segments
+
+
+MAX_SPEEDS_LISTED = 8
+"""Speed stretches `speed_profile` lists one by one; more are summarised."""
+
+
+def speed_profile(segments: list[Segment]) -> str:
+    """The run's speeds in words: "8000 → 12000 → stop → 6000 rpm" (the twin's window
+    speeds), or a summary for a run of many speed changes; "" without segments."""
+    if not segments:
+        return ""
+    if len(segments) <= MAX_SPEEDS_LISTED:
+        return " → ".join("stop" if rpm == 0 else f"{rpm:.0f}" for _, _, rpm in segments) + (
+            " rpm" if any(rpm for _, _, rpm in segments) else "")
+    running = [rpm for _, _, rpm in segments if rpm > 0]
+    stops = sum(1 for _, _, rpm in segments if rpm == 0)
+    span = f"{min(running):.0f}–{max(running):.0f} rpm" if running else "stopped"
+    return (f"{span} in {len(segments)} stretches"
+            + (f", {stops} stop{'s' if stops > 1 else ''}" if stops else ""))
+
+
+def _mark_speeds(ax: Axes, segments: list[Segment]) -> None:
+    """Shade the stops grey and draw a dotted line at each speed change (minutes)."""
+    for a, b, rpm in segments:
+        if rpm == 0:
+            ax.axvspan(a / 60.0, b / 60.0, color="0.88", lw=0, zorder=0)
+    if len(segments) - 1 <= MAX_SPEED_CHANGES_MARKED:
+        for a, _, _ in segments[1:]:
+            ax.axvline(a / 60.0, color="0.45", ls=":", lw=0.9, zorder=0.5)
+
+
+def _speed_note(segments: list[Segment]) -> str:
+    if not segments:
+        return ""
+    marks = []
+    if any(rpm == 0 for _, _, rpm in segments):
+        marks.append("grey: stopped")
+    if 1 < len(segments) <= MAX_SPEED_CHANGES_MARKED + 1:
+        marks.append("dotted: speed change")
+    return f"speed {speed_profile(segments)}" + (f" ({', '.join(marks)})" if marks else "")
+
+
+def temperature_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
+    """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11),
+    the stops shaded and the speed changes marked."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = kp.numbers("time_s") / 60.0
-    fig = new_figure(figsize=(17, 3.2))
+    segments = speed_segments(corr)
+    fig = new_figure(figsize=(17, 3.6))
     axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
+        _mark_speeds(ax, segments)
         first = method_col == methods[0]
-        ax.plot(t_min[first], kp.numbers(f"{s}_meas_C")[first], "k.", ms=2, label="measured")
+        measured = kp.numbers(f"{s}_meas_C")[first]
+        ax.plot(t_min[first], measured, "k.", ms=2, label="measured")
         for m in methods:
             sel = method_col == m
             ax.plot(
@@ -145,7 +224,11 @@ def _temperature_figure(kp: _Columns) -> bytes:
                 label=m,
             )
             _shade_band(ax, kp, sel, t_min, f"{s}_twin_lo_C", f"{s}_twin_hi_C", m)
-        ax.set_title(s, y=1.0)
+        ax.set_title(f"{s}: {SENSOR_LOCATIONS[s]}", y=1.0, fontsize=10)
+        if not np.isfinite(measured).any():  # a stuck or dead channel: left out
+            ax.text(0.5, 0.04, "no valid measurement\n(excluded, see data quality)",
+                    transform=ax.transAxes, ha="center", va="bottom", fontsize=8,
+                    color="#b00")
         ax.set_xlabel("time [min]")
         ax.grid(alpha=0.3)
         # four intervals suit a panel 3.4 in wide, and halve the ticks matplotlib builds
@@ -153,27 +236,43 @@ def _temperature_figure(kp: _Columns) -> bytes:
         ax.locator_params(axis="y", nbins=4)
     axes[0].set_ylabel("temperature [°C]")
     axes[0].legend(fontsize=7)
-    return _png(fig)
+    note = _speed_note(segments)
+    fig.suptitle(f"{run}: T1–T5 measured and twin" + (f"; {note}" if note else ""),
+                 fontsize=11, y=0.985)
+    _layout(fig, top=0.8)
+    return fig
 
 
-def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
-    """The axial nose drift measured and per method, and the correction factors per window."""
+FACTOR_NAMES = {"C_H_front": "bearing heat front", "C_H_rear": "bearing heat rear",
+                "C_C_front": "contact resistance front", "C_C_rear": "contact resistance rear"}
+"""corrections.csv's factor columns in words, for the legend."""
+
+
+def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
+    """The axial nose drift measured and per method, and the correction factors per window,
+    both over the run's time with the stops shaded and the speed changes marked."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = kp.numbers("time_s") / 60.0
-    fig = new_figure(figsize=(13, 3.2))
-    ax1, ax2 = fig.subplots(1, 2)
+    segments = speed_segments(corr)
+    fig = new_figure(figsize=(13, 3.6))
+    ax1, ax2 = fig.subplots(1, 2, sharex=True)
+    _mark_speeds(ax1, segments)
+    _mark_speeds(ax2, segments)
     first = method_col == methods[0]
     meas = kp.numbers("disp_z_meas_um")[first]
     if np.isfinite(meas).any():
         ax1.plot(t_min[first], meas, "k.", ms=2, label="measured")
+    else:
+        ax1.text(0.5, 0.04, "no drift measurement in the run", transform=ax1.transAxes,
+                 ha="center", va="bottom", fontsize=8, color="#b00")
     for m in methods:
         sel = method_col == m
         ax1.plot(
             t_min[sel], kp.numbers("disp_z_twin_um")[sel], color=METHOD_COLORS.get(m), label=m
         )
         _shade_band(ax1, kp, sel, t_min, "disp_z_twin_lo_um", "disp_z_twin_hi_um", m)
-    ax1.set_title("axial nose drift", y=1.0)
+    ax1.set_title("axial thermal drift of the spindle nose", y=1.0, fontsize=10)
     ax1.set_xlabel("time [min]")
     ax1.set_ylabel("drift [µm]")
     ax1.grid(alpha=0.3)
@@ -184,7 +283,8 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
             sel = cm == m
             if m == "open_loop":
                 continue
-            w = corr.numbers("window")[sel]
+            # a window's factor holds from its start for the window: drawn as steps
+            w_min = corr.numbers("window")[sel] * (WINDOW_S / 60.0)
             for key, style in (
                 ("C_H_front", "-"),
                 ("C_H_rear", "--"),
@@ -192,18 +292,27 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
                 ("C_C_rear", "-."),
             ):
                 ax2.plot(
-                    w,
+                    w_min,
                     _running_factor(corr, key, sel),
                     style,
+                    drawstyle="steps-post",
                     color=METHOD_COLORS.get(m),
-                    label=f"{m} {key}",
+                    label=f"{m}: {FACTOR_NAMES[key]}",
                 )
-    ax2.set_title("correction factors per window", y=1.0)
-    ax2.set_xlabel("window")
+    ax2.set_title("correction factors per 60 s window (1 = nominal model)", y=1.0,
+                  fontsize=10)
+    ax2.set_xlabel("time [min] (window start)")
+    ax2.set_ylabel("factor [–]")
     ax2.grid(alpha=0.3)
     if ax2.get_lines():  # open loop alone has no factors to show
-        ax2.legend(fontsize=6, ncol=2)
-    return _png(fig)
+        # beside the axes: inside, its twelve entries hid the factors' spikes
+        ax2.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                   borderaxespad=0.0)
+    note = _speed_note(segments)
+    fig.suptitle(f"{run}: nose drift and corrections" + (f"; {note}" if note else ""),
+                 fontsize=11, y=0.985)
+    _layout(fig, top=0.8, right=0.8)
+    return fig
 
 
 def _running_factor(corr: _Columns, key: str, sel: np.ndarray) -> np.ndarray:
@@ -268,6 +377,7 @@ def distribution_plot(runs: list[dict], methods: list[str]) -> bytes:
         ax.set_xticks(range(len(methods)), methods)
         ax.set_title(METRIC_LABELS[key], fontsize=10)
         ax.grid(axis="y", alpha=0.3)
+    _layout(fig)
     return _png(fig)
 
 
