@@ -14,6 +14,7 @@ import csv
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING
+from urllib.parse import quote
 
 import numpy as np
 
@@ -339,8 +340,13 @@ def run_plotter(fork: bool = True) -> ForkedTask:
     return ForkedTask(draw, prepare=load_matplotlib, fork=fork)
 
 
+PLOT_ALTS = {"temperatures.png": "T1–T5 measured and twin over time, per method",
+             "drift_corrections.png": "axial nose drift measured and twin, and the "
+                                      "correction factors per window"}
+
+
 def _image(png: Path) -> dict[str, str]:
-    return {"alt": png.stem, "src": png_data_uri(png.read_bytes())}
+    return {"alt": PLOT_ALTS.get(png.name, png.stem), "src": png_data_uri(png.read_bytes())}
 
 
 def _plots(run_dir: Path) -> list[dict[str, str]]:
@@ -349,6 +355,33 @@ def _plots(run_dir: Path) -> list[dict[str, str]]:
     if not all(p.is_file() for p in paths):
         paths = render_run_plots(run_dir)
     return [_image(p) for p in paths]
+
+
+RUN_FILES = (
+    ("keypoints.csv", "T1–T5 and drift per step"),
+    ("corrections.csv", "corrections per window"),
+    ("accuracy.json", "accuracy"),
+    ("quality.json", "data quality"),
+    ("fields.pvd", "fields (ParaView)"),
+    ("decks", "window decks"),
+)
+"""A run folder's files the page links to, where they exist, with what they hold."""
+
+
+def _run_links(run_dir: Path) -> list[dict[str, str]]:
+    """Links (relative to the page, beside the run folder) to the run's files that exist: the page
+    is one file, the numbers and fields stay beside it."""
+    return [{"href": quote(f"{run_dir.name}/{name}"), "text": name, "title": what}
+            for name, what in RUN_FILES if (run_dir / name).exists()]
+
+
+def _snapshot_caption(png: Path) -> str:
+    """What a snapshot file `<method>_t<seconds>s.png` shows, in words."""
+    method, sep, rest = png.stem.rpartition("_t")
+    if sep and rest.endswith("s") and rest[:-1].isdigit():
+        t = int(rest[:-1])
+        return f"temperature field of {method} at t = {t} s ({t / 60:.1f} min)"
+    return png.name
 
 
 DISTRIBUTION_MIN_RUNS = 5
@@ -502,22 +535,31 @@ def _page(out_root: Path, summary: dict) -> str:
         if run_dir is None:  # a name, never a path: nothing is read or drawn outside DIR
             continue
         snapshots = sorted(p for p in (run_dir / "snapshots").glob("*.png") if p.is_file())[-2:]
+        # the speeds the twin ran, in words: the mean alone hid the steps and stops
+        profile = (speed_profile(speed_segments(_read_csv(run_dir / "corrections.csv")))
+                   if (run_dir / "corrections.csv").is_file() else "")
         page_runs.append({
             "name": r["run"],
+            "anchor": f"run-{len(page_runs) + 1}",
             # accuracy.json's speed and ambient are the run's means (of a run with speed
             # steps or a stop too): said so
             "caption": f"mean {r['speed_rpm']:.0f} rpm, mean ambient {r['ambient_C']:.2f} °C, "
-                       f"{r['duration_s'] / 60:.1f} min",
+                       f"{r['duration_s'] / 60:.1f} min"
+                       + (f"; speed {profile}" if profile else ""),
             "plots": _plots(run_dir) if (run_dir / "keypoints.csv").is_file() else [],
             "findings": _findings(run_dir),
-            "snapshots": [{"alt": p.name, "src": png_data_uri(p.read_bytes())}
-                          for p in snapshots],
+            "links": _run_links(run_dir),
+            "snapshots": [{"alt": _snapshot_caption(p), "caption": _snapshot_caption(p),
+                           "src": png_data_uri(p.read_bytes())} for p in snapshots],
         })
+    anchors = {pr["name"]: pr["anchor"] for pr in page_runs}
     return render_page(
         "replay_report.html.j2",
         step_s=STEP_S, window_s=WINDOW_S, methods=methods,
-        rows=[[r["run"], f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
-               *(c for m in methods for c in _accuracy_cells(r["methods"].get(m, {})))]
+        rows=[{"name": r["run"], "anchor": anchors.get(r["run"]),
+               "cells": [f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
+                         *(c for m in methods
+                           for c in _accuracy_cells(r["methods"].get(m, {})))]}
               for r in runs],
         average=["", "", *(c for m in methods for c in _accuracy_cells(mean.get(m, {})))],
         failed=[{"run": f.get("run", "?"), "error": f.get("error", "")}
