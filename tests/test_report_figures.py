@@ -94,11 +94,17 @@ def test_temperature_panels_name_sensor_place_and_units_and_shade_the_stop(run):
     assert "temperature [°C]" in texts
     assert texts.count("time [min]") == 5
     title = fig._suptitle.get_text()
-    assert "my_run" in title and "8000 → stop → 6000 rpm" in title and "grey: stopped" in title
+    assert "my_run" in title and "window 8000 → stop → 6000 rpm" in title
+    assert "grey: stopped" in title
     for ax in fig.axes:  # the stop, 5..8 min, shaded on every panel
         assert (5.0, 8.0) in _spans(ax)
         assert {line.get_xdata()[0] for line in ax.get_lines()
                 if line.get_linestyle() == ":"} == {5.0, 8.0}
+    # one legend row under the title, none inside a panel to cover the curves
+    assert all(ax.get_legend() is None for ax in fig.axes)
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == [
+        "measured", *METHODS, "estimator 90 % band"]
     # T2 has no valid sample: its panel says so rather than showing nothing unexplained
     assert any("no valid measurement" in t.get_text() for t in fig.axes[1].texts)
     assert not any("no valid measurement" in t.get_text() for t in fig.axes[0].texts)
@@ -127,7 +133,7 @@ def test_no_text_is_cut_off_at_the_figures_edge(run, which):
     _png(fig)  # drawn as the report draws it (its dpi and margins)
     renderer = fig.canvas.get_renderer()
     width, height = fig.bbox.width, fig.bbox.height
-    artists = [fig._suptitle]
+    artists = [fig._suptitle, *fig.legends]
     for ax in fig.axes:
         artists += [ax.title, ax.xaxis.label, ax.yaxis.label, *ax.texts]
         if ax.get_legend():
@@ -136,3 +142,17 @@ def test_no_text_is_cut_off_at_the_figures_edge(run, which):
         box = a.get_window_extent(renderer)
         assert box.x0 >= 0 and box.y0 >= 0 and box.x1 <= width and box.y1 <= height, (
             a, box, width, height)
+
+
+@pytest.mark.parametrize("which", ["temperature", "drift"])
+def test_the_title_the_legend_row_and_the_panel_titles_do_not_overlap(run, which):
+    from twin.loop.report import _png
+    kp, corr = run
+    fig = (temperature_figure if which == "temperature" else drift_figure)(kp, corr, "run")
+    _png(fig)
+    renderer = fig.canvas.get_renderer()
+    title = fig._suptitle.get_window_extent(renderer)
+    legend = fig.legends[0].get_window_extent(renderer)
+    assert legend.y1 <= title.y0
+    for ax in fig.axes:
+        assert ax.title.get_window_extent(renderer).y1 <= legend.y0

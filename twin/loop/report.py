@@ -197,7 +197,8 @@ def _speed_note(segments: list[Segment]) -> str:
         marks.append("grey: stopped")
     if 1 < len(segments) <= MAX_SPEED_CHANGES_MARKED + 1:
         marks.append("dotted: speed change")
-    return f"speed {speed_profile(segments)}" + (f" ({', '.join(marks)})" if marks else "")
+    return (f"speed per 60 s window {speed_profile(segments)}"
+            + (f" ({', '.join(marks)})" if marks else ""))
 
 
 def temperature_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
@@ -236,12 +237,24 @@ def temperature_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
         # and draws (a quarter of the figure's cost, which ends a replay's critical path)
         ax.locator_params(axis="y", nbins=4)
     axes[0].set_ylabel("temperature [°C]")
-    axes[0].legend(fontsize=7)
+    _legend_row(fig, axes[0])
     note = _speed_note(segments)
     fig.suptitle(f"{run}: T1–T5 measured and twin" + (f"; {note}" if note else ""),
                  fontsize=11, y=0.985)
-    _layout(fig, top=0.8)
+    _layout(fig, top=TOP_UNDER_LEGEND)
     return fig
+
+
+TOP_UNDER_LEGEND = 0.76
+"""The axes' top (figure fraction) under the title and the legend row."""
+
+
+def _legend_row(fig: Figure, ax: Axes) -> None:
+    """The measured points, the methods and the band as one row under the figure's title:
+    inside a panel the legend covered curves whichever corner it took."""
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.925),
+               ncol=max(len(labels), 1), fontsize=8, frameon=False, markerscale=2)
 
 
 FACTOR_NAMES = {"C_H_front": "bearing heat front", "C_H_rear": "bearing heat rear",
@@ -277,7 +290,7 @@ def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
     ax1.set_xlabel("time [min]")
     ax1.set_ylabel("drift [µm]")
     ax1.grid(alpha=0.3)
-    ax1.legend(fontsize=7)
+    _legend_row(fig, ax1)
     if corr:
         cm = np.array(corr["method"])
         for m in methods:
@@ -312,7 +325,7 @@ def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
     note = _speed_note(segments)
     fig.suptitle(f"{run}: nose drift and corrections" + (f"; {note}" if note else ""),
                  fontsize=11, y=0.985)
-    _layout(fig, top=0.8, right=0.8)
+    _layout(fig, top=TOP_UNDER_LEGEND, right=0.8)
     return fig
 
 
