@@ -21,7 +21,15 @@ import numpy as np
 from twin.contract import SENSOR_LOCATIONS, SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.errors import InputError
 from twin.io.atomic import write_bytes, write_json, write_text
-from twin.io.figures import load_matplotlib, new_figure, png_bytes
+from twin.io.figures import (
+    MAX_SPEED_CHANGES_MARKED,
+    Stretch,
+    load_matplotlib,
+    mark_speeds,
+    new_figure,
+    png_bytes,
+    speed_stretches,
+)
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
 from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
@@ -130,15 +138,7 @@ def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
     return paths
 
 
-Segment = tuple[float, float, float]
-"""(start_s, end_s, speed_rpm) of a stretch of windows the twin ran at one speed."""
-
-MAX_SPEED_CHANGES_MARKED = 40
-"""Speed changes a figure marks with a line; a run changing speed more often (a recorded
-cutting cycle) gets its stops shaded only: a line a minute hid the curves."""
-
-
-def speed_segments(corr: _Columns) -> list[Segment]:
+def speed_segments(corr: _Columns) -> list[Stretch]:
     """The speeds the twin ran (corrections.csv: one per window, the first method's rows;
     window k from 60 k s) as stretches of one speed, in time order; [] without them."""
     if not corr:
@@ -147,24 +147,16 @@ def speed_segments(corr: _Columns) -> list[Segment]:
     start = corr.numbers("window")[first] * WINDOW_S
     if "speed_rpm" not in corr:
         return []
-    speed = corr.numbers("speed_rpm")[first]
-    order = np.argsort(start, kind="stable")
-    segments: list[Segment] = []
-    for a, rpm in zip(start[order], speed[order], strict=True):
-        if not (np.isfinite(a) and np.isfinite(rpm)):
-            continue
-        if segments and segments[-1][2] == rpm:
-            segments[-1] = (segments[-1][0], float(a) + WINDOW_S, float(rpm))
-        else:
-            segments.append((float(a), float(a) + WINDOW_S, float(rpm)))
-    return segments
+    ends = start[np.isfinite(start)]
+    return speed_stretches(start, corr.numbers("speed_rpm")[first],
+                           float(ends.max()) + WINDOW_S if ends.size else 0.0)
 
 
 MAX_SPEEDS_LISTED = 8
 """Speed stretches `speed_profile` lists one by one; more are summarised."""
 
 
-def speed_profile(segments: list[Segment]) -> str:
+def speed_profile(segments: list[Stretch]) -> str:
     """The run's speeds in words: "8000 → 12000 → stop → 6000 rpm" (the twin's window
     speeds), or a summary for a run of many speed changes; "" without segments."""
     if not segments:
@@ -179,17 +171,7 @@ def speed_profile(segments: list[Segment]) -> str:
             + (f", {stops} stop{'s' if stops > 1 else ''}" if stops else ""))
 
 
-def _mark_speeds(ax: Axes, segments: list[Segment]) -> None:
-    """Shade the stops grey and draw a dotted line at each speed change (minutes)."""
-    for a, b, rpm in segments:
-        if rpm == 0:
-            ax.axvspan(a / 60.0, b / 60.0, color="0.88", lw=0, zorder=0)
-    if len(segments) - 1 <= MAX_SPEED_CHANGES_MARKED:
-        for a, _, _ in segments[1:]:
-            ax.axvline(a / 60.0, color="0.45", ls=":", lw=0.9, zorder=0.5)
-
-
-def _speed_note(segments: list[Segment]) -> str:
+def _speed_note(segments: list[Stretch]) -> str:
     if not segments:
         return ""
     marks = []
@@ -212,7 +194,7 @@ def temperature_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
     axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
-        _mark_speeds(ax, segments)
+        mark_speeds(ax, segments, 60.0)
         first = method_col == methods[0]
         measured = kp.numbers(f"{s}_meas_C")[first]
         ax.plot(t_min[first], measured, "k.", ms=2, label="measured")
@@ -271,8 +253,8 @@ def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
     segments = speed_segments(corr)
     fig = new_figure(figsize=(13, 3.6))
     ax1, ax2 = fig.subplots(1, 2, sharex=True)
-    _mark_speeds(ax1, segments)
-    _mark_speeds(ax2, segments)
+    mark_speeds(ax1, segments, 60.0)
+    mark_speeds(ax2, segments, 60.0)
     first = method_col == methods[0]
     meas = kp.numbers("disp_z_meas_um")[first]
     if np.isfinite(meas).any():
