@@ -156,3 +156,26 @@ def test_the_title_the_legend_row_and_the_panel_titles_do_not_overlap(run, which
     assert legend.y1 <= title.y0
     for ax in fig.axes:
         assert ax.title.get_window_extent(renderer).y1 <= legend.y0
+
+
+def test_figures_drawn_in_a_replays_staging_folder_name_the_run(run, tmp_path, monkeypatch):
+    # a replay draws its figures in `.NAME.PID.HEX.partial` before renaming it NAME: the
+    # titles read ".spindle_10800rpm_30min.20170.7619aab9.partial: T1–T5 ..."
+    import shutil
+
+    import twin.loop.report
+    from twin.io.atomic import output_name, temporary_name
+    from twin.loop.report import render_run_plots
+
+    staging = tmp_path / temporary_name("spindle_9000rpm_30min", ".partial")
+    staging.mkdir()
+    for name in ("keypoints.csv", "corrections.csv"):
+        shutil.copy(tmp_path / name, staging / name)
+    titles = []
+    draw = twin.loop.report._png
+    monkeypatch.setattr(twin.loop.report, "_png",
+                        lambda fig: titles.append(fig._suptitle.get_text()) or draw(fig))
+    render_run_plots(staging)
+    assert len(titles) == 2
+    assert all(t.startswith("spindle_9000rpm_30min: ") for t in titles), titles
+    assert output_name("run.v2") == "run.v2"  # any other name is itself

@@ -20,7 +20,7 @@ import numpy as np
 
 from twin.contract import SENSOR_LOCATIONS, SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.errors import InputError
-from twin.io.atomic import write_bytes, write_json, write_text
+from twin.io.atomic import output_name, write_bytes, write_json, write_text
 from twin.io.figures import (
     MAX_SPEED_CHANGES_MARKED,
     Stretch,
@@ -126,7 +126,7 @@ def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
         return []
     corr = _read_csv(run_dir / "corrections.csv")
     paths = [run_dir / "plots" / name for name in PLOTS]
-    name = run_dir.name
+    name = output_name(run_dir.name)  # a replay draws in its staging folder
 
     def draw_drift(_: str) -> None:
         write_bytes(paths[1], _png(drift_figure(kp, corr, name)))
