@@ -179,3 +179,16 @@ def test_figures_drawn_in_a_replays_staging_folder_name_the_run(run, tmp_path, m
     assert len(titles) == 2
     assert all(t.startswith("spindle_9000rpm_30min: ") for t in titles), titles
     assert output_name("run.v2") == "run.v2"  # any other name is itself
+
+
+def test_open_loop_alone_says_it_has_no_factors_and_draws_no_empty_legend(run, recwarn):
+    # the speed marks are lines too: an open-loop run with a speed change drew an empty
+    # legend ("No artists with labels found to put in legend")
+    kp, corr = run
+    keep = np.array(kp["method"]) == "open_loop"
+    only = type(kp)(kp.path, {k: list(np.array(v)[keep]) for k, v in kp.items()})
+    fig = drift_figure(only, corr, "run")
+    ax2 = fig.axes[1]
+    assert ax2.get_legend() is None
+    assert [t.get_text() for t in ax2.texts] == ["no correction (open loop only)"]
+    assert not [w for w in recwarn if "legend" in str(w.message)]

@@ -300,10 +300,13 @@ def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
     ax2.set_xlabel("time [min] (window start)")
     ax2.set_ylabel("factor [–]")
     ax2.grid(alpha=0.3)
-    if ax2.get_lines():  # open loop alone has no factors to show
+    if ax2.get_legend_handles_labels()[0]:  # (the speed marks are lines without a label)
         # beside the axes: inside, its twelve entries hid the factors' spikes
         ax2.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0),
                    borderaxespad=0.0)
+    else:  # open loop alone has no factors to show
+        ax2.text(0.5, 0.5, "no correction (open loop only)", transform=ax2.transAxes,
+                 ha="center", va="center", fontsize=9, color="0.4")
     note = _speed_note(segments)
     fig.suptitle(f"{run}: nose drift and corrections" + (f"; {note}" if note else ""),
                  fontsize=11, y=0.985)
