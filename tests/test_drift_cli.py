@@ -217,6 +217,35 @@ def test_a_probe_that_never_moves_is_bad_input_and_reports_still_work(machine, t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dead.csv", "report"]
 
 
+def test_the_reports_figures_show_the_speeds_and_its_images_say_what_they_are(
+        machine, tmp_path, monkeypatch):
+    # the measured-vs-predicted figure showed no speed: a step test's stops and speeds
+    # were left to be guessed from the drift; the page's images had no alt text
+    import re
+
+    import twin.drift.report
+
+    folder, data, model = machine
+    figures = []
+    draw = twin.drift.report._png
+    monkeypatch.setattr(twin.drift.report, "_png", lambda fig: figures.append(fig) or draw(fig))
+    assert run("report", str(model), str(data), "--out", str(tmp_path / "r")).exit_code == 0
+    top, bottom = figures[0].axes
+    labels = [t.get_text() for t in top.texts]
+    # the machine: 3000 rpm, stop, 6000 rpm, stop, 3000 rpm, 40 min each
+    assert labels == ["3000 rpm", "stopped", "6000 rpm", "stopped", "3000 rpm"]
+    for ax in (top, bottom):
+        stops = sorted((round(p.get_x() * 60), round((p.get_x() + p.get_width()) * 60))
+                       for p in ax.patches if p.get_width() > 0 and p.get_height() == 1)
+        assert stops == [(40, 80), (120, 160)]  # minutes
+    renderer = figures[0].canvas.get_renderer()
+    legend = top.get_legend().get_window_extent(renderer)
+    assert legend.y0 >= top.get_window_extent(renderer).y1 - 1  # above the curves
+    html = (tmp_path / "r" / "report.html").read_text()
+    tags = re.findall(r"<img [^>]*>", html)
+    assert len(tags) == 3 and all(re.search(r"alt='[^']+'", t) for t in tags)
+
+
 def test_a_stop_while_the_report_is_drawn_leaves_the_earlier_pair(machine, tmp_path,
                                                                   monkeypatch):
     # metrics.json was written before the figures were drawn: Ctrl-C while drawing left

@@ -718,7 +718,8 @@ def test_report_passes_over_a_folder_among_the_snapshots(replayed, tmp_path):
     (folder / "hot_9000" / "snapshots" / "zz.png").mkdir()
     result = invoke("report", str(folder))
     assert result.exit_code == 0, result.output
-    assert 'alt="ratio_t00300s.png"' in (folder / "report.html").read_text()
+    assert 'alt="temperature field of ratio at t = 300 s (5.0 min)"' in (
+        folder / "report.html").read_text()
 
 def test_a_runs_files_all_know_it_by_its_file_name(runs_dir, tmp_path):
     # quality.json (and the snapshots' titles) took the run's `# name:` line while
@@ -958,6 +959,34 @@ def test_the_report_says_its_speed_and_ambient_are_a_runs_means(replayed):
     page = (replayed / "report.html").read_text()
     assert "<th rowspan=2>mean speed [rpm]</th><th rowspan=2>mean ambient [°C]</th>" in page
     assert "mean 9000 rpm, mean ambient 25.00 °C, 5.0 min" in page
+
+
+def test_the_report_page_links_only_what_exists_and_needs_no_network(replayed, tmp_path):
+    """Every link of report.html resolves: in-page anchors to a heading, file links to a
+    run's files beside the page; every image is embedded; nothing is fetched from another
+    host (the page is read offline, mailed, archived).  The run's caption gives its speeds
+    and the snapshot says what it shows."""
+    import re
+    from urllib.parse import unquote
+
+    folder = shutil.copytree(replayed, tmp_path / "replay")
+    shutil.rmtree(folder / "hot_9000" / "decks")  # a link to it must go with it
+    assert invoke("report", str(folder)).exit_code == 0
+    page = (folder / "report.html").read_text()
+    assert not re.search(r"""(?:src|href)\s*=\s*["']?(?:https?:)?//""", page), "external"
+    assert "@import" not in page and "url(" not in page
+    srcs = re.findall(r'<img [^>]*src="([^"]*)"', page)
+    assert srcs and all(s.startswith("data:image/png;base64,") for s in srcs)
+    assert all(re.search(r'alt="[^"]+"', tag) for tag in re.findall(r"<img [^>]*>", page))
+    ids = set(re.findall(r'id="([^"]+)"', page))
+    hrefs = re.findall(r'href="([^"]+)"', page)
+    files = [h for h in hrefs if not h.startswith("#")]
+    assert {h[1:] for h in hrefs if h.startswith("#")} == ids == {"run-1"}
+    assert sorted(files) == sorted(f"hot_9000/{n}" for n in (
+        "keypoints.csv", "corrections.csv", "accuracy.json", "quality.json", "fields.pvd"))
+    assert all((folder / unquote(h)).exists() for h in files)
+    assert "; speed 9000 rpm</p>" in page
+    assert "<figcaption>temperature field of ratio at t = 300 s (5.0 min)</figcaption>" in page
 
 
 def test_the_mean_line_says_over_how_many_runs_a_method_is_averaged(runs_dir, tmp_path):

@@ -108,6 +108,17 @@ def test_spikes_replaced(tmp_path):
     assert kinds(run) == {"spike"}
 
 
+def test_a_spikes_threshold_is_stated_with_its_unit(tmp_path):
+    # quality.json and the report read "deviation above 0.5 from the running median"
+    cols = noisy_warmup()
+    cols["T1_C"][300] += 9.0
+    cols["disp_z_um"] = np.linspace(0.0, 5.0, cols["time_s"].size)
+    cols["disp_z_um"][200] += 6.0
+    run = read_run(write(tmp_path, csv_text(cols)))
+    assert one(run, "spike", "T1_C")["detail"].endswith(" K from the running median")
+    assert one(run, "spike", "disp_z_um")["detail"].endswith(" µm from the running median")
+
+
 def coarse_load_change(n=151, dt=4.0):
     """T1/T3 as `twin simulate` writes them at 0.25 Hz: a fast warm-up whose bearing load
     drops at 60 s (first-order responses, closed form), so the rings turn sharply there."""

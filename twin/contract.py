@@ -14,6 +14,12 @@ from __future__ import annotations
 SENSOR_NAMES: tuple[str, ...] = ("T1", "T2", "T3", "T4", "T5")
 """The thermocouples T1..T5, in the order of every (…, 5) temperature array."""
 
+SENSOR_LOCATIONS: dict[str, str] = {
+    "T1": "front-bearing outer ring", "T2": "front-bearing sleeve",
+    "T3": "rear-bearing outer ring", "T4": "rear-bearing sleeve", "T5": "housing surface",
+}
+"""Where each thermocouple sits (REFERENCE.md §1), as figures and pages name it."""
+
 WINDOW_S = 60.0
 """Correction window length (s)."""
 

@@ -23,7 +23,7 @@ def snapshot(
     """Headless picture of the twin's field at a time of a recorded run."""
     from twin.correction.methods import make_corrector
     from twin.loop.replay import check_field_time, replay_method
-    from twin.loop.snapshot import render_snapshot
+    from twin.loop.snapshot import render_snapshot, snapshot_title
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
 
@@ -51,6 +51,6 @@ def snapshot(
         field=field.value,
         section=section,
         T_initial_C=r.T_initial_C,
-        title=f"{recorded.name} · {method_name} · t = {t:.0f} s",
+        title=snapshot_title(recorded.name, method_name, t, recorded),
     )
     typer.echo(f"wrote {out}")

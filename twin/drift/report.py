@@ -16,7 +16,7 @@ from twin.drift.data import DriftData
 from twin.drift.model import DriftModel
 from twin.drift.output import drift_metrics, write_metrics
 from twin.io.atomic import write_text
-from twin.io.figures import new_figure, png_bytes
+from twin.io.figures import mark_speeds, new_figure, png_bytes, speed_stretches
 from twin.io.html_pages import png_data_uri, render_page
 
 if TYPE_CHECKING:
@@ -38,6 +38,11 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
         y = data.targets_um[:, j]
         for s in np.unique(segments):
             rows = segments == s
+            if data.speed_rpm is not None:  # the stops shaded, the speeds written on top
+                stretches = speed_stretches(3600.0 * hours[rows], data.speed_rpm[rows],
+                                            3600.0 * hours[rows][-1])
+                mark_speeds(top, stretches, 3600.0, label=True)
+                mark_speeds(bottom, stretches, 3600.0)
             top.fill_between(hours[rows], lo[rows, j], hi[rows, j], color="tab:blue",
                              alpha=0.25, lw=0, label="90 % interval" if s == 0 else None)
             top.plot(hours[rows], y[rows], color="k", lw=1,
@@ -46,7 +51,13 @@ def _figures(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarra
                      label=f"predicted ({model.method})" if s == 0 else None)
             bottom.plot(hours[rows], mean[rows, j] - y[rows], color="tab:red", lw=0.8)
         top.set_ylabel(f"{target} [µm]")
-        top.legend(loc="best", fontsize=8)
+        if data.speed_rpm is not None:
+            top.set_title("grey: spindle stopped; dotted: speed change", fontsize=9,
+                          loc="right")
+            top.set_ylim(top.get_ylim()[0], top.get_ylim()[1] + 0.12 * np.ptp(top.get_ylim()))
+        # above the axes, left of that note: inside it covered the first speed's label
+        top.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, fontsize=8,
+                   frameon=False, borderaxespad=0.2)
         bottom.axhline(0.0, color="k", lw=0.5)
         bottom.set_ylabel("residual [µm]")
         bottom.set_xlabel("time from the first row [h]" if segments.max() == 0

@@ -48,11 +48,19 @@ def atomic_target(path: str | os.PathLike[str]) -> Iterator[Path]:
 
 # `.stem.PID.HEX.suffix`: the process that writes it, so a later one can tell an orphan
 _TEMPORARY = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{8}(\..*)?$")
+_STEM = re.compile(r"^\.(.+)\.\d+\.[0-9a-f]{8}(\..*)?$")
 
 
 def temporary_name(stem: str, suffix: str = "") -> str:
     """A hidden name beside an output, unique to this process and call."""
     return f".{stem}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
+
+
+def output_name(name: str) -> str:
+    """The output a `temporary_name` stands for (`.run.123.0a1b2c3d.partial` → `run`), any
+    other name as it is: a figure drawn in a staging folder names the run, not the folder."""
+    match = _STEM.match(name)
+    return match.group(1) if match else name
 
 
 def is_orphan(name: str) -> bool:

@@ -14,13 +14,22 @@ import csv
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING
+from urllib.parse import quote
 
 import numpy as np
 
-from twin.contract import SENSOR_NAMES, STEP_S, WINDOW_S
+from twin.contract import SENSOR_LOCATIONS, SENSOR_NAMES, STEP_S, WINDOW_S
 from twin.errors import InputError
-from twin.io.atomic import write_bytes, write_json, write_text
-from twin.io.figures import load_matplotlib, new_figure, png_bytes
+from twin.io.atomic import output_name, write_bytes, write_json, write_text
+from twin.io.figures import (
+    MAX_SPEED_CHANGES_MARKED,
+    Stretch,
+    load_matplotlib,
+    mark_speeds,
+    new_figure,
+    png_bytes,
+    speed_stretches,
+)
 from twin.io.html_pages import png_data_uri, render_page
 from twin.loop.folders import folder_lock
 from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
@@ -84,9 +93,13 @@ def _read_csv(path: Path) -> _Columns:
 PLOTS = ("temperatures.png", "drift_corrections.png")
 
 
+def _layout(fig: Figure, top: float = 0.9, right: float = 0.99) -> None:
+    """Fixed margins: a "tight" bounding box draws the figure twice (a third of a replay).
+    top and right leave room for a title line and a legend beside the axes."""
+    fig.subplots_adjust(left=0.05, right=right, bottom=0.17, top=top, wspace=0.25)
+
+
 def _png(fig: Figure) -> bytes:
-    # fixed margins: a "tight" bounding box draws the figure twice (a third of a replay)
-    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.17, top=0.9, wspace=0.25)
     return png_bytes(fig, dpi=80)
 
 
@@ -113,28 +126,78 @@ def render_run_plots(run_dir: Path, split: bool = False) -> list[Path]:
         return []
     corr = _read_csv(run_dir / "corrections.csv")
     paths = [run_dir / "plots" / name for name in PLOTS]
+    name = output_name(run_dir.name)  # a replay draws in its staging folder
 
     def draw_drift(_: str) -> None:
-        write_bytes(paths[1], _drift_figure(kp, corr))
+        write_bytes(paths[1], _png(drift_figure(kp, corr, name)))
 
     with ForkedTask(draw_drift, fork=split) as drift:
         drift.start()
-        write_bytes(paths[0], _temperature_figure(kp))
+        write_bytes(paths[0], _png(temperature_figure(kp, corr, name)))
         drift.join()
     return paths
 
 
-def _temperature_figure(kp: _Columns) -> bytes:
-    """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11)."""
+def speed_segments(corr: _Columns) -> list[Stretch]:
+    """The speeds the twin ran (corrections.csv: one per window, the first method's rows;
+    window k from 60 k s) as stretches of one speed, in time order; [] without them."""
+    if not corr:
+        return []
+    first = np.array(corr["method"]) == corr["method"][0]
+    start = corr.numbers("window")[first] * WINDOW_S
+    if "speed_rpm" not in corr:
+        return []
+    ends = start[np.isfinite(start)]
+    return speed_stretches(start, corr.numbers("speed_rpm")[first],
+                           float(ends.max()) + WINDOW_S if ends.size else 0.0)
+
+
+MAX_SPEEDS_LISTED = 8
+"""Speed stretches `speed_profile` lists one by one; more are summarised."""
+
+
+def speed_profile(segments: list[Stretch]) -> str:
+    """The run's speeds in words: "8000 → 12000 → stop → 6000 rpm" (the twin's window
+    speeds), or a summary for a run of many speed changes; "" without segments."""
+    if not segments:
+        return ""
+    if len(segments) <= MAX_SPEEDS_LISTED:
+        return " → ".join("stop" if rpm == 0 else f"{rpm:.0f}" for _, _, rpm in segments) + (
+            " rpm" if any(rpm for _, _, rpm in segments) else "")
+    running = [rpm for _, _, rpm in segments if rpm > 0]
+    stops = sum(1 for _, _, rpm in segments if rpm == 0)
+    span = f"{min(running):.0f}–{max(running):.0f} rpm" if running else "stopped"
+    return (f"{span} in {len(segments)} stretches"
+            + (f", {stops} stop{'s' if stops > 1 else ''}" if stops else ""))
+
+
+def _speed_note(segments: list[Stretch]) -> str:
+    if not segments:
+        return ""
+    marks = []
+    if any(rpm == 0 for _, _, rpm in segments):
+        marks.append("grey: stopped")
+    if 1 < len(segments) <= MAX_SPEED_CHANGES_MARKED + 1:
+        marks.append("dotted: speed change")
+    return (f"speed per 60 s window {speed_profile(segments)}"
+            + (f" ({', '.join(marks)})" if marks else ""))
+
+
+def temperature_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
+    """T1..T5 measured and per method over time, one panel per sensor (the paper's Fig. 11),
+    the stops shaded and the speed changes marked."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = kp.numbers("time_s") / 60.0
-    fig = new_figure(figsize=(17, 3.2))
+    segments = speed_segments(corr)
+    fig = new_figure(figsize=(17, 3.6))
     axes = fig.subplots(1, 5, sharex=True)
     for i, s in enumerate(SENSOR_NAMES):
         ax = axes[i]
+        mark_speeds(ax, segments, 60.0)
         first = method_col == methods[0]
-        ax.plot(t_min[first], kp.numbers(f"{s}_meas_C")[first], "k.", ms=2, label="measured")
+        measured = kp.numbers(f"{s}_meas_C")[first]
+        ax.plot(t_min[first], measured, "k.", ms=2, label="measured")
         for m in methods:
             sel = method_col == m
             ax.plot(
@@ -145,46 +208,79 @@ def _temperature_figure(kp: _Columns) -> bytes:
                 label=m,
             )
             _shade_band(ax, kp, sel, t_min, f"{s}_twin_lo_C", f"{s}_twin_hi_C", m)
-        ax.set_title(s, y=1.0)
+        ax.set_title(f"{s}: {SENSOR_LOCATIONS[s]}", y=1.0, fontsize=10)
+        if not np.isfinite(measured).any():  # a stuck or dead channel: left out
+            ax.text(0.5, 0.04, "no valid measurement\n(excluded, see data quality)",
+                    transform=ax.transAxes, ha="center", va="bottom", fontsize=8,
+                    color="#b00")
         ax.set_xlabel("time [min]")
         ax.grid(alpha=0.3)
         # four intervals suit a panel 3.4 in wide, and halve the ticks matplotlib builds
         # and draws (a quarter of the figure's cost, which ends a replay's critical path)
         ax.locator_params(axis="y", nbins=4)
     axes[0].set_ylabel("temperature [°C]")
-    axes[0].legend(fontsize=7)
-    return _png(fig)
+    _legend_row(fig, axes[0])
+    note = _speed_note(segments)
+    fig.suptitle(f"{run}: T1–T5 measured and twin" + (f"; {note}" if note else ""),
+                 fontsize=11, y=0.985)
+    _layout(fig, top=TOP_UNDER_LEGEND)
+    return fig
 
 
-def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
-    """The axial nose drift measured and per method, and the correction factors per window."""
+TOP_UNDER_LEGEND = 0.76
+"""The axes' top (figure fraction) under the title and the legend row."""
+
+
+def _legend_row(fig: Figure, ax: Axes) -> None:
+    """The measured points, the methods and the band as one row under the figure's title:
+    inside a panel the legend covered curves whichever corner it took."""
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.925),
+               ncol=max(len(labels), 1), fontsize=8, frameon=False, markerscale=2)
+
+
+FACTOR_NAMES = {"C_H_front": "bearing heat front", "C_H_rear": "bearing heat rear",
+                "C_C_front": "contact resistance front", "C_C_rear": "contact resistance rear"}
+"""corrections.csv's factor columns in words, for the legend."""
+
+
+def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
+    """The axial nose drift measured and per method, and the correction factors per window,
+    both over the run's time with the stops shaded and the speed changes marked."""
     methods = list(dict.fromkeys(kp["method"]))
     method_col = np.array(kp["method"])
     t_min = kp.numbers("time_s") / 60.0
-    fig = new_figure(figsize=(13, 3.2))
-    ax1, ax2 = fig.subplots(1, 2)
+    segments = speed_segments(corr)
+    fig = new_figure(figsize=(13, 3.6))
+    ax1, ax2 = fig.subplots(1, 2, sharex=True)
+    mark_speeds(ax1, segments, 60.0)
+    mark_speeds(ax2, segments, 60.0)
     first = method_col == methods[0]
     meas = kp.numbers("disp_z_meas_um")[first]
     if np.isfinite(meas).any():
         ax1.plot(t_min[first], meas, "k.", ms=2, label="measured")
+    else:
+        ax1.text(0.5, 0.04, "no drift measurement in the run", transform=ax1.transAxes,
+                 ha="center", va="bottom", fontsize=8, color="#b00")
     for m in methods:
         sel = method_col == m
         ax1.plot(
             t_min[sel], kp.numbers("disp_z_twin_um")[sel], color=METHOD_COLORS.get(m), label=m
         )
         _shade_band(ax1, kp, sel, t_min, "disp_z_twin_lo_um", "disp_z_twin_hi_um", m)
-    ax1.set_title("axial nose drift", y=1.0)
+    ax1.set_title("axial thermal drift of the spindle nose", y=1.0, fontsize=10)
     ax1.set_xlabel("time [min]")
     ax1.set_ylabel("drift [µm]")
     ax1.grid(alpha=0.3)
-    ax1.legend(fontsize=7)
+    _legend_row(fig, ax1)
     if corr:
         cm = np.array(corr["method"])
         for m in methods:
             sel = cm == m
             if m == "open_loop":
                 continue
-            w = corr.numbers("window")[sel]
+            # a window's factor holds from its start for the window: drawn as steps
+            w_min = corr.numbers("window")[sel] * (WINDOW_S / 60.0)
             for key, style in (
                 ("C_H_front", "-"),
                 ("C_H_rear", "--"),
@@ -192,18 +288,30 @@ def _drift_figure(kp: _Columns, corr: _Columns) -> bytes:
                 ("C_C_rear", "-."),
             ):
                 ax2.plot(
-                    w,
+                    w_min,
                     _running_factor(corr, key, sel),
                     style,
+                    drawstyle="steps-post",
                     color=METHOD_COLORS.get(m),
-                    label=f"{m} {key}",
+                    label=f"{m}: {FACTOR_NAMES[key]}",
                 )
-    ax2.set_title("correction factors per window", y=1.0)
-    ax2.set_xlabel("window")
+    ax2.set_title("correction factors per 60 s window (1 = nominal model)", y=1.0,
+                  fontsize=10)
+    ax2.set_xlabel("time [min] (window start)")
+    ax2.set_ylabel("factor [–]")
     ax2.grid(alpha=0.3)
-    if ax2.get_lines():  # open loop alone has no factors to show
-        ax2.legend(fontsize=6, ncol=2)
-    return _png(fig)
+    if ax2.get_legend_handles_labels()[0]:  # (the speed marks are lines without a label)
+        # beside the axes: inside, its twelve entries hid the factors' spikes
+        ax2.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                   borderaxespad=0.0)
+    else:  # open loop alone has no factors to show
+        ax2.text(0.5, 0.5, "no correction (open loop only)", transform=ax2.transAxes,
+                 ha="center", va="center", fontsize=9, color="0.4")
+    note = _speed_note(segments)
+    fig.suptitle(f"{run}: nose drift and corrections" + (f"; {note}" if note else ""),
+                 fontsize=11, y=0.985)
+    _layout(fig, top=TOP_UNDER_LEGEND, right=0.8)
+    return fig
 
 
 def _running_factor(corr: _Columns, key: str, sel: np.ndarray) -> np.ndarray:
@@ -230,8 +338,13 @@ def run_plotter(fork: bool = True) -> ForkedTask:
     return ForkedTask(draw, prepare=load_matplotlib, fork=fork)
 
 
+PLOT_ALTS = {"temperatures.png": "T1–T5 measured and twin over time, per method",
+             "drift_corrections.png": "axial nose drift measured and twin, and the "
+                                      "correction factors per window"}
+
+
 def _image(png: Path) -> dict[str, str]:
-    return {"alt": png.stem, "src": png_data_uri(png.read_bytes())}
+    return {"alt": PLOT_ALTS.get(png.name, png.stem), "src": png_data_uri(png.read_bytes())}
 
 
 def _plots(run_dir: Path) -> list[dict[str, str]]:
@@ -240,6 +353,33 @@ def _plots(run_dir: Path) -> list[dict[str, str]]:
     if not all(p.is_file() for p in paths):
         paths = render_run_plots(run_dir)
     return [_image(p) for p in paths]
+
+
+RUN_FILES = (
+    ("keypoints.csv", "T1–T5 and drift per step"),
+    ("corrections.csv", "corrections per window"),
+    ("accuracy.json", "accuracy"),
+    ("quality.json", "data quality"),
+    ("fields.pvd", "fields (ParaView)"),
+    ("decks", "window decks"),
+)
+"""A run folder's files the page links to, where they exist, with what they hold."""
+
+
+def _run_links(run_dir: Path) -> list[dict[str, str]]:
+    """Links (relative to the page, beside the run folder) to the run's files that exist: the page
+    is one file, the numbers and fields stay beside it."""
+    return [{"href": quote(f"{run_dir.name}/{name}"), "text": name, "title": what}
+            for name, what in RUN_FILES if (run_dir / name).exists()]
+
+
+def _snapshot_caption(png: Path) -> str:
+    """What a snapshot file `<method>_t<seconds>s.png` shows, in words."""
+    method, sep, rest = png.stem.rpartition("_t")
+    if sep and rest.endswith("s") and rest[:-1].isdigit():
+        t = int(rest[:-1])
+        return f"temperature field of {method} at t = {t} s ({t / 60:.1f} min)"
+    return png.name
 
 
 DISTRIBUTION_MIN_RUNS = 5
@@ -268,6 +408,7 @@ def distribution_plot(runs: list[dict], methods: list[str]) -> bytes:
         ax.set_xticks(range(len(methods)), methods)
         ax.set_title(METRIC_LABELS[key], fontsize=10)
         ax.grid(axis="y", alpha=0.3)
+    _layout(fig)
     return _png(fig)
 
 
@@ -392,22 +533,31 @@ def _page(out_root: Path, summary: dict) -> str:
         if run_dir is None:  # a name, never a path: nothing is read or drawn outside DIR
             continue
         snapshots = sorted(p for p in (run_dir / "snapshots").glob("*.png") if p.is_file())[-2:]
+        # the speeds the twin ran, in words: the mean alone hid the steps and stops
+        profile = (speed_profile(speed_segments(_read_csv(run_dir / "corrections.csv")))
+                   if (run_dir / "corrections.csv").is_file() else "")
         page_runs.append({
             "name": r["run"],
+            "anchor": f"run-{len(page_runs) + 1}",
             # accuracy.json's speed and ambient are the run's means (of a run with speed
             # steps or a stop too): said so
             "caption": f"mean {r['speed_rpm']:.0f} rpm, mean ambient {r['ambient_C']:.2f} °C, "
-                       f"{r['duration_s'] / 60:.1f} min",
+                       f"{r['duration_s'] / 60:.1f} min"
+                       + (f"; speed {profile}" if profile else ""),
             "plots": _plots(run_dir) if (run_dir / "keypoints.csv").is_file() else [],
             "findings": _findings(run_dir),
-            "snapshots": [{"alt": p.name, "src": png_data_uri(p.read_bytes())}
-                          for p in snapshots],
+            "links": _run_links(run_dir),
+            "snapshots": [{"alt": _snapshot_caption(p), "caption": _snapshot_caption(p),
+                           "src": png_data_uri(p.read_bytes())} for p in snapshots],
         })
+    anchors = {pr["name"]: pr["anchor"] for pr in page_runs}
     return render_page(
         "replay_report.html.j2",
         step_s=STEP_S, window_s=WINDOW_S, methods=methods,
-        rows=[[r["run"], f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
-               *(c for m in methods for c in _accuracy_cells(r["methods"].get(m, {})))]
+        rows=[{"name": r["run"], "anchor": anchors.get(r["run"]),
+               "cells": [f"{r['speed_rpm']:.0f}", f"{r['ambient_C']:.2f}",
+                         *(c for m in methods
+                           for c in _accuracy_cells(r["methods"].get(m, {})))]}
               for r in runs],
         average=["", "", *(c for m in methods for c in _accuracy_cells(mean.get(m, {})))],
         failed=[{"run": f.get("run", "?"), "error": f.get("error", "")}

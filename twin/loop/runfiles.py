@@ -243,7 +243,7 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     _write_corrections(out_dir / "corrections.csv", results)
     plots.start(str(out_dir))
     if snapshots != "none":
-        _write_snapshots(out_dir, model, results[primary], snapshots, title=run.name)
+        _write_snapshots(out_dir, model, results[primary], snapshots, run)
     write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods)]),
                   out_dir / "quality.json")
     for name, r in results.items():
@@ -280,12 +280,13 @@ def _window_ends(fields: dict[float, np.ndarray], choice: str) -> list[float]:
 
 
 def _write_snapshots(out_dir: Path, model: SpindleModel, r: MethodReplay, snapshots: str,
-                     title: str) -> None:
-    from twin.loop.snapshot import render_snapshot
+                     run: RecordedRun) -> None:
+    from twin.loop.snapshot import render_snapshot, snapshot_title
 
     for t in _window_ends(r.fields, snapshots):
         render_snapshot(model, r.fields[t], out_dir / _snapshot_name(r.method, t),
-                        title=f"{title} · {r.method} · t = {t:.0f} s", T_initial_C=r.T_initial_C)
+                        title=snapshot_title(run.name, r.method, t, run),
+                        T_initial_C=r.T_initial_C)
 
 
 def _snapshot_name(method: str, t: float) -> str:
@@ -305,7 +306,7 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     end` or `none`) or damaged (the caller replays the run)."""
     from twin.io.vtk import read_vtu
     from twin.loop.replay import initial_temperature_C, windows_in
-    from twin.loop.snapshot import render_snapshot
+    from twin.loop.snapshot import render_snapshot, snapshot_title
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
 
@@ -325,7 +326,7 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
         if T is None or np.shape(T) != (model.n_dofs,) or not np.all(np.isfinite(T)):
             raise InputError("no temperature_C array of the spindle's vertices", file=str(path))
         render_snapshot(model, np.asarray(T, float), out_dir / _snapshot_name(primary, t),
-                        title=f"{run_name(run_path)} · {primary} · t = {t:.0f} s",
+                        title=snapshot_title(run_name(run_path), primary, t, run),
                         T_initial_C=initial_temperature_C(run))
     return len(wanted)
 

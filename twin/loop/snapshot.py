@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
+    from twin.runs.run import RecordedRun
     from twin.spindle.model import SpindleModel
 
 FIELDS = {
@@ -28,6 +29,17 @@ FIELDS = {
     # "|u|" came out of VTK's title font as a raised "u": the word says it
     "displacement": ("displacement_um", "Displacement magnitude [µm]", "viridis"),
 }
+
+
+def snapshot_title(name: str, method: str, t: float, run: RecordedRun) -> str:
+    """A snapshot's first line: the run, the method, the time in s and min, and the speed
+    recorded then ("stopped" at 0 rpm): a picture taken in a stop looked like one at speed."""
+    title = f"{name} · {method} · t = {t:.0f} s ({t / 60:.1f} min)"
+    k = int(np.searchsorted(run.time_s, t, side="right")) - 1
+    rpm = float(run.speed_rpm[max(k, 0)]) if run.speed_rpm.size else float("nan")
+    if not np.isfinite(rpm):
+        return title
+    return f"{title} · " + ("stopped (0 rpm)" if rpm == 0 else f"{rpm:.0f} rpm")
 
 
 def render_snapshot(
@@ -135,12 +147,31 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
         shape_opacity=0.6,
         always_visible=True,
     )
+    nose = _nose_vertex(model)
+    plotter.add_point_labels(
+        [points[nose]], ["nose"], point_size=10, font_size=14, point_color="black",
+        text_color="black", shape_opacity=0.6, always_visible=True,
+    )
     lines = [title] if title else []
     lines.append(f"hottest {t_max:.1f} °C at r = {hot_xyz[0]:.0f} mm, z = {hot_xyz[2]:.0f} mm")
     lines.append(f"nose drift (axial) {drift_z:+.2f} µm")
+    if field == "displacement":  # the colours are the drift; the shape is not deformed
+        since = "" if T_initial_C is None else f" at {T_initial_C:.1f} °C"
+        lines.append(f"shape undeformed; colour: thermal displacement since the uniform "
+                     f"start{since}")
     plotter.add_text("\n".join(lines), position="upper_left", font_size=11, color="black")
     if section:
         plotter.view_xz()
+        # the flat section gets its r and z scales (mm, round ticks), the 3-D view its nose
+        # marker only; zoomed out so the text lines above do not cover the nose
+        r_top, r_labels = nice_axis(float(points[:, 0].max()))
+        z_top, z_labels = nice_axis(float(points[:, 2].max()))
+        plotter.show_bounds(bounds=[0.0, r_top, 0.0, 0.0, 0.0, z_top], xtitle="r [mm]",
+                            ytitle="", ztitle="z [mm]", n_xlabels=r_labels,
+                            n_zlabels=z_labels, fmt="%.0f", color="black", font_size=12,
+                            location="outer", ticks="outside", show_yaxis=False,
+                            show_ylabels=False)
+        plotter.camera.zoom(0.8)
     else:
         # look into the removed quadrant (x > 0, y < 0), so both cut faces show
         cx, cy, cz = body.center
@@ -163,6 +194,19 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
     finally:
         plotter.close()
     return Path(out_png)
+
+
+def nice_axis(high: float, intervals: int = 5) -> tuple[float, int]:
+    """An axis from 0 to `high` rounded up to round ticks (a step of 1, 2 or 5 × 10^n,
+    about `intervals` of them): (the axis end, how many labels).  The section's r axis
+    read 0, 38.8, 77.5, 116.2, 155."""
+    if not high > 0:
+        return 1.0, 2
+    raw = high / intervals
+    power = 10.0 ** np.floor(np.log10(raw))
+    step = next(m * power for m in (1.0, 2.0, 5.0, 10.0) if m * power >= raw * (1 - 1e-9))
+    steps = int(np.ceil(high / step - 1e-9))
+    return float(steps * step), steps + 1
 
 
 def field_marker(field: str, values: np.ndarray) -> tuple[int, str]:

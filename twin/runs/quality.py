@@ -124,6 +124,12 @@ def _unit_floor(name: str, celsius: float, micron: float) -> float:
     return micron if name.endswith("_um") else celsius
 
 
+def _unit_of_change(name: str) -> str:
+    """The unit of a difference of the column's values, for a finding's detail: a spike's
+    threshold read "deviation above 0.5" with no unit (K or µm, or rpm)."""
+    return "µm" if name.endswith("_um") else "rpm" if name.endswith("_rpm") else "K"
+
+
 def drop_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
     """Drop rows that repeat an earlier row exactly (every column, time included).
 
@@ -213,7 +219,8 @@ def remove_spikes(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     return out, [finding(name, "spike", "replaced by the running median of "
                          f"{2 * cfg.spike_half_window + 1} samples", rows=rows[idx],
                          spans_s=spans, count=int(idx.size),
-                         detail=f"deviation above {threshold:.3g} from the running median")]
+                         detail=f"deviation above {threshold:.3g} {_unit_of_change(name)} "
+                                "from the running median")]
 
 
 def _jumps_away_and_back(ok: np.ndarray, t: np.ndarray, v: np.ndarray,
