@@ -286,6 +286,7 @@ from twin.correction.features import (
     WindowFeatures,
     bin_mean,
     min_bin_samples,
+    rows_between,
 )
 from twin.correction.rerun import (
     first_window_at_speed,
@@ -675,7 +676,7 @@ class EnsembleEstimator:
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
         meas = np.asarray(f.measured_C, float)
-        in_read = (t_meas > read_t[0] - cfg.step_s + 1e-9) & (t_meas <= read_t[-1] + 1e-9)
+        in_read = rows_between(t_meas, read_t[0] - cfg.step_s + 1e-9, read_t[-1] + 1e-9)
         needed = min_bin_samples(t_meas[in_read], cfg.window_s)
         y_mean, y_anom, observed, sd = [], [], [], []
         for i, b in enumerate(bins):
@@ -844,8 +845,8 @@ class EnsembleEstimator:
         cfg = self.config
         fc = self._forecast
         t = np.asarray(f.measured_time_s, float)
-        rows = t > f.start_s - cfg.window_s + 1e-9
-        if not rows.any():
+        rows = rows_between(t, f.start_s - cfg.window_s + 1e-9, np.inf)
+        if rows.start == rows.stop:
             return
         sim_t = np.asarray(f.simulated_time_s, float)[-cfg.steps_per_window - 1:]
         sim_C = np.asarray(f.simulated_C, float)[-cfg.steps_per_window - 1:]
