@@ -114,3 +114,56 @@ def test_speed_change_is_found_by_bisection() -> None:
     assert change(np.where(t >= 180.0, 12000.0, 9000.0)) is None  # on the window's end
     assert change(np.where(t <= 120.0, 12000.0, 9000.0)) is None  # before the window
     assert change(np.where(t == 121.0, 0.0, 9000.0)) == 121.0  # its first sample
+
+
+def _dead_ring_features(sim_gap: bool) -> WindowFeatures:
+    """Window 240 of a 4-h history at 1 Hz: the front ring (T1) dead throughout, its sleeve
+    (T2) valid from 900 s on; the twin's history 4 s apart, with a gap (NaN) at the
+    sleeve's first valid sample where `sim_gap`."""
+    rng = np.random.default_rng(5)
+    t = np.arange(0.0, 14400.5, 1.0)
+    T = 30.0 + 8.0 * (1 - np.exp(-t / 3000.0))[:, None] + rng.normal(0, 0.05, (t.size, 5))
+    T[:, 0] = np.nan
+    T[t < 900.0, 1] = np.nan
+    sim_t = np.arange(0.0, 14400.5, 4.0)
+    sim = 30.0 + 7.5 * (1 - np.exp(-sim_t / 2800.0))[:, None] + np.array([3, 1, 2.5, 1, 0])
+    if sim_gap:
+        sim[225, 0] = np.nan  # 900 s
+    nominal = BoundaryValues(1e6, 1e6, 1e-4, 1e-4)
+    return WindowFeatures(240, 14400.0, 9000.0, 25.0, t, T, sim_t, sim, nominal, nominal,
+                          previous_factors=(1.1, 1.0, 1.0, 1.0))
+
+
+def _whole_stand_in(f: WindowFeatures) -> WindowFeatures:
+    """The stand-in over the whole history, as until 2026-11-27."""
+    measured = f.measured_C.copy()
+    now = f.simulated_now()
+    ring_rise = now[0] - f.ambient_C
+    divisor = max(now[1] - f.ambient_C, 0.5 * ring_rise)
+    twin_ring, twin_sleeve = (np.interp(f.measured_time_s, f.simulated_time_s,
+                                        f.simulated_C[:, c]) for c in (0, 1))
+    measured[:, 0] = twin_ring + ring_rise / divisor * (measured[:, 1] - twin_sleeve)
+    return WindowFeatures(**{**f.__dict__, "measured_C": measured})
+
+
+@pytest.mark.parametrize("sim_gap", [False, True])
+def test_a_dead_ring_stand_in_reads_as_the_whole_columns(sim_gap: bool) -> None:
+    """Written over the window just ended and at the sleeve's first valid sample only, the
+    stand-in gives the ratio law (bpnn's anchor) every value the whole column gave: the
+    initial value, the last one, the window's line; with a gap in the twin's history there,
+    the whole column is written."""
+    from twin.correction.methods import ANCHOR_LAW, ratio_anchor
+
+    f = _dead_ring_features(sim_gap)
+    assert f.dead_rings() == ("front",)
+    read, whole = f.with_dead_rings_read_through_sleeves(), _whole_stand_in(f)
+    assert np.isnan(read.measured_C[1000:13000, 0]).all() != sim_gap
+    for name in ("measured_initial", "measured_now"):
+        assert np.array_equal(getattr(read, name)(), getattr(whole, name)(), equal_nan=True)
+    for a, b in zip(window_line_fit(read.measured_time_s, read.measured_C, 14400.0),
+                    window_line_fit(whole.measured_time_s, whole.measured_C, 14400.0),
+                    strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    assert ANCHOR_LAW.correct(read).values == ANCHOR_LAW.correct(whole).values
+    # the anchor itself moved the front heat: the stand-in was read, not held
+    assert ratio_anchor(f, np.array([1.1, 1.0, 1.0, 1.0]))[0] != pytest.approx(1.1e6)

@@ -287,9 +287,11 @@ class WindowFeatures:
         cooling jacket holds the sleeve near the coolant (the front sleeve, 0.2 of its
         ring's there, at or below ambient with a cold coolant).  The step has the sign of
         the sleeve's error on either side of ambient.  No stand-in (NaN: the heat is held)
-        where the twin's ring is not over ambient.  The simulated columns are left as they
-        are.  The stand-in's drop says nothing about the contact: the anchor holds a dead
-        ring's resistance (`twin.correction.methods.ratio_anchor`).
+        where the twin's ring is not over ambient.  The stand-in is written over the window
+        just ended and at the sleeve's first valid sample, what the ratio law reads (NaN
+        between).  The simulated columns are left as they are.  The stand-in's drop says
+        nothing about the contact: the anchor holds a dead ring's resistance
+        (`twin.correction.methods.ratio_anchor`).
 
         Why not the sleeve itself in Eq. 2, (t_m,sleeve − t_amb)/(t_f,sleeve − t_amb), as
         until 2026-11-27: a sleeve whose rise over ambient is not the bearing's turns the
@@ -315,18 +317,35 @@ class WindowFeatures:
         measured = self.measured_C.copy()
         twin_now = (self.simulated_now() if len(self.simulated_time_s)
                     else np.full(measured.shape[1], np.nan))
+        time = np.asarray(self.measured_time_s, dtype=float)
+        recent = rows_between(time, self.start_s - self.window_s - 1e-9, np.inf).start
         for bearing in dead:
             ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
             ring_rise = twin_now[ring] - self.ambient_C
+            measured[:, ring] = np.nan
             if not ring_rise > 0.0:  # no twin yet, or no rise to scale a heat error by
-                measured[:, ring] = np.nan
                 continue
             divisor = max(twin_now[sleeve] - self.ambient_C, SLEEVE_RISE_SHARE * ring_rise)
-            twin_ring, twin_sleeve = (
-                np.interp(self.measured_time_s, self.simulated_time_s, self.simulated_C[:, c])
-                for c in (ring, sleeve))
-            measured[:, ring] = twin_ring + ring_rise / divisor * (measured[:, sleeve]
-                                                                   - twin_sleeve)
+
+            def stand_in(rows: np.ndarray, ring: int = ring, sleeve: int = sleeve,
+                         scale: float = ring_rise / divisor) -> bool:
+                """Write the stand-in at `rows`; whether it is finite wherever the
+                sleeve is."""
+                twin_ring, twin_sleeve = (
+                    np.interp(time[rows], self.simulated_time_s, self.simulated_C[:, c])
+                    for c in (ring, sleeve))
+                sleeve_C = measured[rows, sleeve]
+                measured[rows, ring] = twin_ring + scale * (sleeve_C - twin_sleeve)
+                return bool(np.isfinite(measured[rows, ring])[np.isfinite(sleeve_C)].all())
+
+            # written where it is read: over the window just ended (its line, its bins,
+            # its last value) and at the sleeve's first valid sample (the run's initial
+            # value); the rows between stay NaN.  The whole column, as until 2026-11-27,
+            # cost a 24-h run's last windows 86 400 rows each.  Where the twin's history
+            # has a gap (NaN) there, the whole column, so every reader gets the same.
+            first = _finite_rows(measured[:recent, [sleeve]], last=False)
+            if not stand_in(np.r_[first[first >= 0], recent:time.size]):
+                stand_in(np.arange(time.size))
         return dataclasses.replace(self, measured_C=measured)
 
     def anchored_inputs(self, anchor: ArrayLike) -> dict[str, np.ndarray]:
