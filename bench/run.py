@@ -24,6 +24,7 @@ MODULES = [
     "bench.loop",
     "bench.replay_cli",
     "bench.estimator",
+    "bench.long_run",
     "bench.drift",
 ]
 

@@ -287,9 +287,11 @@ class WindowFeatures:
         cooling jacket holds the sleeve near the coolant (the front sleeve, 0.2 of its
         ring's there, at or below ambient with a cold coolant).  The step has the sign of
         the sleeve's error on either side of ambient.  No stand-in (NaN: the heat is held)
-        where the twin's ring is not over ambient.  The simulated columns are left as they
-        are.  The stand-in's drop says nothing about the contact: the anchor holds a dead
-        ring's resistance (`twin.correction.methods.ratio_anchor`).
+        where the twin's ring is not over ambient.  The stand-in is written over the window
+        just ended and at the sleeve's first valid sample, what the ratio law reads (NaN
+        between).  The simulated columns are left as they are.  The stand-in's drop says
+        nothing about the contact: the anchor holds a dead ring's resistance
+        (`twin.correction.methods.ratio_anchor`).
 
         Why not the sleeve itself in Eq. 2, (t_m,sleeve − t_amb)/(t_f,sleeve − t_amb), as
         until 2026-11-27: a sleeve whose rise over ambient is not the bearing's turns the
@@ -315,18 +317,35 @@ class WindowFeatures:
         measured = self.measured_C.copy()
         twin_now = (self.simulated_now() if len(self.simulated_time_s)
                     else np.full(measured.shape[1], np.nan))
+        time = np.asarray(self.measured_time_s, dtype=float)
+        recent = rows_between(time, self.start_s - self.window_s - 1e-9, np.inf).start
         for bearing in dead:
             ring, sleeve = RING_SENSOR[bearing], SLEEVE_SENSOR[bearing]
             ring_rise = twin_now[ring] - self.ambient_C
+            measured[:, ring] = np.nan
             if not ring_rise > 0.0:  # no twin yet, or no rise to scale a heat error by
-                measured[:, ring] = np.nan
                 continue
             divisor = max(twin_now[sleeve] - self.ambient_C, SLEEVE_RISE_SHARE * ring_rise)
-            twin_ring, twin_sleeve = (
-                np.interp(self.measured_time_s, self.simulated_time_s, self.simulated_C[:, c])
-                for c in (ring, sleeve))
-            measured[:, ring] = twin_ring + ring_rise / divisor * (measured[:, sleeve]
-                                                                   - twin_sleeve)
+
+            def stand_in(rows: np.ndarray, ring: int = ring, sleeve: int = sleeve,
+                         scale: float = ring_rise / divisor) -> bool:
+                """Write the stand-in at `rows`; whether it is finite wherever the
+                sleeve is."""
+                twin_ring, twin_sleeve = (
+                    np.interp(time[rows], self.simulated_time_s, self.simulated_C[:, c])
+                    for c in (ring, sleeve))
+                sleeve_C = measured[rows, sleeve]
+                measured[rows, ring] = twin_ring + scale * (sleeve_C - twin_sleeve)
+                return bool(np.isfinite(measured[rows, ring])[np.isfinite(sleeve_C)].all())
+
+            # written where it is read: over the window just ended (its line, its bins,
+            # its last value) and at the sleeve's first valid sample (the run's initial
+            # value); the rows between stay NaN.  The whole column, as until 2026-11-27,
+            # cost a 24-h run's last windows 86 400 rows each.  Where the twin's history
+            # has a gap (NaN) there, the whole column, so every reader gets the same.
+            first = _finite_rows(measured[:recent, [sleeve]], last=False)
+            if not stand_in(np.r_[first[first >= 0], recent:time.size]):
+                stand_in(np.arange(time.size))
         return dataclasses.replace(self, measured_C=measured)
 
     def anchored_inputs(self, anchor: ArrayLike) -> dict[str, np.ndarray]:
@@ -394,27 +413,60 @@ def correction_factors(values: ArrayLike, nominal: ArrayLike,
 
 
 def last_at_or_before(time_s: ArrayLike, values: ArrayLike, t_s: float) -> np.ndarray:
-    """Per column, the last finite value sampled at or before t_s (NaN if there is none)."""
+    """Per column, the last finite value sampled at or before t_s (NaN if there is none);
+    `time_s` ascending (`rows_between`)."""
     time = np.asarray(time_s, dtype=float)
     vals = np.asarray(values, dtype=float).reshape(time.size, -1)
-    out = np.full(vals.shape[1], np.nan)
-    usable = time <= t_s + 1e-9
-    for j in range(vals.shape[1]):
-        idx = np.flatnonzero(usable & np.isfinite(vals[:, j]))
-        if idx.size:
-            out[j] = vals[idx[-1], j]
-    return out
+    usable = vals[rows_between(time, -np.inf, t_s + 1e-9)]
+    return _finite_at(usable, _finite_rows(usable, last=True))
 
 
 def first_finite(values: ArrayLike) -> np.ndarray:
     """Per column, the first finite value (NaN if there is none)."""
     vals = np.asarray(values, dtype=float)
+    return _finite_at(vals, _finite_rows(vals, last=False))
+
+
+def _finite_at(vals: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Per column j, vals[rows[j], j], NaN where rows[j] is −1."""
     out = np.full(vals.shape[1], np.nan)
-    for j in range(vals.shape[1]):
-        idx = np.flatnonzero(np.isfinite(vals[:, j]))
-        if idx.size:
-            out[j] = vals[idx[0], j]
+    found = rows >= 0
+    out[found] = vals[rows[found], np.flatnonzero(found)]
     return out
+
+
+def _finite_rows(vals: np.ndarray, last: bool) -> np.ndarray:
+    """Per column of `vals` (n, m), the row of its first (`last`: last) finite value, −1
+    where it has none.  The rows are read in blocks doubling from that end, so a column
+    valid near it costs a block, not the whole history: a loop window reads the last
+    value and the run's first, and a whole-history scan made each window's cost grow with
+    the run (a 24-h replay's last windows read 86 400 rows for each)."""
+    n, m = vals.shape
+    rows = np.full(m, -1)
+    todo = np.arange(m)
+    done, size = 0, 64
+    while todo.size and done < n:
+        upto = min(n, done + size)
+        block = vals[n - upto:n - done][::-1] if last else vals[done:upto]
+        finite = np.isfinite(block[:, todo])
+        found = finite.any(axis=0)
+        at = done + finite.argmax(axis=0)[found]
+        rows[todo[found]] = n - 1 - at if last else at
+        todo = todo[~found]
+        done, size = upto, 2 * size
+    return rows
+
+
+def rows_between(time_s: np.ndarray, after_s: float, upto_s: float,
+                 with_upto: bool = True) -> slice:
+    """The rows of `time_s` with after_s < t <= upto_s (`with_upto` False: < upto_s), for
+    times in ascending order (a run's, whose reader refuses time going back, and the
+    twin's steps): found by bisection, so a window reading its last 60 s costs the same in
+    a run's 24th hour as in its first.  A boolean mask over the whole history, as until
+    2026-11-27, made every window's reads grow with the run (the same rows, in the same
+    order)."""
+    return slice(int(np.searchsorted(time_s, after_s, side="right")),
+                 int(np.searchsorted(time_s, upto_s, side="right" if with_upto else "left")))
 
 
 OBSERVATION_BINS = 3
@@ -444,9 +496,9 @@ def min_bin_samples(time_s: ArrayLike, window_s: float = WINDOW_S) -> int:
 
 def bin_mean(time_s: np.ndarray, values: np.ndarray, lo_s: float,
              hi_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per column, the mean of the finite values sampled in (lo_s, hi_s] and their count."""
-    rows = (time_s > lo_s + 1e-9) & (time_s <= hi_s + 1e-9)
-    v = values[rows]
+    """Per column, the mean of the finite values sampled in (lo_s, hi_s] and their count
+    (`time_s` ascending: `rows_between`)."""
+    v = values[rows_between(time_s, lo_s + 1e-9, hi_s + 1e-9)]
     ok = np.isfinite(v)
     counts = ok.sum(axis=0)
     total = np.where(ok, v, 0.0).sum(axis=0)
@@ -457,7 +509,8 @@ def window_observed(time_s: ArrayLike, values: ArrayLike, end_s: float,
                     window_s: float = WINDOW_S) -> np.ndarray:
     """Per column, True where each of the `OBSERVATION_BINS` bins of (end_s − window_s,
     end_s] holds at least `min_bin_samples` valid (finite) samples: the estimator's rule
-    for an observation, over the whole window that `window_line_fit` reads.
+    for an observation, over the whole window that `window_line_fit` reads (`time_s`
+    ascending).
 
     Why the whole window: the ratio law reads a level at end_s and a rise over the window
     off a line through its samples.  With the last bins lost (a logger gap) that line
@@ -469,8 +522,8 @@ def window_observed(time_s: ArrayLike, values: ArrayLike, end_s: float,
     vals = np.asarray(values, dtype=float)
     vals = vals[:, None] if vals.ndim == 1 else vals
     edges = end_s - window_s + window_s * np.arange(OBSERVATION_BINS + 1) / OBSERVATION_BINS
-    rows = (time > edges[0] + 1e-9) & (time <= end_s + 1e-9)
-    needed = min_bin_samples(time[rows], window_s)
+    needed = min_bin_samples(time[rows_between(time, edges[0] + 1e-9, end_s + 1e-9)],
+                             window_s)
     observed = np.ones(vals.shape[1], dtype=bool)
     for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         observed &= bin_mean(time, vals, lo, hi)[1] >= needed
@@ -481,18 +534,19 @@ def window_line_fit(
     time_s: ArrayLike, values: ArrayLike, end_s: float, window_s: float = WINDOW_S
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per column, (level at end_s in °C, rise over the span in K) of a least-squares line
-    through the finite samples in (end_s − window_s, end_s].
+    through the finite samples in (end_s − window_s, end_s] (`time_s` ascending).
 
     Sensor noise averages out instead of entering a two-point difference at full size.
     A column with a single sample gives that sample as level and NaN rise; with none, NaN.
     """
     time = np.asarray(time_s, dtype=float)
     vals = np.asarray(values, dtype=float).reshape(time.size, -1)
-    in_span = (time > end_s - window_s - 1e-9) & (time <= end_s + 1e-9)
+    in_span = rows_between(time, end_s - window_s - 1e-9, end_s + 1e-9)
+    time, vals = time[in_span], vals[in_span]
     level = np.full(vals.shape[1], np.nan)
     rise = np.full(vals.shape[1], np.nan)
     for j in range(vals.shape[1]):
-        ok = in_span & np.isfinite(vals[:, j])
+        ok = np.isfinite(vals[:, j])
         t = time[ok]
         if t.size == 1:
             level[j] = vals[ok, j][0]

@@ -30,7 +30,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from twin.correction.features import WindowFeatures
+from twin.correction.features import WindowFeatures, rows_between
 
 LOAD_UPDATE_STEPS = 1
 """A re-run's nominal loads follow its own temperatures every solver step (4 s), as the
@@ -53,7 +53,7 @@ def speed_change_s(f: WindowFeatures, forecast_speed_rpm: float) -> float | None
     if f.measured_speed_rpm is None:
         return None
     t = np.asarray(f.measured_time_s, float)
-    rows = (t > f.start_s - f.window_s + 1e-9) & (t < f.start_s - 1e-9)
+    rows = rows_between(t, f.start_s - f.window_s + 1e-9, f.start_s - 1e-9, with_upto=False)
     moved = np.abs(np.asarray(f.measured_speed_rpm, float)[rows] - forecast_speed_rpm) > 0.5
     return float(t[rows][np.argmax(moved)]) if moved.any() else None
 

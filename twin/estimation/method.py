@@ -299,6 +299,7 @@ from twin.correction.features import (
     WindowFeatures,
     bin_mean,
     min_bin_samples,
+    rows_between,
 )
 from twin.correction.rerun import (
     first_window_at_speed,
@@ -688,7 +689,7 @@ class EnsembleEstimator:
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
         t_meas = np.asarray(f.measured_time_s, float)
         meas = np.asarray(f.measured_C, float)
-        in_read = (t_meas > read_t[0] - cfg.step_s + 1e-9) & (t_meas <= read_t[-1] + 1e-9)
+        in_read = rows_between(t_meas, read_t[0] - cfg.step_s + 1e-9, read_t[-1] + 1e-9)
         needed = min_bin_samples(t_meas[in_read], cfg.window_s)
         y_mean, y_anom, observed, sd = [], [], [], []
         for i, b in enumerate(bins):
@@ -860,8 +861,8 @@ class EnsembleEstimator:
         noise, twin within 0.05 K) cover 100 % and that of a rough one too little."""
         cfg = self.config
         t = np.asarray(f.measured_time_s, float)
-        rows = t > f.start_s - cfg.window_s + 1e-9
-        if not rows.any():
+        rows = rows_between(t, f.start_s - cfg.window_s + 1e-9, np.inf)
+        if rows.start == rows.stop:
             return
         tm = t[rows]
         steps = cfg.steps_per_window

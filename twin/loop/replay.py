@@ -387,6 +387,10 @@ def replay_method(
     time_s = STEP_S * np.arange(1, n_steps + 1)
     starts = WINDOW_S * np.arange(windows)
     state = run.before(starts)
+    # the samples measured by each window start: a prefix of the run (its times ascend),
+    # handed on as views; a boolean mask and its copies over the whole history, as until
+    # 2026-11-27, cost each window of a 24-h run up to 86 400 rows a column
+    measured_by = np.searchsorted(run.time_s, starts, side="right")
     sim_T = np.empty((n_steps + 1, 5))
     sim_T[0] = model.sensor_matrix @ T
     reported_T = np.empty((n_steps, 5))  # T1..T5 as reported: the metal or the readings
@@ -413,7 +417,7 @@ def replay_method(
         coolant = None if state.coolant_C is None else float(state.coolant_C[k])
         bc = conditions(speed, ambient, coolant, sim_T[k * STEPS_PER_WINDOW])
         nominal = BoundaryValues(bc.H_front, bc.H_rear, bc.R_front, bc.R_rear)
-        upto = run.time_s <= start
+        upto = slice(0, int(measured_by[k]))
         n_sim = k * STEPS_PER_WINDOW + 1
         features = WindowFeatures(
             window=k,
