@@ -496,3 +496,43 @@ def test_a_toml_file_that_cannot_be_read_names_its_option(tmp_path):
         assert result.exit_code == 2
         assert result.output == (f"error: {missing}, option {option!r}: cannot read file: "
                                  "No such file or directory\n")
+
+
+def test_an_ambient_or_coolant_a_table_overrides_is_told(tmp_path):
+    # `--ambient 30` with an [ambient] table from 24 °C emulated a run at 24 °C, and a
+    # profile's ambient_C column and a [coolant] table did the same to --ambient and
+    # --coolant: the required option was dropped without a word
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    scenario, profile = tmp_path / "s.toml", tmp_path / "p.csv"
+    scenario.write_text("[ambient]\ntime_s = [0, 120]\nambient_C = [24, 25]\n"
+                        "[coolant]\ntime_s = [0]\ninlet_C = [22]\n")
+    profile.write_text("time_s,speed_rpm,ambient_C\n0,6000,20\n")
+    runner = CliRunner()
+
+    def synth(*args: str) -> tuple[str, str]:
+        out = tmp_path / "run.csv"
+        result = runner.invoke(app, ["synth", "--minutes", "2", "--seed", "1", "--quiet",
+                                     "--out", str(out), *args])
+        assert result.exit_code == 0, result.output
+        metadata = dict(line[2:].split(": ", 1) for line in out.read_text().splitlines()
+                        if line.startswith("# "))
+        return result.output, metadata["ambient_C"]
+
+    told, emulated = synth("--speed", "6000", "--scenario", str(scenario),
+                           "--ambient", "30", "--coolant", "26")
+    assert emulated == "24"  # the table wins, as DESIGN.md says: and the user hears of it
+    assert told == (f"warning: --ambient 30 is not used: {scenario}'s [ambient] sets it "
+                    "(24 °C at 0 s)\n"
+                    f"warning: --coolant 26 is not used: {scenario}'s [coolant] sets it "
+                    "(22 °C at 0 s)\n")
+    told, emulated = synth("--profile", str(profile), "--ambient", "35")
+    assert emulated == "20"
+    assert told == (f"warning: --ambient 35 is not used: {profile}'s ambient_C column sets "
+                    "it (20 °C at 0 s)\n")
+    # the same value as the table (a suite's reproducing command) is nothing to tell
+    assert synth("--speed", "6000", "--scenario", str(scenario), "--ambient", "24",
+                 "--coolant", "22") == ("", "24")
+    assert synth("--profile", str(profile), "--ambient", "20") == ("", "20")

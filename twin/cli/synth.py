@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError, TomlError
+
+if TYPE_CHECKING:
+    from twin.plant.profile import SpeedProfile
+    from twin.plant.scenario import Scenario
 
 SYNTH_HELP = """Emulate a recorded run: the truth model plus sensor lag, noise and faults.
 
@@ -48,7 +54,9 @@ def synth(
                                          help="Run length, minutes (two 60 s windows at "
                                          "least; --suite: default 40)."),
     ambient: float | None = typer.Option(None, "--ambient", help="Ambient temperature at the "
-                                         f"start, °C ({RANGE_C}; not with --suite)."),
+                                         f"start, °C ({RANGE_C}; not with --suite; a "
+                                         "scenario's [ambient] or the profile's ambient_C "
+                                         "overrides it, with a warning)."),
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C]) from 0 s, each "
@@ -62,7 +70,9 @@ def synth(
     rate: float = typer.Option(1.0, "--rate", min=0.1, max=10.0, help="Sample rate, Hz."),
     coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
                                          f"at the start, °C ({RANGE_C}; default: the "
-                                         "ambient, as the nominal model assumes)."),
+                                         "ambient, as the nominal model assumes; a "
+                                         "scenario's [coolant] overrides it, with a "
+                                         "warning)."),
     overwrite: bool = typer.Option(False, "--overwrite", help="With --suite: remove the "
                                    "runs already in the --out folder that this suite does "
                                    "not write (without it they are an error)."),
@@ -110,6 +120,11 @@ def synth(
         # the scenario's table won and the profile's column was read for nothing
         raise TomlError(f"[ambient] and the profile's ambient_C column ({profile}) both give "
                         "the ambient: keep one of them", file=str(scenario), key="ambient")
+    for warning in _overridden_options(ambient, coolant, truth, speed_profile,
+                                       scenario, profile):
+        # shown under --quiet too, as the ignored profile columns are: the run is emulated
+        # at another temperature than the command line says
+        typer.echo(f"warning: {warning}", err=True)
     run = synthesize(
         speed_rpm=speed, profile=speed_profile,
         minutes=minutes, ambient_C=ambient, seed=seed, scenario=truth, rate_hz=rate,
@@ -132,6 +147,32 @@ def synth(
 
 
 synth.__doc__ = SYNTH_HELP
+
+
+def _overridden_options(ambient: float | None, coolant: float | None, truth: Scenario,
+                        speed_profile: SpeedProfile | None, scenario: Path | None,
+                        profile: Path | None) -> list[str]:
+    """What to tell where `--ambient` or `--coolant` differs from the value a scenario table
+    or the profile's ambient_C column gives at 0 s: those override the option (DESIGN.md),
+    and the required --ambient was else dropped without a word (`--ambient 30` with an
+    [ambient] table from 24 °C emulated a run at 24 °C)."""
+    import numpy as np
+
+    given: list[tuple[str, float | None, float | None, str]] = []
+    if truth.ambient is not None:
+        given.append(("--ambient", ambient,
+                      float(np.interp(0.0, truth.ambient.time_s, truth.ambient.ambient_C)),
+                      f"{scenario}'s [ambient]"))
+    elif speed_profile is not None and speed_profile.ambient_C is not None:
+        given.append(("--ambient", ambient, float(speed_profile.ambient_C(0.0)),
+                      f"{profile}'s ambient_C column"))
+    if truth.coolant is not None:
+        given.append(("--coolant", coolant,
+                      float(np.interp(0.0, truth.coolant.time_s, truth.coolant.inlet_C)),
+                      f"{scenario}'s [coolant]"))
+    return [f"{option} {value:g} is not used: {source} sets it ({table:g} °C at 0 s)"
+            for option, value, table, source in given
+            if value is not None and not math.isclose(value, table, abs_tol=1e-6)]
 
 
 def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
