@@ -409,3 +409,25 @@ def test_a_spreadsheets_trailing_separators_are_read_past(tmp_path):
     inner = lines[0].replace("speed_rpm,", "speed_rpm,,")
     expect_error(write(tmp_path, "\n".join([inner] + lines[1:]) + "\n"), 1, None,
                  "header field 3 is empty")
+
+
+def test_a_spreadsheets_rows_of_separators_are_read_past(tmp_path):
+    """Excel writes ",,,,,," for the empty rows of its used range below (or between) the
+    data; the run was refused ("line 903, column 'time_s': time is missing") though such a
+    row holds no value.  A row with a value in it is still read, and still refused."""
+    clean = csv_text(warmup())
+    lines = clean.splitlines()
+    width = lines[0].count(",")
+    padded = "\n".join(lines[:4] + ["," * width] + lines[4:] + ["," * width, " ,, ,"]) + "\n"
+    a = read_run(write(tmp_path, clean, "clean.csv"))
+    b = read_run(write(tmp_path, padded, "padded.csv"))
+    assert np.array_equal(a.T_C, b.T_C) and np.array_equal(a.time_s, b.time_s)
+    assert b.quality == []
+    # the lines after a row of separators keep their editor's numbers
+    broken = lines[:4] + ["," * width] + lines[4:]
+    broken[6] = broken[6].replace(broken[6].split(",")[0], "x", 1)
+    expect_error(write(tmp_path, "\n".join(broken) + "\n"), 7, "time_s",
+                 "cannot read 'x' as a number")
+    # a row holding one value under blank cells is a sample with no time
+    expect_error(write(tmp_path, "\n".join(lines + ["," * (width - 1) + ",7"]) + "\n"),
+                 len(lines) + 1, "time_s", "time is missing")

@@ -48,7 +48,7 @@ def read_csv_table(path: str | os.PathLike[str],
     data_numbers: list[int] = []
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
-        if not stripped:
+        if not stripped or is_blank_record(stripped):
             continue
         if stripped.startswith("#"):
             if header is None and ":" in stripped:
@@ -99,6 +99,13 @@ def read_csv_table(path: str | os.PathLike[str],
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored, row_unit=LINE)
+
+
+def is_blank_record(line: str) -> bool:
+    """True for a line of separators and blanks only (",,,,"): the rows a spreadsheet writes
+    below the data where its used range runs on, read past as blank lines are; they hold
+    no value to lose."""
+    return not line.replace(",", "").strip()
 
 
 def without_trailing_blanks(fields: list[str], width: int | None = None) -> list[str]:
