@@ -431,3 +431,32 @@ def test_a_spreadsheets_rows_of_separators_are_read_past(tmp_path):
     # a row holding one value under blank cells is a sample with no time
     expect_error(write(tmp_path, "\n".join(lines + ["," * (width - 1) + ",7"]) + "\n"),
                  len(lines) + 1, "time_s", "time is missing")
+
+
+def test_a_spreadsheets_cell_texts(tmp_path):
+    """Excel writes #N/A for a reading not available (its NA() and failed lookups): the
+    run was refused ("cannot read '#N/A' as a number") where 'n/a' read as a dropout.  A
+    formula's error value and a quoted decimal comma stay errors, saying what they are."""
+    clean = csv_text(warmup())
+    lines = clean.splitlines()
+
+    def with_T1(line: int, cell: str) -> str:
+        edited = list(lines)
+        fields = edited[line - 1].split(",")
+        fields[3] = cell
+        edited[line - 1] = ",".join(fields)
+        return "\n".join(edited) + "\n"
+
+    run = read_run(write(tmp_path, with_T1(51, "#N/A")))
+    assert [(f["column"], f["kind"], f["rows"]) for f in run.quality] == [
+        ("T1_C", "dropout", [51])]  # repaired and reported, as an empty cell is
+    same = read_run(write(tmp_path, with_T1(51, " n/a "), "same.csv"))
+    assert np.array_equal(run.T_C, same.T_C, equal_nan=True)
+    err = expect_error(write(tmp_path, with_T1(51, "#DIV/0!")), 51, "T1_C",
+                       "cannot read '#DIV/0!' as a number (a spreadsheet's error value")
+    assert "leave the cell empty" in err.reason
+    expect_error(write(tmp_path, with_T1(51, '"31,25"')), 51, "T1_C",
+                 "cannot read '31,25' as a number (a decimal comma? write decimal points)")
+    err = expect_error(write(tmp_path, with_T1(51, "31.2 C")), 51, "T1_C",
+                       "cannot read '31.2 C' as a number")
+    assert "(" not in err.reason  # no guess where there is nothing to say

@@ -46,8 +46,9 @@ class RawTable:
                           column=column, row_unit=self.row_unit)
 
 
-MISSING_TOKENS = frozenset({"", "nan", "na", "n/a", "null", "none"})
-"""Cell texts (case-insensitive, after stripping blanks) that mean "no value"."""
+MISSING_TOKENS = frozenset({"", "nan", "na", "n/a", "#n/a", "null", "none"})
+"""Cell texts (case-insensitive, after stripping blanks) that mean "no value" (`#N/A`: a
+spreadsheet's "not available", what its NA() and lookups write for a missing reading)."""
 
 MAX_NUMBER_CHARS = 64
 """No number a logger writes needs more characters; a longer cell is refused unread."""
@@ -62,6 +63,16 @@ def is_number(cell: str) -> bool:
     return _NUMBER.fullmatch(cell.strip()) is not None
 
 
+def _hint(text: str) -> str:
+    """What a cell that is no number most likely is, where a spreadsheet wrote it."""
+    if is_number(text.replace(",", ".", 1)):
+        return " (a decimal comma? write decimal points)"
+    if text.startswith("#") and text.endswith(("!", "?")):
+        return (" (a spreadsheet's error value: correct the formula, or leave the cell "
+                "empty for a missing reading)")
+    return ""
+
+
 def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> float:
     """One cell of a run table as a float (NaN for a missing value), or `InputError` at
     `row` (a "line" or a "row", as `RawTable.row_unit`)."""
@@ -72,8 +83,8 @@ def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> fl
     if text.lower() in MISSING_TOKENS:
         return math.nan
     if not is_number(text):
-        raise InputError(f"cannot read {cell!r} as a number", file=file, row=row,
-                         column=column, row_unit=row_unit)
+        raise InputError(f"cannot read {cell!r} as a number{_hint(text)}", file=file,
+                         row=row, column=column, row_unit=row_unit)
     value = float(text)
     if math.isinf(value):
         raise InputError(f"{cell!r} is not a finite number", file=file, row=row, column=column,
