@@ -460,3 +460,21 @@ def test_a_spreadsheets_cell_texts(tmp_path):
     err = expect_error(write(tmp_path, with_T1(51, "31.2 C")), 51, "T1_C",
                        "cannot read '31.2 C' as a number")
     assert "(" not in err.reason  # no guess where there is nothing to say
+
+
+def test_a_spreadsheets_separator_line_is_read_past(tmp_path):
+    """An export for Excel may start with `sep=,` (the separator Excel is to use): it was
+    taken for the header ("line 2: expected 1 fields as in the header, found 8")."""
+    clean = csv_text(warmup())
+    a = read_run(write(tmp_path, clean, "clean.csv"))
+    b = read_run(write(tmp_path, "# name: hint\nsep=,\n" + clean, "hint.csv"))
+    assert np.array_equal(a.T_C, b.T_C) and np.array_equal(a.time_s, b.time_s)
+    lines = clean.splitlines()
+    lines[2] = "x" + lines[2][1:]
+    expect_error(write(tmp_path, "SEP=,\n" + "\n".join(lines) + "\n"), 4, "time_s",
+                 "cannot read 'x")  # the lines keep their editor's numbers
+    expect_error(write(tmp_path, "sep=;\n" + clean.replace(",", ";")), 1, None,
+                 "the first line says the file is separated by ';'")
+    # below the header it is a data line like any other
+    expect_error(write(tmp_path, clean + "sep=,\n"), len(lines) + 1, None,
+                 "expected 8 fields as in the header, found 2")

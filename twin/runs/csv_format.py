@@ -56,6 +56,8 @@ def read_csv_table(path: str | os.PathLike[str],
                 if key.strip():
                     metadata[key.strip()] = value.strip()
             continue
+        if header is None and is_separator_hint(stripped, file, number):
+            continue
         if header is None:
             header = without_trailing_blanks(
                 [name.strip() for name in next(csv_records([line], file, [number]))])
@@ -99,6 +101,20 @@ def read_csv_table(path: str | os.PathLike[str],
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
                     ignored_columns=ignored, row_unit=LINE)
+
+
+def is_separator_hint(line: str, file: str, number: int) -> bool:
+    """True for the `sep=,` line above the header that Excel reads as the separator to use
+    (some exports write it): read past.  Another separator there is an `InputError`, in the
+    words of `check_comma_separated`.  The hint was taken for the header ("line 2: expected
+    1 fields as in the header, found 12")."""
+    if len(line) != 5 or line[:4].lower() != "sep=":
+        return False
+    if line[4] != ",":
+        raise InputError(f"the first line says the file is separated by {line[4]!r}; write "
+                         "it comma-separated, with decimal points", file=file, row=number,
+                         row_unit=LINE)
+    return True
 
 
 def is_blank_record(line: str) -> bool:
