@@ -507,3 +507,26 @@ def test_notes_name_file_line_and_column_as_the_error_messages_do(machine, tmp_p
     metrics = json.loads((report / "metrics.json").read_text())
     found = metrics["data_findings"][-1]
     assert (found["first_row"], found["last_row"], found["row_unit"]) == (22, 27, "line")
+
+
+def test_a_column_drift_does_not_read_is_told(tmp_path):
+    # a speed logged as 'speed' was dropped without a word: fit chose among the two
+    # methods that need no speed, and the user never heard the speed was not used
+    cols = synthetic_columns(hours=1.0)
+    cols["speed"] = cols.pop("speed_rpm")
+    cols["operator"] = np.zeros(cols["time_s"].size)
+    path = tmp_path / "logged.csv"
+    write_csv(path, cols)
+    result = run("fit", str(path), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"))
+    assert result.exit_code == 0, result.output
+    message = " ".join(result.output.split())
+    assert (f"note: {path}: column(s) 'speed', 'operator' not read (drift data: time_s, "
+            "speed_rpm, *_C temperatures, *_um displacements)") in message
+    assert "ridge_dynamic" not in message  # what the note explains
+    cols["speed_rpm"] = cols.pop("speed")
+    del cols["operator"]
+    write_csv(path, cols)
+    result = run("fit", str(path), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"), "--method", "mlr")
+    assert result.exit_code == 0 and "not read" not in result.output

@@ -71,6 +71,11 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
         typer.echo(f"note: {f['where']}: {f['repair']}", err=True)
     for name, why in data.left_out.items():
         typer.echo(f"note: temperature column {name!r} left out: {why}", err=True)
+    # a speed logged as 'speed' or 'n_rpm' was dropped without a word, and fit chose among
+    # the two methods that need no speed
+    for file, names in data.not_read.items():
+        typer.echo(f"note: {file}: column(s) {', '.join(map(repr, names))} not read (drift "
+                   "data: time_s, speed_rpm, *_C temperatures, *_um displacements)", err=True)
 
 
 @drift_app.command("fit", cls=PlainHelpCommand)

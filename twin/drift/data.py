@@ -62,7 +62,8 @@ class DriftData:
     displacement columns `targets` (NaN where not measured, or None when the files hold
     none of them).  `segment_starts` are the first row of every file; `rows` the row of
     every sample in its file (1-based line of a CSV file).  `left_out` maps a temperature
-    column not taken as a sensor (`usable_temperatures`) to the reason.
+    column not taken as a sensor (`usable_temperatures`) to the reason; `not_read` a file to
+    its columns that are none of the above (a speed named `speed`), for the user to hear.
     """
 
     files: list[str]
@@ -76,6 +77,7 @@ class DriftData:
     rows: np.ndarray
     findings: list[dict] = field(default_factory=list)
     left_out: dict[str, str] = field(default_factory=dict)
+    not_read: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
@@ -243,7 +245,8 @@ def drift_data(
         speed_rpm=np.concatenate(speeds) if use_speed else None, sensors=sensors,
         T_C=np.concatenate(temps), targets=targets, targets_um=targets_um,
         segment_starts=np.asarray(starts, dtype=np.int64), rows=np.concatenate(rows),
-        findings=findings, left_out=left_out)
+        findings=findings, left_out=left_out,
+        not_read={t.file: list(t.ignored_columns) for t in tables if t.ignored_columns})
 
 
 def read_drift_data(
