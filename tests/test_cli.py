@@ -892,3 +892,44 @@ def test_help_shows_arguments_as_design_names_them(path, usage, rows):
     assert f"Usage: {usage}\n" in result.output, result.output
     for row in rows:
         assert row in result.output, (row, result.output)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["replay", "run.csv", "--out", ""],
+     "an empty argument after '--out' (an unset shell variable?); see 'twin replay --help'"),
+    (["replay", "", "--out", "x"],
+     "an empty argument after 'replay' (an unset shell variable?); see 'twin replay --help'"),
+    (["drift", "fit", "d.csv", "--target", "a_um", "--out="],
+     "option '--out' is empty (an unset shell variable?); see 'twin drift fit --help'"),
+    (["simulate", "--speed", "9000", "--minutes", "1", "--ambient", "22", "--out", ""],
+     "an empty argument after '--out' (an unset shell variable?); see 'twin simulate --help'"),
+])
+def test_an_empty_argument_is_bad_input(tmp_path, monkeypatch, capsys, args, message):
+    # typer reads "" as the path '.': `twin replay run.csv --out "$DIR"` with DIR unset
+    # wrote run folders, summary.json and report.html into the current folder, `twin
+    # simulate` its fields there, and `twin replay ""` replayed the current folder's runs
+    from twin.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "run.csv").write_text("time_s,speed_rpm,ambient_C,T1_C,T2_C,T3_C,T4_C,T5_C\n"
+                                      + "".join(f"{t},9000,22,22,22,22,22,22\n"
+                                                for t in range(0, 200, 2)))
+    monkeypatch.setattr(sys, "argv", ["twin", *args])
+    with pytest.raises(SystemExit) as exit_:
+        main()
+    assert exit_.value.code == 2
+    assert capsys.readouterr().err == f"error: {message}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv"]  # nothing written
+
+
+def test_a_dot_is_still_the_current_folder(tmp_path, monkeypatch):
+    # only the empty text is refused: '.' written out stays a folder like any other
+    from twin.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["twin", "simulate", "--speed", "6000", "--minutes",
+                                      "0.2", "--ambient", "22", "--out", ".", "--quiet"])
+    with pytest.raises(SystemExit) as exit_:
+        main()
+    assert exit_.value.code == 0
+    assert (tmp_path / "summary.json").is_file()

@@ -295,6 +295,10 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
     a usage block and a box that wraps the message over several lines."""
     from typer import Abort
 
+    empty = _empty_argument(app, prog_name, sys.argv[1:])
+    if empty is not None:
+        print(f"error: {empty}", file=sys.stderr)
+        sys.exit(EXIT_INPUT_ERROR)
     watch = _CtrlCWatch()
     try:
         with _ctrl_c_noted(watch):
@@ -329,6 +333,39 @@ def run_console_script(app: Callable[..., Any], prog_name: str) -> None:
         # typer turns a Ctrl-C while it reads the options into this code without a word
         exit_interrupted(told=watch.told)
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _empty_argument(app: Callable[..., Any], prog_name: str, args: list[str]) -> str | None:
+    """The message for an empty argument (`--out ""` or `--out=`: a shell variable left
+    unset), or None.  No option or argument of a command takes an empty text, and a path
+    read it as `.`: `twin replay run.csv --out "$DIR"` wrote its folders, summary.json and
+    report.html into the current folder, and `twin replay ""` replayed it."""
+    for k, arg in enumerate(args):
+        if arg.startswith("--") and arg.endswith("=") and len(arg) > 3:
+            what = f"option {arg[:-1]!r} is empty"
+        elif arg == "":
+            before = args[k - 1] if k else ""
+            what = "an empty argument" + (f" after {before!r}" if before else "")
+        else:
+            continue
+        command = _command_path(app, prog_name, args)
+        return f"{what} (an unset shell variable?); see '{command} --help'"
+    return None
+
+
+def _command_path(app: Callable[..., Any], prog_name: str, args: list[str]) -> str:
+    """`prog_name` and the (sub)command names that lead `args` (`twin drift fit`)."""
+    import typer.main
+
+    command = typer.main.get_command(app)  # type: ignore[arg-type]
+    words = [prog_name]
+    for arg in args:
+        commands = getattr(command, "commands", None)
+        if not commands or arg not in commands:
+            break
+        command = commands[arg]
+        words.append(arg)
+    return " ".join(words)
 
 
 def exit_interrupted(*, told: bool = False) -> NoReturn:
