@@ -10,10 +10,11 @@ stopped stretches apart: a turning spindle shakes its probes.
 
 Why it is here: the emulated spindle's sensor noise (`twin/plant/suite.py`) should be no
 kinder than a real machine's.  On `examples/real/train.csv` (15 s sampling) the
-thermocouples give 0.005–0.016 °C (one channel 0.09 °C) and the probes 0.02–0.04 µm while
-running, 0.012–0.017 µm stopped; the suite draws 0.02–0.1 °C and 0.05–0.3 µm per 1 s
-sample.  Even if the real logger averaged its 15 s (noise per second √15 ≈ 3.9 times
-higher: up to 0.06 °C and 0.15 µm), the suite's upper ends lie above the real machine.
+thermocouples give 0.005–0.021 °C (one channel 0.10 °C) and the probes 0.02–0.04 µm while
+running, 0.004–0.012 °C (the one 0.08 °C) and 0.012–0.017 µm stopped; the suite draws
+0.02–0.1 °C and 0.05–0.3 µm per 1 s sample.  Even if the real logger averaged its 15 s
+(noise per second √15 ≈ 3.9 times higher: up to 0.08 °C and 0.14 µm), the suite's upper
+ends lie above the real machine.
 """
 
 from __future__ import annotations
