@@ -1019,3 +1019,32 @@ def test_the_report_leaves_a_gap_in_c_h_at_a_stop():
                                   [1, 1.1, np.nan, np.nan, np.nan, 1.11])
     np.testing.assert_array_equal(_running_factor(corr, "C_C_front", sel),
                                   [1, 0.9, 1, 1, 1, 1.2])
+
+
+def test_quality_json_names_the_tail_after_the_last_whole_window(runs_dir, replayed, tmp_path):
+    """A replay solves and scores whole 60 s windows: a 152 s run was replayed and scored
+    over 120 s, and neither quality.json nor the report said its last 32 s were left."""
+    from twin.loop.replay import NOT_REPLAYED
+
+    lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
+    kept = [line for line in lines[header + 1:] if float(line.split(",")[0]) <= 152.0]
+    short = tmp_path / "short.csv"
+    short.write_text("\n".join(lines[:header + 1] + kept) + "\n")
+    assert replay(short, out=tmp_path / "out", methods="open_loop").exit_code == 0
+    quality = json.loads((tmp_path / "out" / "short" / "quality.json").read_text())
+    tail = [f for f in quality["findings"] if f["kind"] == NOT_REPLAYED]
+    first = next(k for k, line in enumerate(kept) if float(line.split(",")[0]) > 120.0)
+    assert tail == [{
+        "column": "time_s", "kind": NOT_REPLAYED, "count": len(kept) - first,
+        "rows": [header + 2 + first],  # its line in the file
+        "spans_s": [[120.0, 152.0]],
+        "action": "not replayed and not scored: a replay solves whole 60 s windows",
+        "detail": "the 32 s after the last whole window (ends at 120 s)"}]
+    assert float(lines[header + 1 + first].split(",")[0]) > 120.0
+    assert float(lines[header + first].split(",")[0]) <= 120.0
+    keypoints = (tmp_path / "out" / "short" / "keypoints.csv").read_text().splitlines()
+    assert float(keypoints[-1].split(",")[0]) == 120.0  # what the finding says
+    # a run of whole windows has no such finding
+    whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
+    assert not [f for f in whole if f["kind"] == NOT_REPLAYED]

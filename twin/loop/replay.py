@@ -313,6 +313,26 @@ def held_correction_findings(run: RecordedRun, methods: Sequence[str]) -> list[d
     return found
 
 
+NOT_REPLAYED = "not_replayed"
+"""quality.json kind of `tail_findings`."""
+
+
+def tail_findings(run: RecordedRun) -> list[dict]:
+    """The quality.json finding (`twin.runs.quality.finding`) of the samples after the
+    run's last whole 60 s window, which a replay neither solves nor scores: a 150 s run
+    was replayed and scored over 120 s, and neither quality.json nor the report said so."""
+    end = n_windows(run) * WINDOW_S
+    after = np.flatnonzero(run.time_s > end + 1e-6)
+    if after.size == 0:
+        return []
+    return [finding("time_s", NOT_REPLAYED,
+                    "not replayed and not scored: a replay solves whole 60 s windows",
+                    rows=run.rows[after[:1]], count=after.size,
+                    spans_s=[(end, run.duration_s)],
+                    detail=f"the {run.duration_s - end:g} s after the last whole window "
+                           f"(ends at {end:g} s)")]
+
+
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
     T0 = first.T_valid_C[0]
