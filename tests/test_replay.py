@@ -1048,3 +1048,43 @@ def test_quality_json_names_the_tail_after_the_last_whole_window(runs_dir, repla
     # a run of whole windows has no such finding
     whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
     assert not [f for f in whole if f["kind"] == NOT_REPLAYED]
+
+
+def test_quality_json_tells_an_axial_probe_not_zeroed_at_the_start(runs_dir, replayed,
+                                                                   tmp_path):
+    """The twin's drift starts at 0 µm with the run; a probe zeroed elsewhere (50 µm off)
+    was scored as recorded, deformation accuracy some 15 %, without a word of the cause."""
+    from twin.loop.replay import PROBE_NOT_ZEROED
+
+    lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
+    column = lines[header].split(",").index("disp_z_um")
+
+    def shifted(by: float) -> list[str]:
+        out = []
+        for line in lines[header + 1:]:
+            cells = line.split(",")
+            cells[column] = f"{float(cells[column]) + by:.4f}"
+            out.append(",".join(cells))
+        return lines[:header + 1] + out
+
+    off = tmp_path / "off.csv"
+    off.write_text("\n".join(shifted(50.0)) + "\n")
+    assert replay(off, out=tmp_path / "out", methods="open_loop").exit_code == 0
+    quality = json.loads((tmp_path / "out" / "off" / "quality.json").read_text())
+    told = [f for f in quality["findings"] if f["kind"] == PROBE_NOT_ZEROED]
+    first = float(lines[header + 1].split(",")[column]) + 50.0
+    assert told == [{
+        "column": "disp_z_um", "kind": PROBE_NOT_ZEROED, "count": 1,
+        "rows": [header + 2], "spans_s": [],
+        "action": "scored as recorded: the twin's drift starts at 0 µm at the run start; "
+                  "zero the probe there (or subtract its first reading)",
+        "detail": f"reads {first:.3g} µm at the start, more than 1 µm from 0"}]
+    # a probe a little off (noise) is nothing to tell; nor is one zeroed at the start
+    near = tmp_path / "near.csv"
+    near.write_text("\n".join(shifted(0.5)) + "\n")
+    assert replay(near, out=tmp_path / "out", methods="open_loop").exit_code == 0
+    quality = json.loads((tmp_path / "out" / "near" / "quality.json").read_text())
+    assert not [f for f in quality["findings"] if f["kind"] == PROBE_NOT_ZEROED]
+    whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
+    assert not [f for f in whole if f["kind"] == PROBE_NOT_ZEROED]

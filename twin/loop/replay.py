@@ -333,6 +333,33 @@ def tail_findings(run: RecordedRun) -> list[dict]:
                            f"(ends at {end:g} s)")]
 
 
+PROBE_NOT_ZEROED = "probe_not_zeroed"
+"""quality.json kind of `probe_offset_findings`."""
+
+PROBE_ZERO_TOLERANCE_UM = 1.0
+"""How far the axial probe's first reading may lie from 0 before quality.json tells it:
+three times the largest probe noise a suite draws (0.3 µm)."""
+
+
+def probe_offset_findings(run: RecordedRun) -> list[dict]:
+    """The quality.json finding of an axial probe that does not read about 0 at the run's
+    start.  The twin's drift starts at 0 there (its uniform start field) and is scored
+    against the readings as recorded: a probe zeroed elsewhere, 50 µm off, scored 15 %
+    deformation accuracy for open loop and pulled the estimator's temperatures off (99.86
+    → 96.80 %) without a word of the cause."""
+    if run.disp_um is None or not run.valid.get("disp_z_um", np.zeros(1, bool))[0]:
+        return []
+    first = float(run.disp_um[0, 2])
+    if abs(first) <= PROBE_ZERO_TOLERANCE_UM:
+        return []
+    return [finding("disp_z_um", PROBE_NOT_ZEROED,
+                    "scored as recorded: the twin's drift starts at 0 µm at the run start; "
+                    "zero the probe there (or subtract its first reading)",
+                    rows=run.rows[:1],
+                    detail=f"reads {first:.3g} µm at the start, more than "
+                           f"{PROBE_ZERO_TOLERANCE_UM:g} µm from 0")]
+
+
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
     T0 = first.T_valid_C[0]
