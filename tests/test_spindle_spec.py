@@ -154,3 +154,46 @@ def test_a_spec_value_must_be_a_finite_number_as_written(tmp_path, new, says):
         load_spec(path)
     assert info.value.row == text[:text.index(old)].count("\n") + 1
     assert "conductivity_W_per_mK" in str(info.value) and says in str(info.value)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    # a size typed in cm (0.7) or m (0.007): the mesher ran on without bound
+    ("element_size_mm = 7.0", "element_size_mm = 0.3",
+     "line 14, key 'mesh.element_size_mm': Input should be greater than or equal to 1.4"),
+    ("min_elements_across = 2", "min_elements_across = 50",
+     "line 15, key 'mesh.min_elements_across': Input should be less than or equal to 10"),
+])
+def test_a_mesh_too_fine_to_build_is_refused_before_meshing(tmp_path, old, new, message):
+    from twin.cli import app
+
+    text = DEFAULT_SPEC_PATH.read_text()
+    assert text[:text.index(old)].count("\n") + 1 == int(message.split()[1].rstrip(","))
+    path = tmp_path / "fine.toml"
+    path.write_text(text.replace(old, new, 1))
+    for command in (["mesh"], ["simulate", "--speed", "9000", "--minutes", "1",
+                               "--ambient", "22"]):
+        out = tmp_path / ("m.msh" if command == ["mesh"] else "sim")
+        result = CliRunner().invoke(app, [*command, "--spec", str(path), "--out", str(out)])
+        assert result.exit_code == 2
+        assert result.output == f"error: {path}, {message}\n"
+        assert not out.exists()
+
+
+def test_the_size_factor_keeps_the_finest_element_on_any_spec(tmp_path):
+    # --size-factor is floored at 0.2 for the reference spindle's 7 mm; a spec of 1.4 mm at
+    # 0.5 made 0.7 mm elements, four times the floor's count
+    from twin.cli import app
+
+    text = DEFAULT_SPEC_PATH.read_text()
+    path = tmp_path / "fine.toml"
+    path.write_text(text.replace("element_size_mm = 7.0", "element_size_mm = 1.4", 1))
+    out = tmp_path / "m.msh"
+    result = CliRunner().invoke(app, ["mesh", "--spec", str(path), "--size-factor", "0.5",
+                                      "--out", str(out)])
+    assert result.exit_code == 2 and not out.exists()
+    assert result.output == ("error: option '--size-factor': 0.5 times the spec's "
+                             "element_size_mm 1.4 makes 0.7 mm elements; the finest allowed "
+                             "is 1.4 mm; see 'twin mesh --help'\n")
+    result = CliRunner().invoke(app, ["mesh", "--spec", str(path), "--size-factor", "2",
+                                      "--out", str(out), "--quiet"])
+    assert result.exit_code == 0 and out.exists()

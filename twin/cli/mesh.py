@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between
+from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between, check_element_size
 
 
 def mesh(
@@ -28,6 +28,7 @@ def mesh(
     check_out_file(out, inputs=[spec], suffixes=(".msh",))
     _keep_the_bundled_mesh(out, spec, size_factor)
     the_spec = load_spec(spec, option="--spec")
+    check_element_size(the_spec, size_factor)
     result = build_mesh(the_spec, size_factor)
     write_msh(result, out)
     if not quiet:

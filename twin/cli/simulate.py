@@ -11,6 +11,7 @@ from twin.cli.inputs import (
     MIN_SIZE_FACTOR,
     RANGE_C,
     between,
+    check_element_size,
     check_operating_options,
 )
 
@@ -57,7 +58,9 @@ def simulate_command(
         raise InputError("is a twin replay output folder, whose summary.json this would "
                          "replace: choose another --out", file=str(out), column="--out")
     # validate the operating point before the (slower) model build
-    check_operating_options(load_spec(spec, option="--spec"), speed, ambient, coolant)
+    the_spec = load_spec(spec, option="--spec")
+    check_operating_options(the_spec, speed, ambient, coolant)
+    check_element_size(the_spec, size_factor)
     model = SpindleModel.load(spec, size_factor=size_factor)
     every = field_every if field_every > 0 else minutes * 60.0
     result = simulate(model, speed, minutes, ambient, coolant, field_every_s=every)

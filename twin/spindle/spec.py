@@ -67,10 +67,20 @@ class SpindleInfo(_Strict):
     rotating_regions: list[str] = Field(min_length=1)
 
 
+MIN_ELEMENT_SIZE_MM = 1.4
+"""Finest element size a mesh may have (`element_size_mm` times a command's size factor):
+the reference spindle's 7 mm at `--size-factor` 0.2, some 25 times its elements.  A spec
+without a floor meshed on without bound: `element_size_mm = 0.3` (a size typed in cm, or
+0.007 in m) left `twin simulate` still meshing after minutes."""
+
+MAX_ELEMENTS_ACROSS = 10
+"""Most elements `min_elements_across` may ask for across a part's thinnest side."""
+
+
 class MeshOptions(_Strict):
-    element_size_mm: float = Field(gt=0)
+    element_size_mm: float = Field(ge=MIN_ELEMENT_SIZE_MM)
     #: at least this many elements across the thinnest side of every part
-    min_elements_across: int = Field(default=2, ge=1)
+    min_elements_across: int = Field(default=2, ge=1, le=MAX_ELEMENTS_ACROSS)
 
 
 class MaterialSpec(_Strict):
