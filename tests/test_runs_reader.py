@@ -389,8 +389,15 @@ def test_a_utf16_file_is_told_as_such(tmp_path, encoding):
         read_run(path)
     assert str(info.value) == f"{path}: UTF-16 text; save it as UTF-8"
     path.write_bytes(text.encode("latin-1"))  # not UTF-8, but no UTF-16 either
-    with pytest.raises(InputError, match=", line 1: not UTF-8 text"):
+    with pytest.raises(InputError) as info:
         read_run(path)
+    # Excel's "CSV (Comma delimited)" on Windows: the byte and what to do were not said
+    assert str(info.value) == (f"{path}, line 1: not UTF-8 text (byte 0xFC, 'ü' in "
+                               "Windows-1252 or Latin-1); save it as UTF-8 (Excel: 'CSV UTF-8')")
+    path.write_bytes(b"time_s,speed_rpm\n\x81\n")  # a byte Windows-1252 leaves undefined
+    with pytest.raises(InputError) as info:
+        read_run(path)
+    assert str(info.value) == f"{path}, line 2: not UTF-8 text (byte 0x81); save it as UTF-8"
 
 
 def test_a_spreadsheets_trailing_separators_are_read_past(tmp_path):

@@ -239,8 +239,10 @@ def test_toml_text_that_is_not_utf8_names_its_line_as_a_line(tmp_path):
         load_scenario(scenario)
     with pytest.raises(InputError) as as_spec:
         load_spec(spec)
-    assert str(as_scenario.value) == f"{scenario}, line 2, option '--scenario': not UTF-8 text"
-    assert str(as_spec.value) == f"{spec}, line 1: not UTF-8 text"
+    hint = "(byte 0xE9, 'é' in Windows-1252 or Latin-1); save it as UTF-8 (Excel: 'CSV UTF-8')"
+    assert str(as_scenario.value) == (f"{scenario}, line 2, option '--scenario': not UTF-8 "
+                                      f"text {hint}")
+    assert str(as_spec.value) == f"{spec}, line 1: not UTF-8 text {hint}"
 
 
 def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):

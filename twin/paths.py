@@ -82,8 +82,20 @@ def read_input_text(path: str | os.PathLike[str], *, column: str | None = None,
             raise InputError("UTF-16 text; save it as UTF-8", file=str(path),
                              column=column) from None
         line = data[: exc.start].count(b"\n") + 1
-        raise InputError("not UTF-8 text", file=str(path), row=line, column=column,
-                         row_unit="line") from None
+        raise InputError(f"not UTF-8 text{_legacy_hint(data[exc.start:exc.start + 1])}",
+                         file=str(path), row=line, column=column, row_unit="line") from None
+
+
+def _legacy_hint(byte: bytes) -> str:
+    """What a byte that is no UTF-8 most likely is: Excel's "CSV (Comma delimited)" on
+    Windows writes Windows-1252 ('ü' as 0xFC), and "not UTF-8 text" alone left the user
+    to guess what to change."""
+    try:
+        character = byte.decode("cp1252")
+    except UnicodeDecodeError:
+        return f" (byte 0x{byte[0]:02X}); save it as UTF-8"
+    return (f" (byte 0x{byte[0]:02X}, {character!r} in Windows-1252 or Latin-1); save it as "
+            "UTF-8 (Excel: 'CSV UTF-8')")
 
 
 MAX_TOML_BYTES = 2**20
