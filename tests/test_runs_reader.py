@@ -485,3 +485,24 @@ def test_a_spreadsheets_separator_line_is_read_past(tmp_path):
     # below the header it is a data line like any other
     expect_error(write(tmp_path, clean + "sep=,\n"), len(lines) + 1, None,
                  "expected 8 fields as in the header, found 2")
+
+
+@pytest.mark.parametrize("cell", ["00:00:02", "0:02", "2026-11-27 10:00:02",
+                                  "27.11.2026 10:00:02.5", "2026-11-27T10:00:02"])
+def test_a_time_column_of_dates_or_clock_times_is_told_as_such(tmp_path, cell):
+    # a logger's or a spreadsheet's time column ("00:00:02") was "cannot read '00:00:02' as
+    # a number", the user left to find that time_s wants seconds
+    lines = csv_text(warmup()).splitlines()
+    lines[1] = cell + lines[1][lines[1].index(","):]
+    err = expect_error(write(tmp_path, "\n".join(lines) + "\n"), 2, "time_s",
+                       f"cannot read {cell!r} as a number (a date or clock time? time_s "
+                       "holds seconds from the run's start: convert the column)")
+    assert err.reason.endswith("convert the column)")
+    # the same text in another column is no time to convert
+    lines = csv_text(warmup()).splitlines()
+    fields = lines[1].split(",")
+    fields[3] = cell
+    lines[1] = ",".join(fields)
+    err = expect_error(write(tmp_path, "\n".join(lines) + "\n", "other.csv"), 2, "T1_C",
+                       f"cannot read {cell!r} as a number")
+    assert "time_s holds" not in err.reason

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from twin.errors import InputError
+from twin.runs.schema import TIME
 
 
 @dataclass
@@ -63,8 +64,17 @@ def is_number(cell: str) -> bool:
     return _NUMBER.fullmatch(cell.strip()) is not None
 
 
-def _hint(text: str) -> str:
-    """What a cell that is no number most likely is, where a spreadsheet wrote it."""
+_CLOCK = re.compile(r"(?:\d{1,4}[-/.]\d{1,2}[-/.]\d{1,4}[ T]?)?"  # a date,
+                    r"(?:\d{1,2}:\d{2}(?::\d{2}(?:[.,]\d*)?)?)?")  # a clock time
+"""A date, a clock time or both, as a logger or a spreadsheet writes its time column."""
+
+
+def _hint(text: str, column: str) -> str:
+    """What a cell that is no number most likely is, where a spreadsheet or a logger wrote
+    it."""
+    if column == TIME and text and _CLOCK.fullmatch(text.strip()):
+        return (" (a date or clock time? time_s holds seconds from the run's start: "
+                "convert the column)")
     if is_number(text.replace(",", ".", 1)):
         return " (a decimal comma? write decimal points)"
     if text.startswith("#") and text.endswith(("!", "?")):
@@ -83,7 +93,7 @@ def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> fl
     if text.lower() in MISSING_TOKENS:
         return math.nan
     if not is_number(text):
-        raise InputError(f"cannot read {cell!r} as a number{_hint(text)}", file=file,
+        raise InputError(f"cannot read {cell!r} as a number{_hint(text, column)}", file=file,
                          row=row, column=column, row_unit=row_unit)
     value = float(text)
     if math.isinf(value):
