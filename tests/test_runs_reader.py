@@ -506,3 +506,26 @@ def test_a_time_column_of_dates_or_clock_times_is_told_as_such(tmp_path, cell):
     err = expect_error(write(tmp_path, "\n".join(lines) + "\n", "other.csv"), 2, "T1_C",
                        f"cannot read {cell!r} as a number")
     assert "time_s holds" not in err.reason
+
+
+@pytest.mark.parametrize("kind", ["timestamp[ms]", "duration[s]", "date32[day]"])
+def test_a_parquet_time_column_of_time_stamps_is_told_as_such(tmp_path, kind):
+    # as a CSV file's '2026-11-27 10:00:02': "column type timestamp[us] is not numeric"
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    cols = warmup()
+    seconds = cols.pop("time_s").astype("int64")
+    if kind.startswith("date"):
+        time = pa.array(seconds // 86400, pa.int32()).cast(pa.date32())
+    else:
+        time = pa.array(seconds * (1000 if "ms" in kind else 1)).cast(pa.type_for_alias(kind))
+    path = tmp_path / "run.parquet"
+    pq.write_table(pa.table({"time_s": time, **cols}), path)
+    err = expect_error(path, None, "time_s", f"column type {kind} is not numeric: time_s "
+                       "holds seconds from the run's start, convert the column")
+    assert err.reason.endswith("convert the column")
+    cols["T1_C"] = cols["T1_C"] > 30  # another column of another type: no such hint
+    pq.write_table(pa.table({"time_s": seconds.astype(float), **cols}), path)
+    err = expect_error(path, None, "T1_C", "column type bool is not numeric")
+    assert "time_s holds" not in err.reason

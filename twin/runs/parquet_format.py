@@ -15,7 +15,7 @@ import numpy as np
 from twin.errors import InputError
 from twin.io.atomic import atomic_target
 from twin.paths import check_input_file
-from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
+from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES, TIME
 from twin.runs.table import RawTable, parse_cell
 
 if TYPE_CHECKING:
@@ -54,7 +54,11 @@ def _column_values(column: pa.ChunkedArray, file: str, name: str) -> np.ndarray:
         texts = column.to_pylist()
         return np.array([math.nan if text is None else parse_cell(text, file, i, name, ROW)
                          for i, text in enumerate(texts, start=1)], dtype=float)
-    raise InputError(f"column type {kind} is not numeric", file=file, column=name)
+    hint = ""
+    if name == TIME and pa.types.is_temporal(kind):
+        # a logger's time stamps, as a CSV file's '2026-11-27 10:00:02' is told
+        hint = ": time_s holds seconds from the run's start, convert the column"
+    raise InputError(f"column type {kind} is not numeric{hint}", file=file, column=name)
 
 
 def read_parquet_table(path: str | os.PathLike[str],
