@@ -223,3 +223,34 @@ def test_a_suite_into_a_folder_of_an_older_suite_is_refused_naming_the_stale_run
         "notes.txt", "suite2_001.csv", "suite2_001.profile.csv", "suite2_001.scenario.toml",
         "suite2_001.truth.csv"]
     assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_overwrite_removes_only_runs_twin_synth_wrote(tmp_path):
+    """A measured run in the folder is data, not an older suite's run: `--overwrite`
+    removed it with them (`real.csv` listed among the stale runs, then deleted)."""
+    out = tmp_path / "suite"
+    assert invoke("synth", "--suite", 1, "--seed", 1, "--minutes", 2, "--rate", 0.2,
+                  "--out", out, "--quiet").exit_code == 0
+    assert invoke("synth", "--speed", 6000, "--minutes", 2, "--ambient", 22, "--seed", 3,
+                  "--rate", 0.2, "--out", out / "single.parquet", "--quiet").exit_code == 0
+    measured = (out / "suite1_001.csv").read_text().replace(
+        "# source: twin synth (emulated spindle)", "# source: test stand 3")
+    (out / "real.csv").write_text(measured)
+    (out / "notes.csv").write_text("not a run at all\n")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    result = invoke("synth", "--suite", 1, "--seed", 2, "--minutes", 2, "--rate", 0.2,
+                    "--out", out, "--overwrite", "--quiet")
+    assert result.exit_code == 2
+    assert result.output == (f"error: {out}, option '--out': holds 2 run file(s) twin synth "
+                             "did not write (notes.csv, real.csv); --overwrite removes only "
+                             "runs twin synth wrote: move them, or write the suite into "
+                             "another folder\n")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # nothing touched
+    (out / "real.csv").unlink()
+    (out / "notes.csv").unlink()
+    result = invoke("synth", "--suite", 1, "--seed", 2, "--minutes", 2, "--rate", 0.2,
+                    "--out", out, "--overwrite", "--quiet")
+    assert result.exit_code == 0, result.output  # synth's own runs, CSV and Parquet, go
+    assert sorted(p.name for p in out.iterdir()) == [
+        "suite2_001.csv", "suite2_001.profile.csv", "suite2_001.scenario.toml",
+        "suite2_001.truth.csv"]

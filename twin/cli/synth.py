@@ -74,8 +74,9 @@ def synth(
                                          "scenario's [coolant] overrides it, with a "
                                          "warning)."),
     overwrite: bool = typer.Option(False, "--overwrite", help="With --suite: remove the "
-                                   "runs already in the --out folder that this suite does "
-                                   "not write (without it they are an error)."),
+                                   "runs twin synth wrote already in the --out folder that "
+                                   "this suite does not write (without it they are an "
+                                   "error; another run file there is one in any case)."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     from twin.cli.inputs import COMPANION_SUFFIXES, check_operating_options
@@ -183,8 +184,9 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     or removed first with `overwrite`: a later `twin replay out` would mix them in."""
     import time
 
-    from twin.cli.inputs import run_files_in
+    from twin.cli.inputs import COMPANION_SUFFIXES, run_files_in
     from twin.io.destinations import check_out_dir
+    from twin.plant.emulator import written_by_synth
     from twin.plant.scenario import Scenario
     from twin.plant.suite import case_files, draw_suite, write_case
     from twin.spindle import SpindleModel
@@ -205,6 +207,17 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     cases = draw_suite(n, seed, minutes, max_speed_rpm=limit, rate_hz=rate)
     written = {name for case in cases for name in case_files(case.name).values()}
     stale = [p for p in run_files_in(out) if p.name not in written] if out.is_dir() else []
+    # the truth, profile and scenario files beside the runs are synth's by their names
+    foreign = [p for p in stale if not p.name.endswith((*COMPANION_SUFFIXES, ".scenario.toml"))
+               and not written_by_synth(p)]
+    if foreign:
+        # a measured run beside the suite is data: --overwrite removed it with the old runs
+        listed = ", ".join(p.name for p in foreign[:3]) + (
+            f", … and {len(foreign) - 3} more" if len(foreign) > 3 else "")
+        raise InputError(f"holds {len(foreign)} run file(s) twin synth did not write "
+                         f"({listed}); --overwrite removes only runs twin synth wrote: move "
+                         "them, or write the suite into another folder",
+                         file=str(out), column="--out")
     if stale and not overwrite:
         listed = ", ".join(p.name for p in stale[:3]) + (
             f", … and {len(stale) - 3} more" if len(stale) > 3 else "")

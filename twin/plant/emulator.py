@@ -199,6 +199,23 @@ def run_truth(model: SpindleModel, duration_s: float, speed: StepTable, tables: 
                     heat_in_W=heat_in, residual_W=residual, final_field_C=T)
 
 
+SYNTH_SOURCE = "twin synth (emulated spindle)"
+"""The `source` metadata of every run `twin synth` writes (what `--suite --overwrite` may
+remove)."""
+
+
+def written_by_synth(path: Path) -> bool:
+    """Whether the run file `path` says `twin synth` wrote it (its `source` metadata); a
+    file that cannot be read as a run does not."""
+    from twin.errors import InputError
+    from twin.runs import read_table
+
+    try:
+        return read_table(path).metadata.get("source") == SYNTH_SOURCE
+    except InputError:
+        return False
+
+
 def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float | None = None,
                profile: SpeedProfile | None = None, scenario: Scenario | None = None,
                rate_hz: float = 1.0, coolant_C: float | None = None,
@@ -288,7 +305,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         label = Path(profile_name).stem if profile_name else "profile"
     metadata = {
         "name": f"synth_{label}_{minutes:g}min_seed{seed}",
-        "source": "twin synth (emulated spindle)",
+        "source": SYNTH_SOURCE,
         "speed_rpm": f"{speed_rpm:g}" if speed_rpm is not None else "profile",
         # file names only: the run must not depend on the folder it was made from
         "profile": Path(profile_name).name if profile_name else "",
