@@ -529,3 +529,13 @@ def test_a_parquet_time_column_of_time_stamps_is_told_as_such(tmp_path, kind):
     pq.write_table(pa.table({"time_s": seconds.astype(float), **cols}), path)
     err = expect_error(path, None, "T1_C", "column type bool is not numeric")
     assert "time_s holds" not in err.reason
+
+
+def test_a_second_header_says_the_files_were_joined(tmp_path):
+    # `cat monday.csv tuesday.csv` repeats the header mid-file: "line 302, column 'time_s':
+    # cannot read 'time_s' as a number" left the user reading a number column
+    lines = csv_text(warmup()).splitlines()
+    joined = lines[:100] + [" " + lines[0].replace(",", ", ")] + lines[100:]
+    expect_error(write(tmp_path, "# name: two days\n" + "\n".join(joined) + "\n"), 102,
+                 None, "the header again (line 2 holds it): files joined one after the "
+                 "other? keep the first header only")

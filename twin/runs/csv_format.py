@@ -86,6 +86,11 @@ def read_csv_table(path: str | os.PathLike[str],
         if len(fields) != len(header):
             raise InputError(f"expected {len(header)} fields as in the header, found "
                              f"{len(fields)}", file=file, row=line, row_unit=LINE)
+        if [f.strip() for f in fields] == header:
+            # two logs joined one after the other: "cannot read 'time_s' as a number"
+            raise InputError(f"the header again (line {header_line} holds it): files joined "
+                             "one after the other? keep the first header only", file=file,
+                             row=line, row_unit=LINE)
         row = values[k]
         for j, (i, name) in enumerate(known):
             try:
