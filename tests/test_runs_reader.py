@@ -464,6 +464,12 @@ def test_a_spreadsheets_cell_texts(tmp_path):
     assert "leave the cell empty" in err.reason
     expect_error(write(tmp_path, with_T1(51, '"31,25"')), 51, "T1_C",
                  "cannot read '31,25' as a number (a decimal comma? write decimal points)")
+    # a thousands separator is no decimal comma: "9,000" rpm is 9000, not 9.000
+    expect_error(write(tmp_path, with_T1(51, '"9,000"')), 51, "T1_C",
+                 "cannot read '9,000' as a number (a thousands separator, or a decimal "
+                 "comma? write plain numbers with a decimal point: 9000, 25.4)")
+    expect_error(write(tmp_path, with_T1(51, '"12,000.5"')), 51, "T1_C",
+                 "(a thousands separator, or a decimal comma?")
     err = expect_error(write(tmp_path, with_T1(51, "31.2 C")), 51, "T1_C",
                        "cannot read '31.2 C' as a number")
     assert "(" not in err.reason  # no guess where there is nothing to say

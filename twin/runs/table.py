@@ -69,12 +69,19 @@ _CLOCK = re.compile(r"(?:\d{1,4}[-/.]\d{1,2}[-/.]\d{1,4}[ T]?)?"  # a date,
 """A date, a clock time or both, as a logger or a spreadsheet writes its time column."""
 
 
+_GROUPED = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+(?:\.\d+)?")
+"""A number with thousands separators, as a spreadsheet formats it ("9,000")."""
+
+
 def _hint(text: str, column: str) -> str:
     """What a cell that is no number most likely is, where a spreadsheet or a logger wrote
     it."""
     if column == TIME and text and _CLOCK.fullmatch(text.strip()):
         return (" (a date or clock time? time_s holds seconds from the run's start: "
                 "convert the column)")
+    if _GROUPED.fullmatch(text.strip()):  # "9,000" or "1,234.5": 9000 rpm, not 9
+        return (" (a thousands separator, or a decimal comma? write plain numbers with a "
+                "decimal point: 9000, 25.4)")
     if is_number(text.replace(",", ".", 1)):
         return " (a decimal comma? write decimal points)"
     if text.startswith("#") and text.endswith(("!", "?")):
