@@ -530,3 +530,23 @@ def test_a_column_drift_does_not_read_is_told(tmp_path):
     result = run("fit", str(path), "--target", "drift_um", "--out",
                  str(tmp_path / "m.safetensors"), "--method", "mlr")
     assert result.exit_code == 0 and "not read" not in result.output
+
+
+def test_a_stretch_of_time_without_rows_is_told(tmp_path):
+    # a logger stopped for 45 min: the lagged features held the last reading across it,
+    # as for a missing reading, which was told, while the gap in time was not
+    cols = synthetic_columns(hours=2.0)
+    keep = (cols["time_s"] < 1800.0) | (cols["time_s"] >= 4500.0)
+    path = tmp_path / "gap.csv"
+    write_csv(path, {k: v[keep] for k, v in cols.items()}, "# logger: one\n")
+    result = run("fit", str(path), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"), "--method", "mlr")
+    assert result.exit_code == 0, result.output
+    message = " ".join(result.output.split())
+    # the row at 1785 s is data row 120, on line 122 under the metadata line and the header
+    assert (f"note: {path}, lines 122–123, column 'time_s': 2715 s without rows: the "
+            "lagged features hold the last reading across it") in message
+    write_csv(path, cols)
+    result = run("fit", str(path), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"), "--method", "mlr")
+    assert result.exit_code == 0 and "without rows" not in result.output

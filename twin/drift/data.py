@@ -130,6 +130,23 @@ def _gap_findings(table: RawTable, name: str, gaps: list[tuple[int, int]],
     return out
 
 
+TIME_GAP_FACTOR = 10.0
+"""A step between two rows this many times the file's median step is a gap in the log."""
+
+
+def _time_gap_findings(table: RawTable, t: np.ndarray) -> list[dict]:
+    """A finding per stretch of time without rows (a logger stopped for an hour): the lags
+    hold the last reading across it, as they do a missing reading, and that was said of
+    a missing reading alone (the run reader reports such a gap as `long_gap`)."""
+    if t.size < 3:
+        return []
+    step = np.diff(t)
+    gaps = np.flatnonzero(step > TIME_GAP_FACTOR * float(np.median(step)))
+    return [finding for k in gaps for finding in _gap_findings(
+        table, TIME, [(int(k), int(k) + 1)],
+        f"{step[k]:g} s without rows: the lagged features hold the last reading across it")]
+
+
 def _without_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
     """The table without the rows that repeat an earlier one exactly (a logger re-sending
     its buffer), as the recorded-run reader drops them, and a finding per block dropped."""
@@ -211,6 +228,7 @@ def drift_data(
         table, repeats = _without_repeated_rows(table)
         findings += repeats
         t = checked_time(table, repeats=False)
+        findings += _time_gap_findings(table, t)
         _check_temperatures(table)
         wanted = [*sensors, *([SPEED] if use_speed else [])]
         if require_targets:
