@@ -1088,3 +1088,30 @@ def test_quality_json_tells_an_axial_probe_not_zeroed_at_the_start(runs_dir, rep
     assert not [f for f in quality["findings"] if f["kind"] == PROBE_NOT_ZEROED]
     whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
     assert not [f for f in whole if f["kind"] == PROBE_NOT_ZEROED]
+
+
+def test_quality_json_tells_an_axial_probe_that_reads_next_to_nothing_at_speed(tmp_path):
+    """A disp_z_um column written in mm (the reference spindle's 11 µm as 0.011) scored
+    -82 381 % deformation accuracy and pulled the estimator's temperatures off, without a
+    word of the cause."""
+    from twin.loop.replay import PROBE_IN_MM, probe_scale_findings
+    from twin.runs import read_run
+
+    t = np.arange(0.0, 1502.0, 2.0)
+    rise = 1.0 - np.exp(-t / 600.0)
+    cols = {"time_s": t, "speed_rpm": np.full(t.size, 9000.0),
+            "ambient_C": np.full(t.size, 22.0),
+            **{f"T{k}_C": 22.0 + amp * rise for k, amp in enumerate([8, 6, 5, 4, 1], 1)}}
+
+    def findings(disp_um: np.ndarray, speed: float = 9000.0) -> list[dict]:
+        path = tmp_path / "run.csv"
+        write_run(path, {**cols, "speed_rpm": np.full(t.size, speed), "disp_z_um": disp_um})
+        return [f for f in probe_scale_findings(read_run(path)) if f["kind"] == PROBE_IN_MM]
+
+    told = findings(0.011 * rise)  # 11 µm, written in mm
+    assert [(f["column"], f["count"], f["detail"]) for f in told] == [
+        ("disp_z_um", t.size, "every reading within ±0.0101 µm through 25 min at speed: "
+                              "in mm?")]
+    assert findings(11.0 * rise) == []  # in µm
+    assert findings(0.011 * rise, speed=0.0) == []  # a stopped spindle drifts nothing
+    assert findings(np.where(t < 1100, 0.011 * rise, np.nan)) == []  # 18 min of readings

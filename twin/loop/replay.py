@@ -361,6 +361,39 @@ def probe_offset_findings(run: RecordedRun) -> list[dict]:
                            f"{PROBE_ZERO_TOLERANCE_UM:g} µm from 0")]
 
 
+PROBE_IN_MM = "probe_in_mm"
+"""quality.json kind of `probe_scale_findings`."""
+
+PROBE_SCALE_SPAN_UM = 0.1
+PROBE_SCALE_RUNNING_S = 1200.0
+"""A probe whose readings stay within ±`PROBE_SCALE_SPAN_UM` through this long at speed is
+told: a spindle drifts micrometres in minutes (the real machine of `examples/real` 0.9 µm
+in its first 10 min at 1250 rpm, the reference spindle 11 µm in 30 min at 9000 rpm)."""
+
+
+def probe_scale_findings(run: RecordedRun) -> list[dict]:
+    """The quality.json finding of an axial probe that reads next to nothing while the
+    spindle runs: a column written in mm (the twin's disp_z_um is µm) scored -82 381 %
+    deformation accuracy and pulled the estimator's temperatures off (99.86 → 97.33 %)
+    without a word of the cause."""
+    if run.disp_um is None or "disp_z_um" not in run.valid:
+        return []
+    valid = run.valid["disp_z_um"]
+    if not valid.any():
+        return []
+    step = np.diff(run.time_s, append=run.time_s[-1])
+    running_s = float(step[(run.speed_rpm > 0) & valid].sum())
+    span = float(np.max(np.abs(run.disp_um[valid, 2])))
+    if running_s < PROBE_SCALE_RUNNING_S or span >= PROBE_SCALE_SPAN_UM:
+        return []
+    return [finding("disp_z_um", PROBE_IN_MM,
+                    "scored as recorded: the column is in µm (a reading in mm is 1000 times "
+                    "too small)",
+                    count=int(valid.sum()),
+                    detail=f"every reading within ±{span:.3g} µm through "
+                           f"{running_s / 60:.0f} min at speed: in mm?")]
+
+
 def initial_temperature_C(run: RecordedRun) -> float:
     first = run.before(np.array([run.time_s[0]]))
     T0 = first.T_valid_C[0]

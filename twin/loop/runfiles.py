@@ -46,6 +46,7 @@ from twin.loop.replay import (
     method_replay_from_json,
     method_replay_to_json,
     probe_offset_findings,
+    probe_scale_findings,
     replay_method,
     tail_findings,
 )
@@ -247,7 +248,8 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     if snapshots != "none":
         _write_snapshots(out_dir, model, results[primary], snapshots, run)
     write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods),
-                                        *tail_findings(run), *probe_offset_findings(run)]),
+                                        *tail_findings(run), *probe_offset_findings(run),
+                                        *probe_scale_findings(run)]),
                   out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
