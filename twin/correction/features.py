@@ -182,7 +182,9 @@ class WindowFeatures:
     """The twin's field and conditions at the window start (set by the loop)."""
     measured_drift_um: np.ndarray | None = None
     """(n,) the recorded axial nose drift at `measured_time_s` (NaN: invalid; None: not
-    recorded).  Only an estimator told to assimilate it reads it."""
+    recorded), less the probe's start reading where it was not zeroed at the run start
+    (`twin.loop.replay.probe_start_offset_um`).  Only an estimator told to assimilate it
+    reads it."""
     measured_speed_rpm: np.ndarray | None = None
     """(n,) the recorded speed at `measured_time_s` (None: not passed).  An estimator
     re-runs the window just ended with it when the speed changed inside that window."""

@@ -342,22 +342,31 @@ nearly seven times the largest probe noise a suite draws (0.3 µm), so that no e
 run's noise is told as an offset."""
 
 
+def probe_start_offset_um(run: RecordedRun) -> float:
+    """The axial probe's reading at the run start where it was not zeroed there (more than
+    `PROBE_ZERO_TOLERANCE_UM` from 0), else 0, µm.  The twin's drift starts at 0 at the run
+    start (its uniform start field), so the correction methods read the probe's change
+    from that reading; the scores compare with the readings as recorded."""
+    if run.disp_um is None or not run.valid.get("disp_z_um", np.zeros(1, bool))[0]:
+        return 0.0
+    first = float(run.disp_um[0, 2])
+    return first if abs(first) > PROBE_ZERO_TOLERANCE_UM else 0.0
+
+
 def probe_offset_findings(run: RecordedRun) -> list[dict]:
     """The quality.json finding of an axial probe that does not read about 0 at the run's
-    start.  The twin's drift starts at 0 there (its uniform start field) and is scored
-    against the readings as recorded: a probe zeroed elsewhere, 50 µm off, scored 15 %
-    deformation accuracy for open loop and pulled the estimator's temperatures off (99.86
-    → 96.80 %) without a word of the cause."""
-    if run.disp_um is None or not run.valid.get("disp_z_um", np.zeros(1, bool))[0]:
-        return []
-    first = float(run.disp_um[0, 2])
-    if abs(first) <= PROBE_ZERO_TOLERANCE_UM:
+    start (`probe_start_offset_um`).  A probe zeroed elsewhere, 50 µm off, scored 15 %
+    deformation accuracy for open loop and, assimilated as recorded, pulled the
+    estimator's temperatures off (99.86 → 96.80 %) without a word of the cause."""
+    offset = probe_start_offset_um(run)
+    if offset == 0.0:
         return []
     return [finding("disp_z_um", PROBE_NOT_ZEROED,
                     "scored as recorded: the twin's drift starts at 0 µm at the run start; "
-                    "zero the probe there (or subtract its first reading)",
+                    "zero the probe there (or subtract its first reading). The estimator "
+                    "reads the change from that reading",
                     rows=run.rows[:1],
-                    detail=f"reads {first:.3g} µm at the start, more than "
+                    detail=f"reads {offset:.3g} µm at the start, more than "
                            f"{PROBE_ZERO_TOLERANCE_UM:g} µm from 0")]
 
 
@@ -463,7 +472,9 @@ def replay_method(
     measured_T = run.T_valid_C
     measured_drift = None
     if run.disp_um is not None and "disp_z_um" in run.valid:
-        measured_drift = np.where(run.valid["disp_z_um"], run.disp_um[:, 2], np.nan)
+        # its change since the run start where the probe was not zeroed there
+        measured_drift = np.where(run.valid["disp_z_um"],
+                                  run.disp_um[:, 2] - probe_start_offset_um(run), np.nan)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)
     starts = WINDOW_S * np.arange(windows)
