@@ -245,6 +245,13 @@ def test_speed_change_carries_the_factor():
     assert ratio[:2] == pytest.approx([1.1, 1.1], rel=1e-9)
     # the resistances also see the (small) Eq. 5 pressure change over the last window
     assert ratio[2:] == pytest.approx([1.1, 1.1], rel=0.01)
+    # C_H, C_C are on the previous values carried to the new speed (Eq. 3's H'): the speed
+    # doubled the nominal heat, not the correction.  On the previous values themselves
+    # every method, open loop too, showed C_H 2 here (1.82 at the bundled run's step)
+    assert c.C_H == pytest.approx((1.0, 1.0), rel=1e-9)
+    assert c.C_C == pytest.approx((1.0, 1.0), rel=0.01)
+    opened = OpenLoop().correct(dataclasses.replace(f, previous=nominal_old))
+    assert (opened.C_H, opened.C_C) == ((1.0, 1.0), (1.0, 1.0))
 
 
 def test_correction_unpacks_and_reports_factors():

@@ -76,7 +76,7 @@ class OpenLoop:
     (`Correction.loads_follow_rings`); False: held at the window start's for the window."""
 
     def correct(self, features: WindowFeatures) -> Correction:
-        return Correction.relative_to(features.nominal, features.previous,
+        return Correction.relative_to(features.nominal, features.carried_previous(),
                                       loads_follow_rings=self.loads_follow_rings)
 
 
@@ -181,7 +181,7 @@ class RatioCorrection:
         g = self.guards
         if features.window == 0:
             # nothing measured yet that the twin could be compared with
-            return Correction.relative_to(features.nominal, features.previous,
+            return Correction.relative_to(features.nominal, features.carried_previous(),
                                           loads_follow_rings=self.loads_follow_rings)
         # a sensor not measured through the window just ended (a dropout, a logger gap)
         # is absent, not read on its last value: every factor it enters is neutral
@@ -242,7 +242,7 @@ class RatioCorrection:
                     R1, C_C, self.metal_factors[k] * nominal[2 + k], noise_step,
                     g.contact.limits)
         values = limit_to_nominal(values, nominal, g)
-        return Correction.relative_to(values, f.previous,
+        return Correction.relative_to(values, f.carried_previous(),
                                       loads_follow_rings=self.loads_follow_rings)
 
 
@@ -409,7 +409,7 @@ class BpnnCorrection:
                 anchor = fallback[i:i + 1] if self.model.anchored else None
                 values[i] = float(self.model.predict(output, x, anchor)[0])
         values = limit_to_nominal(values, nominal, self.guards)
-        return Correction.relative_to(values, features.previous,
+        return Correction.relative_to(values, features.carried_previous(),
                                       loads_follow_rings=self.loads_follow_rings)
 
 

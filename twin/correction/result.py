@@ -1,7 +1,8 @@
 """What a correction method returns for one window (`Correction`) and the method protocol.
 
 A `Correction` unpacks like the 4-tuple (H_front, H_rear, R_front, R_rear) and also carries
-the factors C_H and C_C relative to the previous window, for `corrections.csv`.  An
+the factors C_H and C_C on the previous window's values carried to this window's nominal
+level, for `corrections.csv`.  An
 estimator (`twin.estimation`) may also set model-form factors (motor loss, film groups), the
 analysed field the window starts from, and the spread of its forecast.
 """
@@ -73,7 +74,11 @@ class Correction:
         cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
     ) -> Correction:
         """These values with C_H, C_C on `previous` (1 where that was 0: a stop);
-        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s, coolant_C."""
+        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s, coolant_C.
+        The methods give the previous window's values carried to this window's nominal
+        level (`WindowFeatures.carried_previous`), the H' and R' of Eq. 3 and Eq. 6: a
+        speed change moves the nominal heat, not the correction (on the previous values
+        themselves every method, open loop too, showed C_H 1.82 at a speed step)."""
         v = [float(x) for x in values]
         c = [float(x) for x in correction_factors(v, previous)]
         return cls(*v, C_H=(c[0], c[1]), C_C=(c[2], c[3]), **extra)

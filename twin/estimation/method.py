@@ -573,7 +573,7 @@ class EnsembleEstimator:
                  if k not in BOUNDARY_VALUES and k not in OBSERVATION_ONLY}
         self._band_sd_used = self._band_sd(self._forecast)
         return Correction.relative_to(
-            (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.previous,
+            (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.carried_previous(),
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
             readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
             sensor_lag_s=self._lag_of(self._start), loads_follow_rings=cfg.loads_follow_rings,

@@ -3,7 +3,8 @@
 Layout under DIR/<run-name>/ (shared DESIGN.md):
     keypoints.csv      time_s, method, T1..T5 twin and measured, nose drift twin/measured,
                        and the 90 % band (…_twin_lo/_hi) when a method has one (estimator)
-    corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C, and
+    corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C (on the
+                       previous values carried to this window's nominal level), and
                        <name>_factor for further estimated values (motor, film groups),
                        sensor_lag_s and coolant_C where a method estimates them
     accuracy.json      per-method metrics (twin.loop.metrics)

@@ -129,7 +129,7 @@ class WindowFit:
             driven = driven * np.exp(scatter)
         # the twin advances as every method's twin does: the values are factors on the
         # nominal values, which follow its rings every solver step
-        return Correction.relative_to(driven, f.previous, loads_follow_rings=True)
+        return Correction.relative_to(driven, f.carried_previous(), loads_follow_rings=True)
 
     def _fit(self, f: WindowFeatures, nominal: np.ndarray) -> np.ndarray:
         times = f.start_s + STEP_S * np.arange(1, STEPS_PER_WINDOW + 1)
