@@ -428,6 +428,31 @@ def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     assert f"anchor {anchor:.2f} %" in result.output and f"{anchor:.3f}" not in result.output
 
 
+def test_model_info_says_one_run_and_one_sample_in_the_singular(tmp_path):
+    # a model trained on one run was told as "1 runs"
+    import dataclasses
+
+    from twin.correction.modelfile import load_model, save_model
+
+    model = load_model(_bundled_model(), option=None)
+    meta = {**model.metadata, "training_runs": ["only.csv"], "samples": 1}
+    one = save_model(dataclasses.replace(model, metadata=meta), tmp_path / "one.safetensors")
+    result = CliRunner().invoke(app, ["model-info", str(one)])
+    assert result.exit_code == 0, result.output
+    first = result.output.splitlines()[0]
+    assert ", 1 sample, 1 run, seed " in first, first
+    result = CliRunner().invoke(app, ["model-info", str(_bundled_model())])
+    runs = len(model.metadata["training_runs"])
+    assert f" samples, {runs} runs, seed " in result.output.splitlines()[0]
+
+
+def test_counts_are_said_in_the_singular_for_one():
+    from twin.wording import counted
+
+    assert [counted(n, "run") for n in (0, 1, 2)] == ["0 runs", "1 run", "2 runs"]
+    assert counted(1, "run file") == "1 run file" and counted(3, "run file") == "3 run files"
+
+
 def test_model_info_names_no_option_it_does_not_have(tmp_path, monkeypatch):
     # MODEL is model-info's argument: the error named a '--model' option the user never gave
     monkeypatch.chdir(tmp_path)

@@ -17,6 +17,7 @@ from twin.cli.inputs import (
 )
 from twin.errors import InputError, raise_if_interrupted
 from twin.io.destinations import check_out_dir
+from twin.wording import counted
 
 
 def replay(
@@ -71,7 +72,7 @@ def replay(
                          "replace: choose another --out", file=str(out), column="--out")
     model_path = checked_model(chosen, model)
     console = Console(stderr=True, quiet=quiet)
-    console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
+    console.print(f"replaying {counted(len(paths), 'run')} with {', '.join(chosen)} → {out}")
     if dask:  # an unreachable one takes 20 s to be told
         console.print(f"connecting to the dask scheduler at {dask} …")
 
@@ -157,7 +158,7 @@ def _mean_line(out: Path) -> str:
         d = v.get("deformation_accuracy_pct")
         # a folder may hold runs replayed with other methods: a mean over fewer runs says so
         n = sum(m in r.get("methods", {}) for r in runs)
-        over = "" if n == len(runs) else f" ({n} of {len(runs)} runs)"
+        over = "" if n == len(runs) else f" ({n} of {counted(len(runs), 'run')})"
         parts.append(f"{m}{over}: T {t:.2f} %"
                      + (f", deformation {d:.2f} %" if d is not None else ""))
     return "mean accuracy — " + "; ".join(parts)

@@ -10,6 +10,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError, TomlError
+from twin.wording import counted
 
 if TYPE_CHECKING:
     from twin.plant.profile import SpeedProfile
@@ -143,7 +144,7 @@ def synth(
     run_path, truth_path = write_synth(run, out)
     if not quiet:
         # the run's length and the time the emulation took, each said as what it is
-        typer.echo(f"wrote {run_path} ({run.n_samples} samples over {minutes:g} min, "
+        typer.echo(f"wrote {run_path} ({counted(run.n_samples, 'sample')} over {minutes:g} min, "
                    f"emulated in {run.elapsed_s:.1f} s) and {truth_path}")
 
 
@@ -214,14 +215,14 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
         # a measured run beside the suite is data: --overwrite removed it with the old runs
         listed = ", ".join(p.name for p in foreign[:3]) + (
             f", … and {len(foreign) - 3} more" if len(foreign) > 3 else "")
-        raise InputError(f"holds {len(foreign)} run file(s) twin synth did not write "
+        raise InputError(f"holds {counted(len(foreign), 'run file')} twin synth did not write "
                          f"({listed}); --overwrite removes only runs twin synth wrote: move "
                          "them, or write the suite into another folder",
                          file=str(out), column="--out")
     if stale and not overwrite:
         listed = ", ".join(p.name for p in stale[:3]) + (
             f", … and {len(stale) - 3} more" if len(stale) > 3 else "")
-        raise InputError(f"holds {len(stale)} run file(s) this suite does not write "
+        raise InputError(f"holds {counted(len(stale), 'run file')} this suite does not write "
                          f"({listed}), which 'twin replay {out}' would mix with the new "
                          "runs; write into an empty folder or pass --overwrite to remove "
                          "them", file=str(out), column="--out")
@@ -237,4 +238,4 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
                        f"{time.perf_counter() - t0:.1f} s)")
     if not quiet:
         per_minute = (time.perf_counter() - start) / (n * minutes)
-        typer.echo(f"{n} runs in {out} ({per_minute:.2f} s per run-minute)")
+        typer.echo(f"{counted(n, 'run')} in {out} ({per_minute:.2f} s per run-minute)")

@@ -10,6 +10,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED
 from twin.loop.target_rules import TargetRule
+from twin.wording import counted
 
 MAX_EPOCHS = 100_000
 """Most Rprop epochs `--epochs` takes, 20× the default."""
@@ -106,8 +107,8 @@ def train(
     # the other configuration too, for the report's comparison, where the samples allow it
     for config in (c for c in (DEFAULT, PAPER) if samples.anchors is not None or not c.anchored):
         if not quiet:
-            typer.echo(f"training ({config.name} configuration) on {len(samples)} samples …",
-                       err=True)
+            typer.echo(f"training ({config.name} configuration) on "
+                       f"{counted(len(samples), 'sample')} …", err=True)
         results[config.name] = train_model(samples, config=config, epochs=epochs, seed=seed,
                                            metadata=meta)
     model = results[chosen.name].model
