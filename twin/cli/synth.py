@@ -61,7 +61,8 @@ def synth(
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C]) from 0 s, each "
-                                        "row held until the next; 0 rpm is a stop."),
+                                        "row held until the next; 0 rpm is a stop; steps after "
+                                        "the run's end are left out, with a warning)."),
     scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
                                          "factors, model-form error, sensors, faults; "
                                          "see above)."),
@@ -116,6 +117,8 @@ def synth(
         typer.echo(f"warning: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
                    "speed profile sets time_s, speed_rpm and ambient_C only (the coolant: a "
                    "scenario's [coolant])", err=True)
+    if speed_profile is not None:
+        _tell_steps_after_the_end(speed_profile, profile, minutes)
     truth = load_scenario(scenario, duration_s=60.0 * minutes)
     profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
     if profile_ambient and truth.ambient is not None:
@@ -149,6 +152,24 @@ def synth(
 
 
 synth.__doc__ = SYNTH_HELP
+
+
+def _tell_steps_after_the_end(speed_profile: SpeedProfile, profile: Path | None,
+                              minutes: float) -> None:
+    """Warn (under --quiet too, as the other profile warnings) of the profile's steps after
+    the run's end, which were dropped without a word: a profile longer than the run is a
+    legitimate reuse, so a warning (`twin.plant.profile.steps_after`), not an error."""
+    from twin.errors import place
+    from twin.plant.profile import steps_after
+
+    dropped = steps_after(speed_profile, 60.0 * minutes)
+    if dropped:
+        line, time_s = dropped[0]
+        where = place(str(profile), line, "time_s", row_unit=speed_profile.row_unit)
+        typer.echo(f"warning: {where}: the step at {time_s:g} s is after the run's end "
+                   f"({60.0 * minutes:g} s, --minutes {minutes:g}); "
+                   f"{counted(len(dropped), 'step')} of the profile from there on left "
+                   "out of the run", err=True)
 
 
 def _overridden_options(ambient: float | None, coolant: float | None, truth: Scenario,
