@@ -67,7 +67,7 @@ def train(
     from twin.correction.training_data import run_curves
     from twin.errors import InputError
     from twin.io.destinations import check_out_file
-    from twin.loop.runfiles import check_distinct_names, run_name
+    from twin.loop.runnames import check_distinct_names, run_name
     from twin.loop.training import gate_networks, training_simulator
     from twin.runs import read_table, run_from_table
     from twin.runs.table import check_distinct_tables
