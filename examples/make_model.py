@@ -65,7 +65,8 @@ def main() -> None:
     assert len({SUITE_SEED, GATE_SEED} | set(EVALUATION_SEEDS)) == 2 + len(EVALUATION_SEEDS)
     runs = suite(SUITE_SEED, RUNS, RUNS_DIR)
     gate = suite(GATE_SEED, GATE_RUNS, GATE_DIR)
-    twin("train", *runs, "--out", str(MODEL), "--seed", str(SEED),
+    # the bundled model: train refuses to replace it without the option
+    twin("train", *runs, "--out", str(MODEL), "--replace-bundled-model", "--seed", str(SEED),
          *[arg for path in gate for arg in ("--gate-runs", path)])
 
 

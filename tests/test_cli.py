@@ -428,6 +428,67 @@ def test_model_info_reads_well_and_says_which_networks_the_gate_kept():
     assert f"anchor {anchor:.2f} %" in result.output and f"{anchor:.3f}" not in result.output
 
 
+def test_model_info_says_one_run_and_one_sample_in_the_singular(tmp_path):
+    # a model trained on one run was told as "1 runs"
+    import dataclasses
+
+    from twin.correction.modelfile import load_model, save_model
+
+    model = load_model(_bundled_model(), option=None)
+    meta = {**model.metadata, "training_runs": ["only.csv"], "samples": 1}
+    one = save_model(dataclasses.replace(model, metadata=meta), tmp_path / "one.safetensors")
+    result = CliRunner().invoke(app, ["model-info", str(one)])
+    assert result.exit_code == 0, result.output
+    first = result.output.splitlines()[0]
+    assert ", 1 sample, 1 run, seed " in first, first
+    result = CliRunner().invoke(app, ["model-info", str(_bundled_model())])
+    runs = len(model.metadata["training_runs"])
+    assert f" samples, {runs} runs, seed " in result.output.splitlines()[0]
+
+
+def test_the_bundled_model_is_replaced_only_on_purpose(tmp_path, monkeypatch):
+    # `twin train --out twin/data/correction_model.safetensors` replaced the model every
+    # replay without --model reads, without a word; `make model` still writes it
+    import hashlib
+
+    from twin.cli.inputs import bundled_runs, check_not_bundled_model
+    from twin.data import bundled_path
+
+    monkeypatch.chdir(tmp_path)
+    model = _bundled_model()
+    before = hashlib.sha256(model.read_bytes()).hexdigest()
+    beside = sorted(p.name for p in model.parent.iterdir())
+    run = str(bundled_runs()[0])
+    for out in (bundled_path("correction_model.safetensors"), model):  # the link, the file
+        result = CliRunner().invoke(app, ["train", run, "--out", str(out), "--epochs", "1"])
+        assert result.exit_code == 2
+        assert result.output == (
+            f"error: {out}, option '--out': is the bundled correction model, which every "
+            "replay without --model reads: write elsewhere and pass --model, or pass "
+            "--replace-bundled-model to replace it (as `make model` does)\n")
+        result = CliRunner().invoke(app, ["drift", "fit", run, "--target", "disp_z_um",
+                                          "--out", str(out)])
+        assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
+        assert "is the bundled correction model" in result.output
+    # the option is for the bundled model only: elsewhere its writer may think it updates it
+    result = CliRunner().invoke(app, ["train", run, "--out", "m.safetensors",
+                                      "--replace-bundled-model"])
+    assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
+    assert "option '--replace-bundled-model': is for --out the bundled model" in result.output
+    assert list(tmp_path.iterdir()) == []
+    assert hashlib.sha256(model.read_bytes()).hexdigest() == before
+    assert sorted(p.name for p in model.parent.iterdir()) == beside
+    check_not_bundled_model(model, replace=True)  # what `make model` passes: allowed
+    assert "--replace-bundled-model" in CliRunner().invoke(app, ["train", "--help"]).output
+
+
+def test_counts_are_said_in_the_singular_for_one():
+    from twin.wording import counted
+
+    assert [counted(n, "run") for n in (0, 1, 2)] == ["0 runs", "1 run", "2 runs"]
+    assert counted(1, "run file") == "1 run file" and counted(3, "run file") == "3 run files"
+
+
 def test_model_info_names_no_option_it_does_not_have(tmp_path, monkeypatch):
     # MODEL is model-info's argument: the error named a '--model' option the user never gave
     monkeypatch.chdir(tmp_path)

@@ -302,3 +302,44 @@ def test_a_run_file_name_that_is_not_utf8_is_bad_input(runs, tmp_path):
     assert [r["run"] for r in summary_of(out)["runs"]] == ["b"]
     build_report(out)  # the failure names the file: the page holds it as the terminal shows it
     assert "run\\udcff.csv" in (out / "report.html").read_text()
+
+
+def test_a_failed_run_is_one_line_on_the_console_and_a_name_clash_draws_no_rows(runs,
+                                                                                tmp_path):
+    # the failed run's row stayed, cut to 80 characters ("cannot read 'abc' a"), above
+    # its error printed whole; a name clash drew a row per run before its error
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    shutil.copy(runs / "a.csv", folder / "good.csv")
+    lines = (runs / "b.csv").read_text().splitlines()
+    row = next(k for k, line in enumerate(lines) if line[:1].isdigit()) + 3
+    cells = lines[row].split(",")
+    cells[3] = "abc"
+    lines[row] = ",".join(cells)
+    (folder / "bad.csv").write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", str(folder), "--methods", "open_loop",
+                                      "--snapshots", "none", "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    told = result.output.splitlines()
+    error = (f"error: {folder / 'bad.csv'}, line {row + 1}, column {lines[0].split(',')[3]!r}: "
+             "cannot read 'abc' as a number")
+    assert [line for line in told if "bad" in line] == [error], result.output
+    assert told[0].startswith("replaying 2 runs with open_loop →"), told[0]
+    rows = [line for line in told if line.startswith("good ")]
+    assert len(rows) == 1 and rows[0].split()[-2] == "done", result.output
+    # two runs of one name: the error alone, nothing written
+    other = tmp_path / "other"
+    other.mkdir()
+    shutil.copy(runs / "a.csv", other / "good.csv")
+    out = tmp_path / "out2"
+    result = CliRunner().invoke(app, ["replay", str(folder / "good.csv"), str(other / "good.csv"),
+                                      "--methods", "open_loop", "--out", str(out)])
+    assert result.exit_code == 2
+    assert result.output == (f"error: {folder / 'good.csv'}, {other / 'good.csv'}: two runs "
+                             "share the name 'good' (their file name)\n")
+    assert not out.exists()

@@ -248,6 +248,31 @@ def _unwritable_folders(tmp_path):
     return folders
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="no /proc here")
+def test_an_out_on_proc_is_told_as_the_kernels_files_not_as_missing():
+    # '--out /proc/x' said "cannot write in /proc: No such file or directory" of a folder
+    # that is there: the system's word for a file system that makes no files
+    result = run_cli(app, ["mesh", "--quiet", "--out", "/proc/x.msh"])
+    assert result.exit_code == 2
+    assert result.output == ("error: /proc/x.msh, option '--out': cannot write in /proc: the "
+                             "kernel's proc file system, which holds no files a command can "
+                             "write (choose a folder on a disk)\n")
+
+
+def test_file_system_type_reads_the_innermost_mount():
+    from twin.io.destinations import file_system_type
+
+    mountinfo = ("22 27 0:21 / /proc rw,relatime - proc proc rw\n"
+                 "27 1 8:1 / / rw,relatime shared:1 - ext4 /dev/sda1 rw\n"
+                 "30 27 0:40 / /mnt/my\\040disk rw master:2 - vfat /dev/sdb1 rw\n"
+                 "31 30 0:41 / /mnt/my\\040disk rw - tmpfs tmpfs rw\n")
+    assert file_system_type(Path("/proc/sys"), mountinfo) == "proc"
+    assert file_system_type(Path("/procx"), mountinfo) == "ext4"  # not under /proc
+    assert file_system_type(Path("/mnt/my disk/a"), mountinfo) == "tmpfs"  # stacked: last
+    assert file_system_type(Path("/mnt/my"), mountinfo) == "ext4"
+    assert file_system_type(Path("/x"), "") is None
+
+
 @pytest.mark.parametrize(("command", "name"), [
     (["twin", "synth", "--speed", 9000, "--minutes", 2, "--ambient", 25, "--seed", 1,
       "--quiet"], "new/run.csv"),

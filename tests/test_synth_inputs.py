@@ -271,6 +271,31 @@ def test_faults_after_the_runs_end_are_refused_naming_them(tmp_path):
     assert not out.exists()
 
 
+def test_profile_steps_after_the_runs_end_are_told_naming_the_first(tmp_path):
+    # issue13_speed_steps.csv (steps at 600 and 1500 s) in a 5-min run: the two steps were
+    # dropped without a word, where a scenario fault after the end is refused; a profile
+    # longer than the run is a legitimate reuse, so it is a warning and the run is written
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    path = tmp_path / "steps.csv"
+    path.write_text("# shift\ntime_s,speed_rpm\n0,6500\n300,9000\n600,11500\n1500,8500\n")
+    out = tmp_path / "run.csv"
+    args = ["synth", "--profile", str(path), "--ambient", "22", "--seed", "1", "--quiet"]
+    result = CliRunner().invoke(app, [*args, "--minutes", "5", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.output == (f"warning: {path}, line 5, column 'time_s': the step at 600 s is "
+                             "after the run's end (300 s, --minutes 5); 2 steps of the profile "
+                             "from there on left out of the run\n")
+    assert out.is_file()
+    # a step at the end itself is reached (the run's last sample), as a fault there is
+    result = CliRunner().invoke(app, [*args, "--minutes", "10", "--out", str(out)])
+    assert result.exit_code == 0 and "line 6" in result.output and "1 step of" in result.output
+    result = CliRunner().invoke(app, [*args, "--minutes", "25", "--out", str(out)])
+    assert result.exit_code == 0 and result.output == ""
+
+
 def test_speed_profile(tmp_path):
     path = tmp_path / "p.csv"
     path.write_text("# warm-up then full speed\ntime_s,speed_rpm,ambient_C\n0,6000,24\n"

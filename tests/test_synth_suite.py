@@ -210,7 +210,7 @@ def test_a_suite_into_a_folder_of_an_older_suite_is_refused_naming_the_stale_run
     assert result.exit_code == 2, result.output
     line = result.output.strip()
     assert "\n" not in line and "Traceback" not in line
-    assert "8 run file(s)" in line and "suite1_001.csv" in line and "--overwrite" in line
+    assert "8 run files" in line and "suite1_001.csv" in line and "--overwrite" in line
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # nothing touched
 
     # the same suite again needs no flag; --overwrite leaves only the new suite's runs
@@ -241,7 +241,7 @@ def test_overwrite_removes_only_runs_twin_synth_wrote(tmp_path):
     result = invoke("synth", "--suite", 1, "--seed", 2, "--minutes", 2, "--rate", 0.2,
                     "--out", out, "--overwrite", "--quiet")
     assert result.exit_code == 2
-    assert result.output == (f"error: {out}, option '--out': holds 2 run file(s) twin synth "
+    assert result.output == (f"error: {out}, option '--out': holds 2 run files twin synth "
                              "did not write (notes.csv, real.csv); --overwrite removes only "
                              "runs twin synth wrote: move them, or write the suite into "
                              "another folder\n")

@@ -99,12 +99,14 @@ def fit(
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Fit a drift model; validation leaves one time block out at a time (never shuffled)."""
+    from twin.cli.inputs import check_not_bundled_model
     from twin.drift.data import read_drift_data
     from twin.drift.methods import method_named
     from twin.drift.model import fit_drift_model, listed_sensors
     from twin.drift.modelfile import save_drift_model
 
     check_out_file(out, inputs=data, suffixes=(".safetensors",))
+    check_not_bundled_model(out)
     _check_inputs(data)
     if method is not None:
         method_named(method)

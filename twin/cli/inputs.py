@@ -134,6 +134,36 @@ def bundled_model() -> Path | None:
     return model if model.is_file() else None
 
 
+REPLACE_BUNDLED_MODEL = "--replace-bundled-model"
+"""The `twin train` option that lets --out be the bundled model (`make model` passes it)."""
+
+
+def check_not_bundled_model(out: Path, *, replace: bool | None = None) -> None:
+    """InputError if `out` is the bundled correction model (through the package's link
+    too), which every replay without --model reads: `twin train --out` of it replaced the
+    default model without a word, as a drift model written there would.  `replace`: the
+    value of train's REPLACE_BUNDLED_MODEL (None: a command that has none), which lets
+    train write it (`make model`) and is refused for any other --out, whose writer
+    may think it updates the bundled model."""
+    from twin.io.destinations import same_file
+
+    bundled = bundled_path("correction_model.safetensors").resolve()
+    if not same_file(out, bundled):
+        if replace:
+            raise InputError(f"is for --out the bundled model ({bundled}); this --out is "
+                             "another file: leave the option out", column=REPLACE_BUNDLED_MODEL)
+        return
+    if replace is None:
+        raise InputError("is the bundled correction model, which every replay without "
+                         "--model reads: write this model elsewhere", file=str(out),
+                         column="--out")
+    if not replace:
+        raise InputError("is the bundled correction model, which every replay without "
+                         "--model reads: write elsewhere and pass --model, or pass "
+                         f"{REPLACE_BUNDLED_MODEL} to replace it (as `make model` does)",
+                         file=str(out), column="--out")
+
+
 def check_element_size(spec: SpindleSpec, size_factor: float) -> None:
     """InputError unless `size_factor` leaves the spec's elements at least
     `MIN_ELEMENT_SIZE_MM`: the floor --size-factor keeps on the reference spindle, held on

@@ -12,11 +12,14 @@ def model_info(model: Path = typer.Argument(..., metavar="MODEL",
     """Check a correction model file and print what it was trained on and how well."""
     from twin.cli.train import gated_runs
     from twin.correction.modelfile import load_model
+    from twin.wording import counted
 
     m = load_model(model, option=None)  # an argument, not --model
     meta = m.metadata
-    typer.echo(f"{model}: {meta.get('config')} configuration, {meta.get('samples')} samples, "
-               f"{len(meta.get('training_runs', []))} runs, seed {meta.get('seed')}, "
+    samples = meta.get("samples")
+    told = counted(samples, "sample") if isinstance(samples, int) else f"{samples} samples"
+    typer.echo(f"{model}: {meta.get('config')} configuration, {told}, "
+               f"{counted(len(meta.get('training_runs', [])), 'run')}, seed {meta.get('seed')}, "
                f"targets {meta.get('targets', 'ratio')}")
     for output, r2 in (meta.get("r2") or {}).items():
         typer.echo(f"  {output:18s} R² {_r2(r2.get('value'))}  factor R² {_r2(r2.get('factor'))}")

@@ -17,6 +17,7 @@ from twin.cli.inputs import (
 )
 from twin.errors import InputError, raise_if_interrupted
 from twin.io.destinations import check_out_dir
+from twin.wording import counted
 
 
 def replay(
@@ -70,8 +71,11 @@ def replay(
         raise InputError("is a twin simulate output folder, whose summary.json this would "
                          "replace: choose another --out", file=str(out), column="--out")
     model_path = checked_model(chosen, model)
+    from twin.loop.runnames import named_runs
+
+    named_runs(paths)  # a name clash refused before any progress row is drawn
     console = Console(stderr=True, quiet=quiet)
-    console.print(f"replaying {len(paths)} run(s) with {', '.join(chosen)} → {out}")
+    console.print(f"replaying {counted(len(paths), 'run')} with {', '.join(chosen)} → {out}")
     if dask:  # an unreachable one takes 20 s to be told
         console.print(f"connecting to the dask scheduler at {dask} …")
 
@@ -84,8 +88,8 @@ def replay(
     in_this_process = not dask and (jobs <= 1 or len(paths) <= 1)
     # redrawn when a run finishes, not by rich's refresh thread: a process running no other
     # thread may fork (twin.loop.overlap)
-    # the run names keep their width: a failed run's long status is what gets cut (it is
-    # printed whole after the bar)
+    # the run names keep their width: a status is what gets cut (a failed run's row goes,
+    # and its error is printed whole after the bar)
     names = Column(no_wrap=True, min_width=min(60, max(len(Path(p).stem) for p in paths)))
     with run_plotter(fork=in_this_process) as plotter, Progress(
         TextColumn("{task.description}", table_column=names),
@@ -97,17 +101,30 @@ def replay(
         disable=quiet,
         auto_refresh=False,
     ) as progress:
-        from twin.loop.batch import replay_batch
+        from twin.loop.batch import FAILED, replay_batch
 
         tasks = {Path(p).stem: progress.add_task(Path(p).stem, total=1, status="") for p in paths}
 
         def tell(name: str, status: str) -> None:
-            progress.update(tasks[name], completed=1, status=status[:80], refresh=True)
+            if status.startswith(FAILED):
+                # its error is printed whole after the batch, one line: its row, cut to
+                # the width left and with a bar drawn as if done, went away too late
+                _drop_row(name)
+            else:
+                progress.update(tasks[name], completed=1, status=status, refresh=True)
             raise_if_interrupted()  # a Ctrl-C a library swallowed stops the batch here
+
+        def _drop_row(name: str) -> None:
+            task = tasks.pop(name, None)
+            if task is not None:
+                progress.remove_task(task)
+                progress.refresh()
 
         def tell_window(name: str, method: str, done: int, total: int) -> None:
             # a long run (a 24-h one replays for minutes) showed a bar standing at 0:00:00
             # until it was done: the bar is redrawn here, as no refresh thread may run
+            if name not in tasks:
+                return
             progress.update(tasks[name], completed=done / total,
                             status=f"{100 * done // total} % ({method})", refresh=True)
 
@@ -136,6 +153,8 @@ def replay(
             if out.is_dir():
                 build_report(out)
             raise
+        for failure in result.failed:  # those refused before they started too
+            _drop_row(failure["run"])
     build_report(out, rebuild_summary=False)
     for failure in result.failed:
         typer.echo(f"error: {failure['error']}", err=True)
@@ -157,7 +176,7 @@ def _mean_line(out: Path) -> str:
         d = v.get("deformation_accuracy_pct")
         # a folder may hold runs replayed with other methods: a mean over fewer runs says so
         n = sum(m in r.get("methods", {}) for r in runs)
-        over = "" if n == len(runs) else f" ({n} of {len(runs)} runs)"
+        over = "" if n == len(runs) else f" ({n} of {counted(len(runs), 'run')})"
         parts.append(f"{m}{over}: T {t:.2f} %"
                      + (f", deformation {d:.2f} %" if d is not None else ""))
     return "mean accuracy — " + "; ".join(parts)

@@ -10,6 +10,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError, TomlError
+from twin.wording import counted
 
 if TYPE_CHECKING:
     from twin.plant.profile import SpeedProfile
@@ -60,7 +61,8 @@ def synth(
     speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
     profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C]) from 0 s, each "
-                                        "row held until the next; 0 rpm is a stop."),
+                                        "row held until the next; 0 rpm is a stop; steps after "
+                                        "the run's end are left out, with a warning)."),
     scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
                                          "factors, model-form error, sensors, faults; "
                                          "see above)."),
@@ -115,6 +117,8 @@ def synth(
         typer.echo(f"warning: {profile}: column(s) {', '.join(speed_profile.ignored)} ignored: a "
                    "speed profile sets time_s, speed_rpm and ambient_C only (the coolant: a "
                    "scenario's [coolant])", err=True)
+    if speed_profile is not None:
+        _tell_steps_after_the_end(speed_profile, profile, minutes)
     truth = load_scenario(scenario, duration_s=60.0 * minutes)
     profile_ambient = speed_profile is not None and speed_profile.ambient_C is not None
     if profile_ambient and truth.ambient is not None:
@@ -143,11 +147,29 @@ def synth(
     run_path, truth_path = write_synth(run, out)
     if not quiet:
         # the run's length and the time the emulation took, each said as what it is
-        typer.echo(f"wrote {run_path} ({run.n_samples} samples over {minutes:g} min, "
+        typer.echo(f"wrote {run_path} ({counted(run.n_samples, 'sample')} over {minutes:g} min, "
                    f"emulated in {run.elapsed_s:.1f} s) and {truth_path}")
 
 
 synth.__doc__ = SYNTH_HELP
+
+
+def _tell_steps_after_the_end(speed_profile: SpeedProfile, profile: Path | None,
+                              minutes: float) -> None:
+    """Warn (under --quiet too, as the other profile warnings) of the profile's steps after
+    the run's end, which were dropped without a word: a profile longer than the run is a
+    legitimate reuse, so a warning (`twin.plant.profile.steps_after`), not an error."""
+    from twin.errors import place
+    from twin.plant.profile import steps_after
+
+    dropped = steps_after(speed_profile, 60.0 * minutes)
+    if dropped:
+        line, time_s = dropped[0]
+        where = place(str(profile), line, "time_s", row_unit=speed_profile.row_unit)
+        typer.echo(f"warning: {where}: the step at {time_s:g} s is after the run's end "
+                   f"({60.0 * minutes:g} s, --minutes {minutes:g}); "
+                   f"{counted(len(dropped), 'step')} of the profile from there on left "
+                   "out of the run", err=True)
 
 
 def _overridden_options(ambient: float | None, coolant: float | None, truth: Scenario,
@@ -214,14 +236,14 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
         # a measured run beside the suite is data: --overwrite removed it with the old runs
         listed = ", ".join(p.name for p in foreign[:3]) + (
             f", … and {len(foreign) - 3} more" if len(foreign) > 3 else "")
-        raise InputError(f"holds {len(foreign)} run file(s) twin synth did not write "
+        raise InputError(f"holds {counted(len(foreign), 'run file')} twin synth did not write "
                          f"({listed}); --overwrite removes only runs twin synth wrote: move "
                          "them, or write the suite into another folder",
                          file=str(out), column="--out")
     if stale and not overwrite:
         listed = ", ".join(p.name for p in stale[:3]) + (
             f", … and {len(stale) - 3} more" if len(stale) > 3 else "")
-        raise InputError(f"holds {len(stale)} run file(s) this suite does not write "
+        raise InputError(f"holds {counted(len(stale), 'run file')} this suite does not write "
                          f"({listed}), which 'twin replay {out}' would mix with the new "
                          "runs; write into an empty folder or pass --overwrite to remove "
                          "them", file=str(out), column="--out")
@@ -237,4 +259,4 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
                        f"{time.perf_counter() - t0:.1f} s)")
     if not quiet:
         per_minute = (time.perf_counter() - start) / (n * minutes)
-        typer.echo(f"{n} runs in {out} ({per_minute:.2f} s per run-minute)")
+        typer.echo(f"{counted(n, 'run')} in {out} ({per_minute:.2f} s per run-minute)")

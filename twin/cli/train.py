@@ -8,8 +8,9 @@ from pathlib import Path
 
 import typer
 
-from twin.cli.inputs import MAX_SEED
+from twin.cli.inputs import MAX_SEED, REPLACE_BUNDLED_MODEL
 from twin.loop.target_rules import TargetRule
+from twin.wording import counted
 
 MAX_EPOCHS = 100_000
 """Most Rprop epochs `--epochs` takes, 20× the default."""
@@ -44,6 +45,12 @@ def train(
         "default networks replays besides the held-out runs; never trained on (repeat the "
         "option for more).",
     ),
+    replace_bundled: bool = typer.Option(
+        False, REPLACE_BUNDLED_MODEL,
+        help="Let --out be the bundled model (twin/data/correction_model.safetensors, "
+        "which every replay without --model reads); refused without it. `make model` "
+        "passes it.",
+    ),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     """Train the 6-10-1 heat and 6-12-1 contact-resistance networks of both bearings.
@@ -51,7 +58,7 @@ def train(
     Writes MODEL and, beside it, MODEL.report.json and MODEL.report.html
     (loss curves, R² of both configurations, predicted vs target).
     """
-    from twin.cli.inputs import expand_run_folders
+    from twin.cli.inputs import check_not_bundled_model, expand_run_folders
     from twin.correction.modelfile import save_model
     from twin.correction.network import DEFAULT, PAPER
     from twin.correction.report import report_paths, write_report
@@ -60,7 +67,7 @@ def train(
     from twin.correction.training_data import run_curves
     from twin.errors import InputError
     from twin.io.destinations import check_out_file
-    from twin.loop.runfiles import check_distinct_names, run_name
+    from twin.loop.runnames import check_distinct_names, run_name
     from twin.loop.training import gate_networks, training_simulator
     from twin.runs import read_table, run_from_table
     from twin.runs.table import check_distinct_tables
@@ -69,6 +76,7 @@ def train(
     runs, gate_runs = expand_run_folders(runs), expand_run_folders(list(gate_runs or []))
     check_out_file(out, inputs=runs + gate_runs, also=report_paths(out),
                    suffixes=(".safetensors",))  # what replay --model and model-info read
+    check_not_bundled_model(out, replace=replace_bundled)
     # realpath: resolve() raised RuntimeError on a symlink loop, an internal error
     trained = {os.path.realpath(path) for path in runs}
     for path in gate_runs:  # the gate measures the networks on runs they never saw
@@ -106,8 +114,8 @@ def train(
     # the other configuration too, for the report's comparison, where the samples allow it
     for config in (c for c in (DEFAULT, PAPER) if samples.anchors is not None or not c.anchored):
         if not quiet:
-            typer.echo(f"training ({config.name} configuration) on {len(samples)} samples …",
-                       err=True)
+            typer.echo(f"training ({config.name} configuration) on "
+                       f"{counted(len(samples), 'sample')} …", err=True)
         results[config.name] = train_model(samples, config=config, epochs=epochs, seed=seed,
                                            metadata=meta)
     model = results[chosen.name].model

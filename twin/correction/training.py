@@ -25,6 +25,7 @@ from twin.correction.network import (
 )
 from twin.correction.samples import SampleSet
 from twin.errors import InputError
+from twin.wording import counted
 
 
 @dataclass(frozen=True)
@@ -66,8 +67,8 @@ def train_model(
     """Train the four networks with one shared 80/20 split drawn from `seed`: whole runs are
     held out (`split_by_run`) when the samples come from two runs or more."""
     if len(samples) < 5:
-        raise InputError(f"too few training samples ({len(samples)} windows); need at least "
-                         "5: give more or longer runs")
+        raise InputError(f"too few training samples ({counted(len(samples), 'window')}); "
+                         "need at least 5: give more or longer runs")
     if config.anchored and samples.anchors is None:
         raise ValueError("the anchored networks need samples with the ratio-law anchor "
                          "(window-fit targets, `--targets fit`)")

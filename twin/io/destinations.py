@@ -15,7 +15,9 @@ repeats the regular-file check right before its rename (`atomic_target`).
 
 from __future__ import annotations
 
+import errno
 import os
+import re
 import stat
 import tempfile
 from collections.abc import Iterable, Sequence
@@ -68,8 +70,53 @@ def _check_writable(folder: Path, target: Path, option: str | None) -> None:
         with tempfile.TemporaryFile(dir=folder):
             pass
     except OSError as exc:
-        raise InputError(f"cannot write in {folder}: {exc.strerror or exc}",
+        raise InputError(f"cannot write in {folder}: {_why_unwritable(folder, exc)}",
                          file=str(target), column=option) from None
+
+
+KERNEL_FILE_SYSTEMS = frozenset({
+    "proc", "sysfs", "cgroup", "cgroup2", "debugfs", "tracefs", "securityfs", "configfs",
+    "pstore", "bpf", "efivarfs", "binfmt_misc", "fusectl", "devpts", "mqueue", "hugetlbfs"})
+"""File systems through which the kernel shows itself (Linux): no command makes files
+there, whatever the permissions say."""
+
+
+def _why_unwritable(folder: Path, exc: OSError) -> str:
+    """Why no file can be made in `folder`, as a user can act on it.  The system's words
+    alone misled: /proc said 'No such file or directory' of a folder that is there."""
+    kind = file_system_type(folder)
+    if kind in KERNEL_FILE_SYSTEMS:
+        return (f"the kernel's {kind} file system, which holds no files a command can "
+                "write (choose a folder on a disk)")
+    if exc.errno == errno.EROFS:
+        return "the file system is mounted read-only"
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return "permission denied (this user may not make files there)"
+    if exc.errno == errno.ENOENT:  # the folder is there (it was found): the system said no
+        return f"the file system refuses new files there ({exc.strerror})"
+    return str(exc.strerror or exc)
+
+
+def file_system_type(path: Path, mountinfo: str | None = None) -> str | None:
+    """The type of the file system `path` is on (`proc`, `ext4`, ...) from Linux's
+    /proc/self/mountinfo (or the text `mountinfo`); None where it cannot be told."""
+    if mountinfo is None:
+        try:
+            mountinfo = Path("/proc/self/mountinfo").read_text()
+        except OSError:  # not Linux, or no /proc
+            return None
+    where = os.path.realpath(path)
+    best, kind = "", None
+    for line in mountinfo.splitlines():
+        fields = line.split()
+        if "-" not in fields[6:] or len(fields) < 5:
+            continue
+        # the mount point, with the octal escapes of a space, tab, newline, backslash
+        mount = re.sub(r"\\([0-7]{3})", lambda m: chr(int(m.group(1), 8)), fields[4])
+        inside = where == mount or where.startswith(mount.rstrip("/") + "/")
+        if inside and len(mount) >= len(best):  # the last of mounts stacked on one point
+            best, kind = mount, fields[fields.index("-", 6) + 1]
+    return kind
 
 
 def refuse_special(target: Path, option: str | None = "--out") -> None:

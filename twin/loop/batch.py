@@ -22,12 +22,11 @@ from twin.loop.folders import folder_lock, remove_orphans
 from twin.loop.overlap import ForkedTask, held_interrupts
 from twin.loop.runfiles import (
     add_snapshots,
-    check_distinct_names,
     is_done,
     replay_run_to_dir,
     resume_token,
-    run_name,
 )
+from twin.loop.runnames import named_runs, run_name
 from twin.loop.summary import collect_summary, read_accuracy
 
 if TYPE_CHECKING:
@@ -142,15 +141,8 @@ def replay_batch(
     """
     out_root = Path(out_root)
     result = BatchResult()
-    named: list[tuple[str, str]] = []
-    for path in runs:
-        try:
-            named.append((str(path), run_name(path)))
-        except InputError as exc:
-            result.failed.append({"error": str(exc), "kind": "input", "run": Path(path).stem,
-                                  "path": str(path)})
+    named, result.failed = named_runs(runs)  # two of one name: refused before any write
     names = [n for _, n in named]
-    check_distinct_names(named)  # refused before anything is written
     named = [(path, name) for path, name in named
              if not _refused_folder(out_root / name, path, result)]
     planned = False  # a Ctrl-C before the batch is planned has nothing to clean up
@@ -341,13 +333,17 @@ def _ignore_interrupts() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
+FAILED = "failed"
+"""How a failed run's status begins, as `replay_batch` tells `progress` (`failed: ERROR`)."""
+
+
 def _tell(progress: Callable[[str, str], None] | None, outcome: dict) -> None:
     if progress is None:
         return
     if "ok" in outcome:
         progress(outcome["ok"]["run"], "done")
     else:
-        progress(outcome["run"], f"failed: {outcome['error']}")
+        progress(outcome["run"], f"{FAILED}: {outcome['error']}")
 
 
 def write_summary(out_root: Path, failed: list[dict], attempted: Sequence[str] = ()) -> dict:

@@ -51,6 +51,7 @@ from twin.loop.replay import (
     replay_method,
     tail_findings,
 )
+from twin.loop.runnames import run_name
 from twin.version import code_identity
 
 if TYPE_CHECKING:
@@ -70,33 +71,6 @@ def file_digest(path: str | Path) -> str:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
-
-
-def run_name(path: str | Path) -> str:
-    """The run's folder name under DIR: the file name without its suffix.  A name that is
-    not one plain folder name (`..csv`, a leading dot) is refused: it would point at DIR
-    itself or hide among the temporary files."""
-    name = Path(path).stem
-    if not name or name.startswith(".") or name != Path(name).name:
-        raise InputError(f"{name!r} cannot name a run folder (a leading dot or a path)",
-                         file=str(path))
-    try:
-        name.encode()
-    except UnicodeEncodeError:  # bytes that are not UTF-8: no report could hold the name
-        raise InputError("the file name is not UTF-8 text, and it names the run's folder "
-                         "and reports: rename the file", file=str(path)) from None
-    return name
-
-
-def check_distinct_names(named: Sequence[tuple[str, str]]) -> None:
-    """Refuse two runs of one name ((path, `run_name`) pairs), naming both files: a run is
-    known by its file name (its folder under DIR, its place in a training split), not by
-    a `# name:` line, which a logger may write alike into every file."""
-    names = [name for _, name in named]
-    shared = sorted({name for name in names if names.count(name) > 1})
-    if shared:
-        raise InputError(f"two runs share the name {shared[0]!r} (their file name)",
-                         file=", ".join(path for path, name in named if name == shared[0]))
 
 
 def resume_token(path: str | Path, methods: Sequence[str], model_path: str | None,

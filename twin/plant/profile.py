@@ -73,3 +73,16 @@ def read_speed_profile(path: str | os.PathLike[str]) -> SpeedProfile:
     return SpeedProfile(StepTable(time, speed), ambient,
                         tuple(int(row) for row in table.rows), tuple(table.ignored_columns),
                         table.row_unit)
+
+
+def steps_after(profile: SpeedProfile, duration_s: float) -> list[tuple[int | None, float]]:
+    """(file line, time) of each step that starts after a run of `duration_s` ends, which
+    the emulator never reaches (a line of None for a profile not read from a file).
+
+    Told, not refused (a scenario's fault after the end is refused): a fault placed after
+    the end is a mistake in a file written for that run, while a profile longer than the
+    run is a legitimate reuse (a shift's profile emulated for its first minutes).  A step
+    at the end itself is reached (its last sample), as a fault at the end is."""
+    times = profile.speed_rpm.time_s
+    return [(profile.rows[k] if profile.rows else None, float(t))
+            for k, t in enumerate(times) if t > duration_s]
