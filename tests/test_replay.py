@@ -1006,20 +1006,22 @@ def test_the_mean_line_says_over_how_many_runs_a_method_is_averaged(runs_dir, tm
 
 
 def test_the_report_leaves_a_gap_in_c_h_at_a_stop():
-    # C_H is a window's heat over the previous one's: 0 at a stop and the fallback 1 after
-    # it; the report drew the line down to 0 at every stop, "the correction went to zero"
+    # C_H is on the previous heat carried to this window's nominal level: the fallback 1
+    # at a stop, no correction; the window after it compares with the factor from before
+    # the stop.  (On the previous heat itself it was 0 at a stop, and the report drew the
+    # line down to 0 at every stop, "the correction went to zero".)
     from pathlib import Path
 
     from twin.loop.report import _Columns, _running_factor
 
     corr = _Columns(Path("corrections.csv"), {
         "H_front": ["1e6", "1.1e6", "0", "0", "9e5", "1e6"],
-        "C_H_front": ["1", "1.1", "0", "1", "1", "1.11"],
+        "C_H_front": ["1", "1.1", "1", "1", "0.98", "1.11"],
         "C_C_front": ["1", "0.9", "1", "1", "1", "1.2"],
     })
     sel = np.ones(6, dtype=bool)
     np.testing.assert_array_equal(_running_factor(corr, "C_H_front", sel),
-                                  [1, 1.1, np.nan, np.nan, np.nan, 1.11])
+                                  [1, 1.1, np.nan, np.nan, 0.98, 1.11])
     np.testing.assert_array_equal(_running_factor(corr, "C_C_front", sel),
                                   [1, 0.9, 1, 1, 1, 1.2])
 

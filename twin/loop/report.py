@@ -315,15 +315,16 @@ def drift_figure(kp: _Columns, corr: _Columns, run: str) -> Figure:
 
 
 def _running_factor(corr: _Columns, key: str, sel: np.ndarray) -> np.ndarray:
-    """corrections.csv's `key` for the rows `sel`, with a gap where a C_H compares a window
-    of a stopped bearing (heat 0) or the one after it: 0 and the fallback 1 there are no
-    correction, and the line fell to 0 at every stop as if the correction had."""
+    """corrections.csv's `key` for the rows `sel`, with a gap where a C_H is a stopped
+    bearing's (heat 0): its fallback 1 there is no correction (and on the previous values
+    themselves, before C_H was on the carried ones, the line fell to 0 at every stop as if
+    the correction had).  The window after a stop compares with the factor from before
+    the stop, a correction like any other."""
     values = corr.numbers(key)[sel]
     if not key.startswith("C_H_"):
         return values
     running = corr.numbers("H_" + key.removeprefix("C_H_"))[sel] > 0
-    after_stop = np.concatenate(([False], ~running[:-1]))
-    return np.where(running & ~after_stop, values, np.nan)
+    return np.where(running, values, np.nan)
 
 
 def run_plotter(fork: bool = True) -> ForkedTask:
