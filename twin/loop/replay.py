@@ -76,6 +76,7 @@ from twin.correction.features import (
     TwinState,
     WindowFeatures,
     correction_factors,
+    rows_between,
     window_observed,
 )
 from twin.correction.rerun import (
@@ -292,10 +293,9 @@ def held_correction_findings(run: RecordedRun, methods: Sequence[str]) -> list[d
         action += "; the estimator leaves its unobserved bins out"
     measured = run.T_valid_C
     ends = WINDOW_S * np.arange(1, n_windows(run))  # window k's correction reads up to 60k s
-    lo = np.searchsorted(run.time_s, ends - WINDOW_S - 1e-9, side="right")
-    hi = np.searchsorted(run.time_s, ends + 1e-9, side="right")
-    unseen = np.array([~window_observed(run.time_s[a:b], measured[a:b], end)
-                       for a, b, end in zip(lo, hi, ends, strict=True)]).reshape(-1, 5)
+    spans = [rows_between(run.time_s, end - WINDOW_S - 1e-9, end + 1e-9) for end in ends]
+    unseen = np.array([~window_observed(run.time_s[rows], measured[rows], end)
+                       for rows, end in zip(spans, ends, strict=True)]).reshape(-1, 5)
     found = []
     for column in sorted({*RING_SENSOR.values(), *SLEEVE_SENSOR.values()}):
         stretches = true_runs(unseen[:, column])
