@@ -1153,3 +1153,32 @@ def test_quality_json_tells_an_axial_probe_that_reads_next_to_nothing_at_speed(t
     assert findings(11.0 * rise) == []  # in µm
     assert findings(0.011 * rise, speed=0.0) == []  # a stopped spindle drifts nothing
     assert findings(np.where(t < 1100, 0.011 * rise, np.nan)) == []  # 18 min of readings
+
+
+def test_a_probe_not_zeroed_whose_first_samples_are_missing_is_read_from_its_first_reading(
+        tmp_path):
+    """A probe 50 µm off whose log starts a few seconds late (its first cells blank, a gap
+    too long to fill) was taken as zeroed: no probe_not_zeroed finding, and the estimator
+    assimilated it as recorded.  Its first valid reading, inside the run's first window, is
+    its start reading."""
+    from twin.loop.replay import PROBE_NOT_ZEROED, probe_offset_findings, probe_start_offset_um
+    from twin.runs import read_run
+
+    t = np.arange(0.0, 600.0, 1.0)
+    rise = 1.0 - np.exp(-t / 600.0)
+    disp = 50.0 + 3.0 * rise
+    late = 40  # the probe logs from 40 s on
+    cols = {"time_s": t, "speed_rpm": np.full(t.size, 9000.0),
+            "ambient_C": np.full(t.size, 22.0),
+            **{f"T{k}_C": 22.0 + amp * rise for k, amp in enumerate([8, 6, 5, 4, 1], 1)},
+            "disp_z_um": np.where(t < late, np.nan, disp)}
+    write_run(tmp_path / "late.csv", cols)
+    run = read_run(tmp_path / "late.csv")
+    assert not run.valid["disp_z_um"][0]  # the leading gap is not filled in
+    assert probe_start_offset_um(run) == pytest.approx(disp[late], abs=1e-3)
+    told = probe_offset_findings(run)
+    assert [(f["kind"], f["rows"]) for f in told] == [(PROBE_NOT_ZEROED, [int(run.rows[late])])]
+    assert told[0]["detail"].startswith("reads 50.2 µm at 40 s,")
+    # a probe that starts logging after the first window is not read as zeroed there
+    write_run(tmp_path / "later.csv", {**cols, "disp_z_um": np.where(t < 90, np.nan, disp)})
+    assert probe_start_offset_um(read_run(tmp_path / "later.csv")) == 0.0

@@ -488,6 +488,10 @@ def test_a_spreadsheets_separator_line_is_read_past(tmp_path):
                  "cannot read 'x")  # the lines keep their editor's numbers
     expect_error(write(tmp_path, "sep=;\n" + clean.replace(",", ";")), 1, None,
                  "the first line says the file is separated by ';'")
+    # a tab there, Excel's hint for a tab-separated export, was stripped with the blanks
+    # and "sep=" taken for the header ("missing required column (the header has sep=)")
+    expect_error(write(tmp_path, "sep=\t\n" + clean.replace(",", "\t")), 1, None,
+                 "the first line says the file is separated by '\\t'")
     # below the header it is a data line like any other
     expect_error(write(tmp_path, clean + "sep=,\n"), len(lines) + 1, None,
                  "expected 8 fields as in the header, found 2")

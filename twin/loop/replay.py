@@ -76,6 +76,7 @@ from twin.correction.features import (
     TwinState,
     WindowFeatures,
     correction_factors,
+    rows_between,
     window_observed,
 )
 from twin.correction.rerun import (
@@ -292,10 +293,9 @@ def held_correction_findings(run: RecordedRun, methods: Sequence[str]) -> list[d
         action += "; the estimator leaves its unobserved bins out"
     measured = run.T_valid_C
     ends = WINDOW_S * np.arange(1, n_windows(run))  # window k's correction reads up to 60k s
-    lo = np.searchsorted(run.time_s, ends - WINDOW_S - 1e-9, side="right")
-    hi = np.searchsorted(run.time_s, ends + 1e-9, side="right")
-    unseen = np.array([~window_observed(run.time_s[a:b], measured[a:b], end)
-                       for a, b, end in zip(lo, hi, ends, strict=True)]).reshape(-1, 5)
+    spans = [rows_between(run.time_s, end - WINDOW_S - 1e-9, end + 1e-9) for end in ends]
+    unseen = np.array([~window_observed(run.time_s[rows], measured[rows], end)
+                       for rows, end in zip(spans, ends, strict=True)]).reshape(-1, 5)
     found = []
     for column in sorted({*RING_SENSOR.values(), *SLEEVE_SENSOR.values()}):
         stretches = true_runs(unseen[:, column])
@@ -342,14 +342,30 @@ nearly seven times the largest probe noise a suite draws (0.3 µm), so that no e
 run's noise is told as an offset."""
 
 
+def probe_start_reading(run: RecordedRun) -> int | None:
+    """The sample of the axial probe's start reading: its first valid one where that lies
+    in the run's first window (a probe whose log starts late, its first cells a gap too
+    long to fill), else None (no probe, or none read that early: the twin's drift may have
+    moved by then)."""
+    if run.disp_um is None or "disp_z_um" not in run.valid:
+        return None
+    valid = np.flatnonzero(run.valid["disp_z_um"])
+    if not valid.size or run.time_s[valid[0]] - run.time_s[0] > WINDOW_S:
+        return None
+    return int(valid[0])
+
+
 def probe_start_offset_um(run: RecordedRun) -> float:
-    """The axial probe's reading at the run start where it was not zeroed there (more than
-    `PROBE_ZERO_TOLERANCE_UM` from 0), else 0, µm.  The twin's drift starts at 0 at the run
-    start (its uniform start field), so the correction methods read the probe's change
-    from that reading; the scores compare with the readings as recorded."""
-    if run.disp_um is None or not run.valid.get("disp_z_um", np.zeros(1, bool))[0]:
+    """The axial probe's start reading (`probe_start_reading`) where it was not zeroed
+    there (more than `PROBE_ZERO_TOLERANCE_UM` from 0), else 0, µm.  The twin's drift
+    starts at 0 at the run start (its uniform start field), so the correction methods read
+    the probe's change from that reading; the scores compare with the readings as
+    recorded.  Read only at the first sample, as until 2026-11-27, a probe 50 µm off whose
+    first cells were blank was taken as zeroed and assimilated as recorded."""
+    i = probe_start_reading(run)
+    if i is None or run.disp_um is None:
         return 0.0
-    first = float(run.disp_um[0, 2])
+    first = float(run.disp_um[i, 2])
     return first if abs(first) > PROBE_ZERO_TOLERANCE_UM else 0.0
 
 
@@ -359,14 +375,16 @@ def probe_offset_findings(run: RecordedRun) -> list[dict]:
     deformation accuracy for open loop and, assimilated as recorded, pulled the
     estimator's temperatures off (99.86 → 96.80 %) without a word of the cause."""
     offset = probe_start_offset_um(run)
-    if offset == 0.0:
+    i = probe_start_reading(run)
+    if offset == 0.0 or i is None:
         return []
+    when = "the start" if i == 0 else f"{run.time_s[i] - run.time_s[0]:g} s"
     return [finding("disp_z_um", PROBE_NOT_ZEROED,
                     "scored as recorded: the twin's drift starts at 0 µm at the run start; "
                     "zero the probe there (or subtract its first reading). The estimator "
                     "reads the change from that reading",
-                    rows=run.rows[:1],
-                    detail=f"reads {offset:.3g} µm at the start, more than "
+                    rows=run.rows[i:i + 1],
+                    detail=f"reads {offset:.3g} µm at {when}, more than "
                            f"{PROBE_ZERO_TOLERANCE_UM:g} µm from 0")]
 
 

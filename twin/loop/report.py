@@ -36,6 +36,7 @@ from twin.loop.metrics import DISTRIBUTION_METRICS, batch_summary, metric_values
 from twin.loop.overlap import ForkedTask
 from twin.loop.summary import collect_summary, run_folder
 from twin.runs.quality import SAMPLES, finding_count
+from twin.wording import counted
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -460,11 +461,13 @@ def _finding_row(finding: object) -> dict[str, str]:
     spans = [f"{a:g}" if a == b else f"{a:g}–{b:g}" for a, b in finding.get("spans_s") or []]
     shown = ", ".join(spans[:MAX_SPANS_SHOWN]) + (" …" if len(spans) > MAX_SPANS_SHOWN else "")
     # the column is "samples": a count of anything else says what it counts ("2 windows")
-    count, counted = finding_count(finding)
-    if count is None or counted == SAMPLES:
+    count, what = finding_count(finding)
+    if count is None or what == SAMPLES:
         count_cell = "" if count is None else str(count)
-    else:  # "2 windows", "1 window"
-        count_cell = f"{count} {counted.removesuffix('s') if count == 1 else counted}"
+    elif isinstance(count, int):  # "2 windows", "1 window"
+        count_cell = counted(count, what.removesuffix("s"), what)
+    else:  # a hand-edited file: shown as it is
+        count_cell = f"{count} {what}"
     return {"column": str(finding.get("column", "")), "kind": str(finding.get("kind", "")),
             "count": count_cell, "spans": shown,
             "action": str(finding.get("action", "")), "detail": str(finding.get("detail", ""))}

@@ -56,7 +56,7 @@ def read_csv_table(path: str | os.PathLike[str],
                 if key.strip():
                     metadata[key.strip()] = value.strip()
             continue
-        if header is None and is_separator_hint(stripped, file, number):
+        if header is None and is_separator_hint(line, file, number):
             continue
         if header is None:
             header = without_trailing_blanks(
@@ -112,7 +112,10 @@ def is_separator_hint(line: str, file: str, number: int) -> bool:
     """True for the `sep=,` line above the header that Excel reads as the separator to use
     (some exports write it): read past.  Another separator there is an `InputError`, in the
     words of `check_comma_separated`.  The hint was taken for the header ("line 2: expected
-    1 fields as in the header, found 12")."""
+    1 fields as in the header, found 12").  `line` as read: only its spaces are stripped,
+    so that a tab named there (`sep=\t`, a tab-separated export) is told, not read as the
+    header "sep=" (a missing required column)."""
+    line = line.strip(" ")
     if len(line) != 5 or line[:4].lower() != "sep=":
         return False
     if line[4] != ",":
