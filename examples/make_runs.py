@@ -1,7 +1,9 @@
 """Regenerate the bundled demo runs in examples/runs/ (`make examples`).
 
 Deterministic: the same seeds, speeds and ambients give the same files.  Each run comes
-with RUN.truth.csv (the emulator's truth, for evaluation only).
+with RUN.truth.csv (the emulator's truth, for evaluation only).  Written by `twin synth
+--replace-bundled-runs`: without the option every command refuses an --out there, since
+every `twin replay` without RUN reads these runs.
 
     spindle_9000rpm_30min        the reference paper's Table 1 case (25.34 °C ambient)
     spindle_7800rpm_30min        validation speeds of the paper (not in its training set)
@@ -12,11 +14,12 @@ with RUN.truth.csv (the emulator's truth, for evaluation only).
 
 from __future__ import annotations
 
+import subprocess
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent))
+ROOT = HERE.parent
 
 RATE_HZ = 0.5  # small files; the run contract accepts down to one sample per 10 s
 
@@ -30,26 +33,17 @@ RUNS = [
 
 
 def main() -> None:
-    from twin.plant.emulator import synthesize, write_synth
-    from twin.plant.profile import read_speed_profile
-    from twin.plant.scenario import load_scenario
-
-    out_dir = HERE / "runs"
-    out_dir.mkdir(exist_ok=True)
+    (HERE / "runs").mkdir(exist_ok=True)
     for name, speed, ambient, seed, profile, scenario in RUNS:
-        scenario_path = HERE / "scenarios" / scenario if scenario else None
-        profile_path = HERE / "scenarios" / profile if profile else None
-        run = synthesize(
-            speed_rpm=speed,
-            profile=read_speed_profile(profile_path) if profile_path else None,
-            minutes=30.0, ambient_C=ambient, seed=seed, rate_hz=RATE_HZ,
-            scenario=load_scenario(scenario_path),
-            scenario_name=f"examples/scenarios/{scenario}" if scenario else None,
-            profile_name=f"examples/scenarios/{profile}" if profile else None,
-        )
-        path, truth = write_synth(run, out_dir / f"{name}.csv")
-        print(f"{path.relative_to(HERE.parent)}  ({run.n_samples} samples, "
-              f"{run.elapsed_s:.1f} s)  + {truth.name}")
+        # relative to ROOT: the run's header names its profile and scenario as given
+        args = ["--speed", f"{speed:g}"] if speed is not None else [
+            "--profile", f"examples/scenarios/{profile}"]
+        if scenario:
+            args += ["--scenario", f"examples/scenarios/{scenario}"]
+        subprocess.run([sys.executable, "-m", "twin", "synth", *args, "--minutes", "30",
+                        "--ambient", f"{ambient:g}", "--seed", str(seed), "--rate",
+                        f"{RATE_HZ:g}", "--out", f"examples/runs/{name}.csv",
+                        "--replace-bundled-runs"], check=True, cwd=ROOT)
 
 
 if __name__ == "__main__":

@@ -994,3 +994,74 @@ def test_a_dot_is_still_the_current_folder(tmp_path, monkeypatch):
         main()
     assert exit_.value.code == 0
     assert (tmp_path / "summary.json").is_file()
+
+
+def _bundled_runs_listing() -> dict[str, str]:
+    import hashlib
+
+    from twin.cli.inputs import bundled_runs_dir
+
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(bundled_runs_dir().iterdir())}
+
+
+@pytest.mark.parametrize("argv", [
+    ["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1",
+     "--out", "RUNS/spindle_9000rpm_30min.csv"],
+    ["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1",
+     "--out", "RUNS/new.csv"],
+    ["synth", "--suite", "1", "--seed", "1", "--minutes", "3", "--out", "RUNS"],
+    ["simulate", "--speed", "9000", "--minutes", "1", "--ambient", "25", "--out", "RUNS/sim"],
+    ["replay", "--methods", "open_loop", "--out", "RUNS"],
+    ["drift", "fit", "RUN", "--target", "disp_z_um", "--out", "RUNS/d.safetensors"],
+    ["drift", "report", "MODEL", "RUN", "--out", "RUNS/report"],
+    ["mesh", "--out", "RUNS/reference_spindle.msh"],
+    ["snapshot", "RUN", "--time", "60", "--out", "RUNS/s.png"],
+])
+@pytest.mark.parametrize("runs", ["package", "repository"])
+def test_the_bundled_runs_are_replaced_only_on_purpose(argv, runs, tmp_path, monkeypatch):
+    # `twin synth --out examples/runs/spindle_9000rpm_30min.csv` replaced a run every
+    # default replay reads, without a word; `make examples` still writes them
+    from twin.cli.inputs import bundled_runs_dir
+    from twin.data import bundled_path
+
+    monkeypatch.chdir(tmp_path)
+    folder = bundled_path("runs") if runs == "package" else bundled_runs_dir()
+    run = str(folder / "spindle_9000rpm_30min.csv")
+    model = str(_bundled_model())
+    before = _bundled_runs_listing()
+    argv = [a.replace("RUNS", str(folder)) for a in argv]
+    argv = [run if a == "RUN" else model if a == "MODEL" else a for a in argv]
+    result = CliRunner().invoke(app, argv)
+    assert result.exit_code == 2, result.output
+    out = argv[argv.index("--out") + 1]
+    assert result.output == (
+        f"error: {out}, option '--out': lies in the bundled runs ({bundled_runs_dir()}), "
+        "which every `twin replay` without RUN reads: write elsewhere"
+        + (", or pass --replace-bundled-runs to replace them (as `make examples` does)"
+           if argv[0] == "synth" else "") + "\n")
+    assert _bundled_runs_listing() == before
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_synth_replaces_a_bundled_run_with_the_option_only(tmp_path, monkeypatch):
+    import pathlib
+
+    from twin.cli.inputs import bundled_runs_dir
+    from twin.io.destinations import check_not_bundled_runs
+
+    monkeypatch.chdir(tmp_path)
+    synth = ["synth", "--speed", "9000", "--minutes", "3", "--ambient", "25", "--seed", "1"]
+    # the option is for the bundled runs only: elsewhere its writer may think it updates them
+    result = CliRunner().invoke(app, [*synth, "--out", "r.csv", "--replace-bundled-runs"])
+    assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
+    assert "option '--replace-bundled-runs': is for an --out in the bundled runs" \
+        in result.output
+    assert list(tmp_path.iterdir()) == []
+    # what `make examples` passes (examples/make_runs.py): allowed, for a run and a suite
+    check_not_bundled_runs(bundled_runs_dir() / "spindle_9000rpm_30min.csv", replace=True)
+    check_not_bundled_runs(bundled_runs_dir(), replace=True)
+    check_not_bundled_runs(tmp_path / "r.csv")  # elsewhere, without the option: allowed
+    assert "--replace-bundled-runs" in CliRunner().invoke(app, ["synth", "--help"]).output
+    make_runs = pathlib.Path(__file__).resolve().parents[1] / "examples" / "make_runs.py"
+    assert "--replace-bundled-runs" in make_runs.read_text()

@@ -10,6 +10,7 @@ import typer
 
 from twin.cli.inputs import MAX_SEED, RANGE_C
 from twin.errors import InputError, TomlError
+from twin.io.destinations import REPLACE_BUNDLED_RUNS
 from twin.wording import counted
 
 if TYPE_CHECKING:
@@ -79,6 +80,11 @@ def synth(
                                    "runs twin synth wrote already in the --out folder that "
                                    "this suite does not write (without it they are an "
                                    "error; another run file there is one in any case)."),
+    replace_bundled: bool = typer.Option(
+        False, REPLACE_BUNDLED_RUNS,
+        help="Let --out lie in the bundled runs (twin/data/runs, examples/runs/ in the "
+        "repository, which every replay without RUN reads); refused without it. `make "
+        "examples` passes it."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
     from twin.cli.inputs import COMPANION_SUFFIXES, check_operating_options
@@ -93,7 +99,7 @@ def synth(
         _synth_suite(suite, seed, 40.0 if minutes is None else minutes, rate, out,
                      given={"--speed": speed, "--profile": profile, "--scenario": scenario,
                             "--ambient": ambient, "--coolant": coolant},
-                     overwrite=overwrite, quiet=quiet)
+                     overwrite=overwrite, quiet=quiet, replace_bundled=replace_bundled)
         return
     if (speed is None) == (profile is None):
         raise InputError("give exactly one of --speed and --profile (or --suite)",
@@ -109,7 +115,7 @@ def synth(
                          "the files synth writes beside a run, which 'twin replay FOLDER' "
                          "leaves out", file=str(out), column="--out")
     check_out_file(out, inputs=[profile, scenario], also=[truth_path_for(out)],
-                   suffixes=(".csv", ".parquet"))
+                   suffixes=(".csv", ".parquet"), replace_bundled_runs=replace_bundled)
     speed_profile = None if profile is None else read_speed_profile(profile)
     if speed_profile is not None and speed_profile.ignored:
         # a warning, shown under --quiet too (which silences progress): a misspelt
@@ -199,7 +205,8 @@ def _overridden_options(ambient: float | None, coolant: float | None, truth: Sce
 
 
 def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
-                 given: dict[str, object], overwrite: bool, quiet: bool) -> None:
+                 given: dict[str, object], overwrite: bool, quiet: bool,
+                 replace_bundled: bool = False) -> None:
     """`--suite N`: draw N cases and write each one's four files into the folder `out`.
 
     Runs already in `out` that this suite does not write (an older suite's) are refused,
@@ -222,7 +229,7 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
         # then passes over (it lists files)
         raise InputError("--suite writes a folder of runs, not a run file: name a folder "
                          "(or leave --suite out for one run)", file=str(out), column="--out")
-    check_out_dir(out)
+    check_out_dir(out, replace_bundled_runs=replace_bundled)
     # one nominal truth model for the whole suite (each run adds its own material factors)
     model = SpindleModel.load(size_factor=Scenario().model.size_factor)
     limit = model.spec.spindle.max_speed_rpm

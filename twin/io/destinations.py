@@ -8,6 +8,11 @@ it over the target.  That rename must never replace something that is not an out
 - an existing non-regular file: a device (`--out /dev/null` run as root would replace the
   system's /dev/null by a regular file), a fifo or a socket, directly or through a symlink.
 
+Nor may it write into the bundled example runs (`twin.data`'s runs/, examples/runs/ in the
+repository), which every `twin replay` without RUN reads: `twin synth --out
+examples/runs/spindle_9000rpm_30min.csv` replaced one without a word.  `twin synth
+--replace-bundled-runs` writes there (`make examples`).
+
 `check_out_file` and `check_out_dir` refuse such a target with an `InputError` (exit 2)
 naming it; commands call them first, before reading or computing anything.  The writer
 repeats the regular-file check right before its rename (`atomic_target`).
@@ -23,6 +28,7 @@ import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+from twin.data import bundled_path
 from twin.errors import InputError
 from twin.paths import regular_file_info
 
@@ -119,6 +125,32 @@ def file_system_type(path: Path, mountinfo: str | None = None) -> str | None:
     return kind
 
 
+REPLACE_BUNDLED_RUNS = "--replace-bundled-runs"
+"""The `twin synth` option that lets --out lie in the bundled runs (`make examples`)."""
+
+
+def check_not_bundled_runs(target: StrPath, option: str | None = "--out",
+                           replace: bool | None = None) -> None:
+    """InputError if `target` is the bundled runs' folder or lies in it (through the
+    package's link too).  `replace`: the value of REPLACE_BUNDLED_RUNS (None: a command
+    that has none), which lets `twin synth` write there and is refused for a target
+    elsewhere, whose writer may think it updates the bundled runs."""
+    try:
+        bundled = bundled_path("runs")
+    except RuntimeError:  # a zipped install: no runs folder to write into
+        return
+    inside = _inside(Path(target), bundled)
+    if replace and not inside:
+        raise InputError(f"is for an --out in the bundled runs ({bundled.resolve()}); this "
+                         "--out is elsewhere: leave the option out", column=REPLACE_BUNDLED_RUNS)
+    if inside and not replace:
+        hint = "" if replace is None else f", or pass {REPLACE_BUNDLED_RUNS} to replace them " \
+            "(as `make examples` does)"
+        raise InputError(f"lies in the bundled runs ({bundled.resolve()}), which every "
+                         f"`twin replay` without RUN reads: write elsewhere{hint}",
+                         file=str(target), column=option)
+
+
 def refuse_special(target: Path, option: str | None = "--out") -> None:
     """InputError if `target` exists (through any symlink) and is not a regular file."""
     # nothing there (or a dangling symlink, which the rename replaces) is fine
@@ -127,15 +159,18 @@ def refuse_special(target: Path, option: str | None = "--out") -> None:
 
 def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
                    option: str | None = "--out", also: Iterable[StrPath] = (),
-                   suffixes: Sequence[str] = ()) -> Path:
+                   suffixes: Sequence[str] = (), replace_bundled_runs: bool | None = None
+                   ) -> Path:
     """`out` as a Path if a command may write the file there (see the module doc).
 
     `inputs` are the files the command reads; `also` are further files it writes beside
     `out` (`RUN.truth.csv`, `MODEL.report.json`), checked the same way.  `suffixes`, if
     given, are the ones `out` may end in, in any case (`S.PNG` too): another name was
     written in a format it does not name, or refused by the writer after the work.
+    `replace_bundled_runs`: `check_not_bundled_runs`' `replace`.
     """
     target = Path(out)
+    check_not_bundled_runs(target, option, replace_bundled_runs)
     _check_ancestors(target, option)
     read = [Path(p) for p in inputs if p is not None]
     for written in (target, *(Path(p) for p in also)):
@@ -152,15 +187,18 @@ def check_out_file(out: StrPath, inputs: Iterable[StrPath | None] = (),
 
 def check_out_dir(out: StrPath, inputs: Iterable[StrPath | None] = (),
                   option: str | None = "--out", owned: Iterable[str] = (),
-                  files: Iterable[str] = ()) -> Path:
+                  files: Iterable[str] = (), replace_bundled_runs: bool | None = None
+                  ) -> Path:
     """`out` as a Path if a command may write its output folder there.
 
     The folder may exist (its other contents stay) or not (it is created).  `owned` are
     the names inside it the command replaces (files or whole folders): no input may lie
     there.  `files` are owned names the command writes as files: a folder (or device,
     fifo) there is refused now, not once the work is done.
+    `replace_bundled_runs`: `check_not_bundled_runs`' `replace`.
     """
     target = Path(out)
+    check_not_bundled_runs(target, option, replace_bundled_runs)
     files = list(files)
     owned = [*owned, *files]
     if not (target.exists() or target.is_symlink()):

@@ -263,10 +263,25 @@ def _write_snapshots(out_dir: Path, model: SpindleModel, r: MethodReplay, snapsh
                      run: RecordedRun) -> None:
     from twin.loop.snapshot import render_snapshot, snapshot_title
 
+    clim = frames_range(model, snapshots, r.fields)
     for t in _window_ends(r.fields, snapshots):
         render_snapshot(model, r.fields[t], out_dir / _snapshot_name(r.method, t),
                         title=snapshot_title(run.name, r.method, t, run),
-                        T_initial_C=r.T_initial_C)
+                        T_initial_C=r.T_initial_C, clim=clim)
+
+
+def frames_range(model: SpindleModel, snapshots: str,
+                 fields: dict[float, np.ndarray]) -> tuple[float, float] | None:
+    """The colour range the snapshots `snapshots` asks for share: with `every`, the range
+    of the temperature over all the run's window-end `fields` of the method pictured (the
+    frames of one run are compared and played as a sequence); else None, the picture's
+    own field's range (one picture, as `twin snapshot` draws).  The replay and --resume's
+    `add_snapshots` (from the field files) both take it here."""
+    from twin.loop.snapshot import colour_range
+
+    if snapshots != "every":
+        return None
+    return colour_range(model, (fields[t] for t in sorted(fields)), "temperature")
 
 
 def _snapshot_name(method: str, t: float) -> str:
@@ -298,16 +313,23 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
         return 0
     model = SpindleModel.load()
     run = read_run(run_path, max_speed_rpm=model.spec.spindle.max_speed_rpm)
-    for t in wanted:
+
+    def field_at(t: float) -> np.ndarray:
         path = out_dir / _field_name(primary, t)
         if not path.is_file():
             raise InputError("no field file to draw the snapshot from", file=str(path))
         T = read_vtu(path).point_data.get("temperature_C")
         if T is None or np.shape(T) != (model.n_dofs,) or not np.all(np.isfinite(T)):
             raise InputError("no temperature_C array of the spindle's vertices", file=str(path))
-        render_snapshot(model, np.asarray(T, float), out_dir / _snapshot_name(primary, t),
+        return np.asarray(T, float)
+
+    # every frame's range is over all the window ends, drawn or kept: read them all then
+    shown = {t: field_at(t) for t in (ends if snapshots == "every" else wanted)}
+    clim = frames_range(model, snapshots, shown)
+    for t in wanted:
+        render_snapshot(model, shown[t], out_dir / _snapshot_name(primary, t),
                         title=snapshot_title(run_name(run_path), primary, t, run),
-                        T_initial_C=initial_temperature_C(run))
+                        T_initial_C=initial_temperature_C(run), clim=clim)
     return len(wanted)
 
 

@@ -5,6 +5,9 @@ so the section itself shows on the two cut faces; `section=True` draws the flat 
 view instead.  The scalar bar carries units; the shown field's largest value is marked
 (the hottest point, or the largest displacement) and the hottest point and the nose
 drift are stated.  `twin replay --snapshots` and `twin snapshot` both use `render_snapshot`.
+A picture's colours span its own field's range unless it is given `clim`: the frames of
+`twin replay --snapshots every` share the run's range (`colour_range`), so that one colour
+is one value in all of them.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from __future__ import annotations
 import os
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
@@ -51,11 +54,44 @@ def render_snapshot(
     T_initial_C: float | None = None,
     section: bool = False,
     window_size: tuple[int, int] = (1200, 800),
+    clim: tuple[float, float] | None = None,
 ) -> Path:
     """Render one field state to a PNG (written atomically); returns the path.  A Ctrl-C
-    meanwhile is taken once the picture is done (`ctrl_c_after`)."""
+    meanwhile is taken once the picture is done (`ctrl_c_after`).  `clim`: the colour
+    range (the field's unit), stated on the colour bar as the run's; None: this field's."""
     with ctrl_c_after():
-        return _render(model, T, out_png, field, title, T_initial_C, section, window_size)
+        return _render(model, T, out_png, field, title, T_initial_C, section, window_size,
+                       clim)
+
+
+def shown_values(arrays: dict[str, np.ndarray], field: str) -> np.ndarray:
+    """What a picture of `field` colours, from `field_arrays`' point arrays: the
+    temperature, or the displacement's magnitude."""
+    if field not in FIELDS:
+        raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")
+    values = arrays[FIELDS[field][0]]
+    return np.linalg.norm(values, axis=1) if values.ndim == 2 else values
+
+
+def colour_range(model: SpindleModel, fields: Iterable[np.ndarray], field: str = "temperature",
+                 T_initial_C: float | None = None) -> tuple[float, float]:
+    """The colour range of a run's frames: the lowest and highest value `field` takes over
+    all the `fields` (temperature vectors, `render_snapshot`'s T).  The frames of a replay
+    each spanned their own field's range (23.0–45.2 °C in one, 23.3–42.2 °C in the next),
+    so that a colour meant another temperature in each.  The temperature is read off the
+    vectors; the displacement needs `field_arrays`' structural solve of each."""
+    from twin.spindle.fields import field_arrays
+
+    n = model.mesh.thermal.p.shape[1]
+    low, high = np.inf, -np.inf
+    for T in fields:
+        arrays = ({"temperature_C": np.asarray(T[:n], float)} if field == "temperature"
+                  else field_arrays(model, T, T_initial_C))
+        values = shown_values(arrays, field)
+        low, high = min(low, float(values.min())), max(high, float(values.max()))
+    if not low <= high:
+        raise ValueError("no field to take a colour range from")
+    return low, high
 
 
 @contextmanager
@@ -79,7 +115,8 @@ def ctrl_c_after() -> Iterator[None]:
 
 
 def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str, title: str,
-            T_initial_C: float | None, section: bool, window_size: tuple[int, int]) -> Path:
+            T_initial_C: float | None, section: bool, window_size: tuple[int, int],
+            clim: tuple[float, float] | None) -> Path:
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
 
@@ -92,7 +129,7 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
 
     if field not in FIELDS:
         raise ValueError(f"field must be one of {', '.join(FIELDS)}, got {field!r}")
-    key, label, cmap = FIELDS[field]
+    _, label, cmap = FIELDS[field]
     arrays = field_arrays(model, T, T_initial_C)
     mesh = model.mesh
     n = mesh.thermal.p.shape[1]
@@ -102,9 +139,7 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
     points[:, 2] = 1e3 * mesh.thermal.p[1]
     cells = np.hstack([np.full((mesh.n_cells, 1), 3), mesh.thermal.t.T]).ravel()
     surf = pv.PolyData(points, cells)
-    values = arrays[key]
-    if values.ndim == 2:
-        values = np.linalg.norm(values, axis=1)
+    values = shown_values(arrays, field)
     surf.point_data[label] = values
     if section:
         body = surf
@@ -121,8 +156,10 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
         cmap=cmap,
         show_edges=False,
         smooth_shading=True,
+        clim=None if clim is None else list(clim),
         scalar_bar_args={
-            "title": label,
+            # the bar's ends are the run's range then, not this frame's: said on it
+            "title": label if clim is None else f"{label}\nrun's range, every frame",
             "color": "black",
             "fmt": "%.1f",
             "vertical": True,
