@@ -55,7 +55,8 @@ def _options(
 def run(
     deck: Path = typer.Argument(..., metavar="DECK", help="The APDL deck (.inp, .mac, "
                                 ".cdb); /INPUT is resolved in its folder."),
-    out: Path = typer.Option(..., "--out", help="Output folder (created if missing)."),
+    out: Path = typer.Option(..., "--out", metavar="DIR",
+                             help="Output folder (created if missing)."),
     quiet: bool = typer.Option(False, "--quiet", help="No summary on success (warnings are "
                                "still told, on stderr)."),
     strict: bool = typer.Option(False, "--strict", help="An unknown or unsupported command "
@@ -64,7 +65,8 @@ def run(
                                  "loaded as the twin loads it (nodes, elements, materials, "
                                  "components, contact real sets 101..): the database a "
                                  "replay's decks/window_kkk.inp run on."),
-    start: Path = typer.Option(None, "--start", help="With --spindle: the temperature state "
+    start: Path = typer.Option(None, "--start", metavar="FILE",
+                               help="With --spindle: the temperature state "
                                "(a replay's decks/window_kkk_start.vtu, or a result_NNN.vtu "
                                "of an earlier run) at its TIME, which a deck's "
                                "ANTYPE,TRANS,REST continues from."),
@@ -130,8 +132,9 @@ def _spindle_session(base_dir: Path, strict: bool) -> Session:
 @app.command("export-cdb", cls=PlainHelpCommand)
 @report_errors
 def export_cdb(
-    out: Path = typer.Option(..., "--out", help="The archive to write (.cdb)."),
-    mesh: Path = typer.Option(None, "--mesh", help="A gmsh .msh instead of the default "
+    out: Path = typer.Option(..., "--out", metavar="FILE.cdb", help="The archive to write (.cdb)."),
+    mesh: Path = typer.Option(None, "--mesh", metavar="FILE.msh",
+                              help="A gmsh .msh instead of the default "
                                                    "spindle mesh (materials then omitted; "
                                                    "a spindle mesh's contact faces are kept "
                                                    "apart, as in the default)."),

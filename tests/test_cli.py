@@ -928,6 +928,9 @@ def test_help_names_arguments_plainly_at_80_columns(usage, command):
     assert result.exit_code == 0, result.output
     text = result.output
     assert not re.search(r"[{}]|<list\[| range>|\[Path\]", text), text
+    # an option's value is named as DESIGN.md names it (`--out DIR`, `--speed RPM`), not by
+    # its Python type (typer's `--out <path>`, `--speed <float>`); choices stay `<a|b>`
+    assert not re.search(r"<(path|float|int|integer|str|text)>", text), text
     assert max(len(line) for line in text.splitlines()) <= 80
     usage_line = " ".join(text.split("\n\n")[0].split())
     assert "<" not in usage_line, usage_line
@@ -939,10 +942,15 @@ def test_help_names_arguments_plainly_at_80_columns(usage, command):
 
 
 @pytest.mark.parametrize("path, usage, rows", [
-    (["replay"], "twin replay [OPTIONS] [RUN]...", ["  RUN...  recorded runs"]),
+    (["replay"], "twin replay [OPTIONS] [RUN]...",
+     ["  RUN...  recorded runs", "  --out DIR ", "  --model MODEL ", "  --jobs N ",
+      "  --dask ADDRESS "]),
     (["report"], "twin report [OPTIONS] DIR", ["  DIR  a replay output folder"]),
     (["train"], "twin train [OPTIONS] RUN...", ["  RUN...  Recorded runs", "--gate-runs RUN "]),
-    (["snapshot"], "twin snapshot [OPTIONS] RUN", ["  --time <float> "]),
+    (["snapshot"], "twin snapshot [OPTIONS] RUN", ["  --time S ", "  --out FILE.png "]),
+    (["simulate"], "twin simulate [OPTIONS]",
+     ["  --speed RPM ", "  --minutes M ", "  --ambient C ", "  --out DIR "]),
+    (["synth"], "twin synth [OPTIONS]", ["  --seed N ", "  --profile CSV ", "  --scenario TOML "]),
     (["drift", "predict"], "twin drift predict [OPTIONS] MODEL DATA",
      ["  MODEL  Drift model file.", "  DATA   Data file"]),
     (["drift", "report"], "twin drift report [OPTIONS] MODEL DATA...", ["  DATA...  Data"]),

@@ -84,17 +84,21 @@ def fit(
     data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet): "
                                       "time_s, optional speed_rpm, *_C temperatures, *_um "
                                       "drifts."),
-    target: str = typer.Option(..., "--target", help="Displacement column(s) to model, "
+    target: str = typer.Option(..., "--target", metavar="COL[,COL...]",
+                               help="Displacement column(s) to model, "
                                "comma-separated (e.g. ch1_um,ch2_um)."),
-    out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
+    out: Path = typer.Option(..., "--out", metavar="MODEL",
+                             help="Model file to write (.safetensors)."),
     method: str | None = typer.Option(
-        None, "--method", help="Force a method: mlr, ridge_lagged, ridge_dynamic, bp, bayes, "
+        None, "--method", metavar="M",
+        help="Force a method: mlr, ridge_lagged, ridge_dynamic, bp, bayes, "
         "stack. Default: the best of all by time-blocked validation."),
     sensors: str = typer.Option(
-        "auto", "--sensors", help="auto (best of every correlation cluster), K (best K of "
+        "auto", "--sensors", metavar="S",
+        help="auto (best of every correlation cluster), K (best K of "
         "those; more than there are clusters is an error), all, or a comma-separated list "
         "of temperature columns."),
-    seed: int = typer.Option(0, "--seed", min=0, max=MAX_SEED,
+    seed: int = typer.Option(0, "--seed", metavar="N", min=0, max=MAX_SEED,
                              help="Seed of the network weights and k-means."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
@@ -140,7 +144,8 @@ def predict(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
     data: Path = typer.Argument(..., metavar="DATA", help="Data file: time_s, speed_rpm (if "
                                 "the model uses it) and the model's temperature columns."),
-    out: Path = typer.Option(..., "--out", help="PRED.csv to write: time_s and per target "
+    out: Path = typer.Option(..., "--out", metavar="PRED.csv",
+                             help="PRED.csv to write: time_s and per target "
                              "<target>, <target>_lo, <target>_hi (90 % interval)."),
     quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
 ) -> None:
@@ -168,7 +173,8 @@ def report(
     model_file: Path = typer.Argument(..., metavar="MODEL", help="Drift model file."),
     data: list[Path] = typer.Argument(..., metavar="DATA",
                                help="Data files holding the model's targets."),
-    out: Path = typer.Option(..., "--out", help="Folder for metrics.json and report.html."),
+    out: Path = typer.Option(..., "--out", metavar="DIR",
+                             help="Folder for metrics.json and report.html."),
     quiet: bool = typer.Option(False, "--quiet", help="No notes on stderr."),
 ) -> None:
     """Write metrics.json and a self-contained report.html (measured vs predicted)."""
@@ -195,9 +201,11 @@ def report(
 @report_errors
 def select(
     data: list[Path] = typer.Argument(..., metavar="DATA", help="Data files (CSV or Parquet)."),
-    target: str = typer.Option(..., "--target", help="Displacement column(s), comma-separated."),
-    top: int | None = typer.Option(None, "--top", min=1, help="Show only the best K."),
-    out: Path | None = typer.Option(None, "--out", help="Also write the ranking as JSON."),
+    target: str = typer.Option(..., "--target", metavar="COL[,COL...]",
+                               help="Displacement column(s), comma-separated."),
+    top: int | None = typer.Option(None, "--top", metavar="K", min=1, help="Show only the best K."),
+    out: Path | None = typer.Option(None, "--out", metavar="FILE.json",
+                                    help="Also write the ranking as JSON."),
 ) -> None:
     """Rank the temperature sensors: grey relational grade (ρ = 0.5), correlation clusters."""
     from twin.drift.data import read_drift_data

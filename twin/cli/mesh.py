@@ -10,12 +10,14 @@ from twin.cli.inputs import MAX_SIZE_FACTOR, MIN_SIZE_FACTOR, between, check_ele
 
 
 def mesh(
-    out: Path = typer.Option(..., "--out", help="Mesh file to write (.msh, gmsh 2.2)."),
+    out: Path = typer.Option(..., "--out", metavar="FILE.msh",
+                             help="Mesh file to write (.msh, gmsh 2.2)."),
     spec: Path | None = typer.Option(
-        None, "--spec", help="Spindle spec TOML (default: the bundled reference spindle)."
+        None, "--spec", metavar="TOML",
+        help="Spindle spec TOML (default: the bundled reference spindle)."
     ),
     size_factor: float = typer.Option(
-        1.0, "--size-factor", callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
+        1.0, "--size-factor", metavar="F", callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
         help="Element size multiplier (< 1 refines).",
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),

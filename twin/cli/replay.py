@@ -25,15 +25,18 @@ def replay(
         None, metavar="RUN", help="recorded runs (CSV/Parquet) or folders of them, e.g. a "
         "`twin synth --suite` folder; none: the bundled example runs"
     ),
-    out: Path = typer.Option(..., "--out", help="output folder"),
-    model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
+    out: Path = typer.Option(..., "--out", metavar="DIR", help="output folder"),
+    model: Path | None = typer.Option(None, "--model", metavar="MODEL",
+                                      help="correction model (bpnn)"),
     methods: str = typer.Option(
-        "open_loop,ratio,bpnn,estimator", "--methods", callback=method_list,
+        "open_loop,ratio,bpnn,estimator", "--methods", metavar="M[,M...]", callback=method_list,
         help="comma-separated: open_loop, ratio, bpnn, estimator",
     ),
-    jobs: int = typer.Option(1, "--jobs", min=1, max=256, help="local worker processes"),
+    jobs: int = typer.Option(1, "--jobs", metavar="N", min=1, max=256,
+                             help="local worker processes"),
     dask: str | None = typer.Option(
-        None, "--dask", callback=dask_address, help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
+        None, "--dask", metavar="ADDRESS", callback=dask_address,
+        help="address of a dask.distributed scheduler, e.g. tcp://127.0.0.1:8786"
     ),
     snapshots: WindowEnds = typer.Option(
         WindowEnds.END, "--snapshots", help="field pictures: none, at the end, every window"

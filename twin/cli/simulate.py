@@ -17,23 +17,24 @@ from twin.cli.inputs import (
 
 
 def simulate_command(
-    speed: float = typer.Option(..., "--speed", help="Spindle speed, rpm."),
-    minutes: float = typer.Option(..., "--minutes", callback=between(0.0),
+    speed: float = typer.Option(..., "--speed", metavar="RPM", help="Spindle speed, rpm."),
+    minutes: float = typer.Option(..., "--minutes", metavar="M", callback=between(0.0),
                                   help="Duration, minutes (rounded up to whole 4 s "
                                   "steps)."),
-    ambient: float = typer.Option(..., "--ambient", help="Ambient temperature, °C "
+    ambient: float = typer.Option(..., "--ambient", metavar="C", help="Ambient temperature, °C "
                                   f"({RANGE_C})."),
-    out: Path = typer.Option(..., "--out", help="Output directory."),
+    out: Path = typer.Option(..., "--out", metavar="DIR", help="Output directory."),
     coolant: float | None = typer.Option(
-        None, "--coolant", help=f"Coolant inlet temperature, °C ({RANGE_C}; default: the "
+        None, "--coolant", metavar="C",
+        help=f"Coolant inlet temperature, °C ({RANGE_C}; default: the "
         "ambient)."
     ),
-    spec: Path | None = typer.Option(None, "--spec", help="Spindle spec TOML."),
-    size_factor: float = typer.Option(1.0, "--size-factor",
+    spec: Path | None = typer.Option(None, "--spec", metavar="TOML", help="Spindle spec TOML."),
+    size_factor: float = typer.Option(1.0, "--size-factor", metavar="F",
                                       callback=between(MIN_SIZE_FACTOR, MAX_SIZE_FACTOR),
                                       help="Mesh size multiplier."),
     field_every: float = typer.Option(
-        60.0, "--field-every", min=0.0, help="Seconds between field snapshots, to the "
+        60.0, "--field-every", metavar="S", min=0.0, help="Seconds between field snapshots, to the "
         "nearest whole 4 s step (0: only the end)."
     ),
     quiet: bool = typer.Option(False, "--quiet", help="Print nothing on success."),

@@ -13,11 +13,13 @@ from twin.io.destinations import check_out_file
 
 def snapshot(
     run: Path = typer.Argument(..., metavar="RUN", help="recorded run (CSV/Parquet)"),
-    time_s: float = typer.Option(..., "--time", min=0.0, help="run time of the picture, s"),
-    out: Path = typer.Option(..., "--out", help="PNG file"),
+    time_s: float = typer.Option(..., "--time", metavar="S", min=0.0,
+                                 help="run time of the picture, s"),
+    out: Path = typer.Option(..., "--out", metavar="FILE.png", help="PNG file"),
     field: Field = typer.Option(Field.TEMPERATURE, "--field", help="the field shown"),
     method: Method = typer.Option(Method.BPNN, "--method", help="correction method"),
-    model: Path | None = typer.Option(None, "--model", help="correction model (bpnn)"),
+    model: Path | None = typer.Option(None, "--model", metavar="MODEL",
+                                      help="correction model (bpnn)"),
     section: bool = typer.Option(False, "--section", help="flat r–z section, not 3-D"),
 ) -> None:
     """Headless picture of the twin's field at a time of a recorded run."""

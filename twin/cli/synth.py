@@ -47,31 +47,37 @@ truth still differs from the twin: motor ±15 %, films ±25 %, conductivity
 
 
 def synth(
-    out: Path = typer.Option(..., "--out", help="Recorded run to write (RUN.csv or "
+    out: Path = typer.Option(..., "--out", metavar="RUN.csv|DIR",
+                             help="Recorded run to write (RUN.csv or "
                              "RUN.parquet; the truth goes to RUN.truth.csv beside it), or "
                              "with --suite the folder of the suite's files."),
-    seed: int = typer.Option(..., "--seed", min=0, max=MAX_SEED,
+    seed: int = typer.Option(..., "--seed", metavar="N", min=0, max=MAX_SEED,
                              help="Seed of every random choice (deterministic)."),
-    minutes: float | None = typer.Option(None, "--minutes", min=2.0, max=24 * 60.0,
+    minutes: float | None = typer.Option(None, "--minutes", metavar="M", min=2.0, max=24 * 60.0,
                                          help="Run length, minutes (two 60 s windows at "
                                          "least; --suite: default 40)."),
-    ambient: float | None = typer.Option(None, "--ambient", help="Ambient temperature at the "
+    ambient: float | None = typer.Option(None, "--ambient", metavar="C",
+                                         help="Ambient temperature at the "
                                          f"start, °C ({RANGE_C}; not with --suite; a "
                                          "scenario's [ambient] or the profile's ambient_C "
                                          "overrides it, with a warning)."),
-    speed: float | None = typer.Option(None, "--speed", min=0.0, help="Constant speed, rpm."),
-    profile: Path | None = typer.Option(None, "--profile", help="Speed profile CSV "
+    speed: float | None = typer.Option(None, "--speed", metavar="RPM", min=0.0,
+                                       help="Constant speed, rpm."),
+    profile: Path | None = typer.Option(None, "--profile", metavar="CSV", help="Speed profile CSV "
                                         "(time_s, speed_rpm[, ambient_C]) from 0 s, each "
                                         "row held until the next; 0 rpm is a stop; steps after "
                                         "the run's end are left out, with a warning)."),
-    scenario: Path | None = typer.Option(None, "--scenario", help="Scenario TOML (truth "
+    scenario: Path | None = typer.Option(None, "--scenario", metavar="TOML",
+                                         help="Scenario TOML (truth "
                                          "factors, model-form error, sensors, faults; "
                                          "see above)."),
-    suite: int | None = typer.Option(None, "--suite", min=1, max=10000,
+    suite: int | None = typer.Option(None, "--suite", metavar="N", min=1, max=10000,
                                      help="Draw this many runs from the seeded scenario "
                                      "distribution (twin.plant.suite) into the --out folder."),
-    rate: float = typer.Option(1.0, "--rate", min=0.1, max=10.0, help="Sample rate, Hz."),
-    coolant: float | None = typer.Option(None, "--coolant", help="Coolant inlet temperature "
+    rate: float = typer.Option(1.0, "--rate", metavar="HZ", min=0.1, max=10.0,
+                               help="Sample rate, Hz."),
+    coolant: float | None = typer.Option(None, "--coolant", metavar="C",
+                                         help="Coolant inlet temperature "
                                          f"at the start, °C ({RANGE_C}; default: the "
                                          "ambient, as the nominal model assumes; a "
                                          "scenario's [coolant] overrides it, with a "

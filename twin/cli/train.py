@@ -20,11 +20,12 @@ def train(
     runs: list[Path] = typer.Argument(..., metavar="RUN", help="Recorded runs (CSV or "
                                       "Parquet) to train on; a folder stands for the runs in "
                                       "it, as in replay."),
-    out: Path = typer.Option(..., "--out", help="Model file to write (.safetensors)."),
+    out: Path = typer.Option(..., "--out", metavar="MODEL",
+                             help="Model file to write (.safetensors)."),
     # bounded: a run alone has no validation split to stop early, so 1e20 ran for ever
-    epochs: int = typer.Option(5000, "--epochs", min=1, max=MAX_EPOCHS,
+    epochs: int = typer.Option(5000, "--epochs", metavar="N", min=1, max=MAX_EPOCHS,
                                help="Maximum Rprop epochs."),
-    seed: int = typer.Option(0, "--seed", min=0, max=MAX_SEED,
+    seed: int = typer.Option(0, "--seed", metavar="N", min=0, max=MAX_SEED,
                              help="Seed of the 80/20 split and the weights."),
     paper_config: bool = typer.Option(
         False, "--paper-config",
