@@ -872,34 +872,30 @@ class EnsembleEstimator:
             return np.column_stack([np.interp(tm, times, v) for v in np.atleast_2d(values.T)])
 
         def twin_and_spread(sim_C: np.ndarray, fc: WindowForecast
-                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                            ) -> tuple[np.ndarray, np.ndarray]:
+            """The twin and the members' variance at the samples: T1..T5, then the drift."""
             sim_C = np.asarray(sim_C, float)[-steps - 1:]
             if cfg.report_readings:  # T1..T5 were reported as readings: judge those
                 sim_C = self._window_readings(sim_t, sim_C, self._start)
             drift, drift_anom = self._drift_forecast(fc)
             var_T, var_d = fc.spread_at_steps(drift_anom)
             var_T = np.vstack([var_T[:1], var_T])  # the window start: as its first step
-            return (at_samples(sim_C), at_samples(var_T), at_samples(drift, sim_t[1:]),
-                    at_samples(var_d, sim_t[1:]))
+            return (np.column_stack([at_samples(sim_C), at_samples(drift, sim_t[1:])]),
+                    np.column_stack([at_samples(var_T), at_samples(var_d, sim_t[1:])]))
 
-        reported = twin_and_spread(np.asarray(f.simulated_C, float), self._forecast)
-        model = (reported if model_fc is self._forecast
-                 else twin_and_spread(model_C, model_fc))
+        reported, spread = twin_and_spread(np.asarray(f.simulated_C, float), self._forecast)
+        model = reported
+        if model_fc is not self._forecast:  # re-run: the variance learns the re-run's misfit
+            model, spread = twin_and_spread(model_C, model_fc)
         band_sd = at_samples(self._band_sd_used, sim_t[1:])
-        measured = np.column_stack([np.asarray(f.measured_C, float)[rows],
-                                    np.asarray(f.measured_drift_um, float)[rows]
-                                    if f.measured_drift_um is not None
-                                    else np.full(len(tm), np.nan)])
-        channels = [(j, j, cfg.band_floor_C) for j in range(measured.shape[1] - 1)]
+        measured = np.asarray(f.measured_C, float)[rows]
+        channels = [(j, measured[:, j], cfg.band_floor_C) for j in range(measured.shape[1])]
         if f.measured_drift_um is not None:
-            channels.append((-1, 0, cfg.band_floor_um))
-        for channel, column, floor in channels:  # each thermocouple its own band
-            drift = channel == -1
-            self._adapt_band(channel, measured[:, channel],
-                             reported[2 if drift else 0][:, column],
-                             band_sd[:, channel],
-                             model[2 if drift else 0][:, column],
-                             model[3 if drift else 1][:, column], floor)
+            channels.append((-1, np.asarray(f.measured_drift_um, float)[rows],
+                             cfg.band_floor_um))
+        for channel, samples, floor in channels:  # each thermocouple its own band
+            self._adapt_band(channel, samples, reported[:, channel], band_sd[:, channel],
+                             model[:, channel], spread[:, channel], floor)
 
     def _adapt_band(self, channel: int, measured: np.ndarray, reported: np.ndarray,
                     band_sd: np.ndarray, model: np.ndarray, spread: np.ndarray,
