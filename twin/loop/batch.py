@@ -8,6 +8,7 @@ One failing run never stops the others: its error is recorded in summary.json
 
 from __future__ import annotations
 
+import functools
 import signal
 import uuid
 from collections.abc import Callable, Iterator, Sequence
@@ -291,10 +292,8 @@ def _execute(todo: list[ReplayJob], jobs: int, client: Client | None,
 
         spindle = SpindleModel.load() if todo else None
         for job in todo:
-            told = None
-            if on_window is not None:
-                told = (lambda name: lambda m, k, n: on_window(name, m, k, n))(
-                    run_name(job.run_path))
+            told = (None if on_window is None
+                    else functools.partial(on_window, run_name(job.run_path)))
             outcome = run_job(job, spindle, overlap=True, plotter=plotter, on_window=told)
             _tell(progress, outcome)
             yield outcome
