@@ -5,7 +5,6 @@ the code that replayed it."""
 from __future__ import annotations
 
 import functools
-import hashlib
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -78,6 +77,7 @@ def sources_digest(roots: dict[str, Path]) -> str:
     """SHA-256 over the `.py` files under each package folder of `roots` ({package name:
     folder}; `__pycache__` left out) and, for `twin`, the files of its `data/meshes`: each
     file's path relative to its package's parent and its bytes, in sorted order."""
+    import hashlib  # here, not at the top: `twin --help` imports this module (--version)
     digest = hashlib.sha256()
     for package, root in sorted(roots.items()):
         files = [path for path in _files(root) if path.suffix == ".py"]
