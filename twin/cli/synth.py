@@ -247,19 +247,15 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
                and not written_by_synth(p)]
     if foreign:
         # a measured run beside the suite is data: --overwrite removed it with the old runs
-        listed = ", ".join(p.name for p in foreign[:3]) + (
-            f", … and {len(foreign) - 3} more" if len(foreign) > 3 else "")
         raise InputError(f"holds {counted(len(foreign), 'run file')} twin synth did not write "
-                         f"({listed}); --overwrite removes only runs twin synth wrote: move "
-                         "them, or write the suite into another folder",
+                         f"({_some_names(foreign)}); --overwrite removes only runs twin "
+                         "synth wrote: move them, or write the suite into another folder",
                          file=str(out), column="--out")
     if stale and not overwrite:
-        listed = ", ".join(p.name for p in stale[:3]) + (
-            f", … and {len(stale) - 3} more" if len(stale) > 3 else "")
         raise InputError(f"holds {counted(len(stale), 'run file')} this suite does not write "
-                         f"({listed}), which 'twin replay {out}' would mix with the new "
-                         "runs; write into an empty folder or pass --overwrite to remove "
-                         "them", file=str(out), column="--out")
+                         f"({_some_names(stale)}), which 'twin replay {out}' would mix "
+                         "with the new runs; write into an empty folder or pass --overwrite "
+                         "to remove them", file=str(out), column="--out")
     for path in stale:  # first: a suite stopped half-way leaves only its own runs
         path.unlink()
     out.mkdir(parents=True, exist_ok=True)
@@ -273,3 +269,10 @@ def _synth_suite(n: int, seed: int, minutes: float, rate: float, out: Path, *,
     if not quiet:
         per_minute = (time.perf_counter() - start) / (n * minutes)
         typer.echo(f"{counted(n, 'run')} in {out} ({per_minute:.2f} s per run-minute)")
+
+
+def _some_names(paths: list[Path]) -> str:
+    """The first three file names of `paths` and how many more: `a.csv, b.csv, c.csv, … and
+    2 more`, as the suite's refusals list the runs in its folder."""
+    return ", ".join(p.name for p in paths[:3]) + (
+        f", … and {len(paths) - 3} more" if len(paths) > 3 else "")
