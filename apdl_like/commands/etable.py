@@ -122,23 +122,19 @@ def etable(s: SessionState, c: Call) -> None:
                                                                                c.label(3))), 0.0)
         return
     if item in ("VOLU", "HEAT"):
-        values = _volume(s) if item == "VOLU" else _heat(s)
-        selected = s.db.elements.selected
-        if not np.any(selected & ~np.isnan(values)):
-            s.say(f"ETABLE: no selected element has {item}; {lab} is 0")
-        s.element_table[lab] = np.where(selected, np.nan_to_num(values), 0.0)
-        return
-    if item != "SMISC":
-        raise ApdlError(f"field 2: ETABLE supports SMISC, TG, TF, VOLU and HEAT, got "
-                        f"{item or '(empty)'!r}")
-    comp = c.int(3, what="Comp")
-    if comp not in (1, 2, 3):
-        raise ApdlError("field 3: SMISC supports 1 (a link's HEAT RATE), 2 and 3 (a bar's "
-                        "TI, TJ; 2: a SURF151's convection heat rate)")
-    values = _smisc(s, comp)
+        values, what = (_volume(s) if item == "VOLU" else _heat(s)), item
+    else:
+        if item != "SMISC":
+            raise ApdlError(f"field 2: ETABLE supports SMISC, TG, TF, VOLU and HEAT, got "
+                            f"{item or '(empty)'!r}")
+        comp = c.int(3, what="Comp")
+        if comp not in (1, 2, 3):
+            raise ApdlError("field 3: SMISC supports 1 (a link's HEAT RATE), 2 and 3 (a bar's "
+                            "TI, TJ; 2: a SURF151's convection heat rate)")
+        values, what = _smisc(s, comp), f"SMISC,{comp}"
     selected = s.db.elements.selected
     if not np.any(selected & ~np.isnan(values)):
-        s.say(f"ETABLE: no selected element has SMISC,{comp}; {lab} is 0")
+        s.say(f"ETABLE: no selected element has {what}; {lab} is 0")
     s.element_table[lab] = np.where(selected, np.nan_to_num(values), 0.0)
 
 
