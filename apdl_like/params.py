@@ -56,6 +56,21 @@ def subscripts(texts: Sequence[str], params: Mapping[str, Value],
             for t in texts]
 
 
+def start_subscripts(texts: Sequence[str], params: Mapping[str, Value],
+                     funcs: Mapping[str, object]) -> list[float]:
+    """The subscripts of `NAME(i,j)` as an array's starting element: row 1 for a bare NAME."""
+    return subscripts(texts, params, funcs) if texts else [1.0]
+
+
+def numeric_array(params: Mapping[str, Value], name: str, field: int) -> np.ndarray:
+    """The *DIM numeric array NAME named in field `field` (*VGET, VGET, *VOPER, *VSCFUN)."""
+    array = params.get(name)
+    if not isinstance(array, np.ndarray) or array.dtype == object:
+        raise ApdlError(f"field {field}: {name} is not a numeric array (define it with *DIM "
+                        "first)")
+    return array
+
+
 def store(params: dict[str, Value], name: str, subs: list[float],
           values: Sequence[float | str]) -> None:
     """Scalar assignment, or values down the column of an array from (i, j, k)."""

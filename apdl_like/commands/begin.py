@@ -12,7 +12,7 @@ from apdl_like.commands.post1 import STRESS_COMPONENTS, sort_extreme
 from apdl_like.commands.post26 import get_variable, variable_at
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import ANGLE_UNIT, element_index
-from apdl_like.params import split_target, store, subscripts
+from apdl_like.params import numeric_array, split_target, start_subscripts, store, subscripts
 
 if TYPE_CHECKING:
     from apdl_like.state import SessionState
@@ -175,10 +175,8 @@ def star_vget(s: SessionState, c: Call) -> None:
         name, subs_text = split_target(c.raw(1).strip())
     except ApdlError as exc:
         raise ApdlError(f"field 1: {exc}") from None
-    array = s.params.get(name)
-    if not isinstance(array, np.ndarray) or array.dtype == object:
-        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
-    subs = subscripts(subs_text, s.params, s.model_functions) if subs_text else [1.0]
+    array = numeric_array(s.params, name, 1)
+    subs = start_subscripts(subs_text, s.params, s.model_functions)
     rows = array.shape[0] - element_index(name, array, subs)[0]
     entity, item, sub = c.label(2), c.label(4), c.label(5)
     first = c.int(3, 1, what="ENTNUM")

@@ -17,7 +17,7 @@ import numpy as np
 from apdl_like.call import POST, POST26, Call, CommandSpec, command, ignored, specs_of
 from apdl_like.errors import ApdlError
 from apdl_like.expressions import element_index
-from apdl_like.params import split_target, store, subscripts
+from apdl_like.params import numeric_array, split_target, start_subscripts, store
 
 if TYPE_CHECKING:
     from apdl_like.plane_thermal import PlaneThermal, ThermalInputs
@@ -179,9 +179,7 @@ def vget(s: SessionState, c: Call) -> None:
     if c.given(4):
         raise ApdlError("field 4 (KCPLX) is not supported: variables here are real")
     name, subs_text = split_target(c.raw(1).strip())
-    array = s.params.get(name)
-    if not isinstance(array, np.ndarray) or array.dtype == object:
-        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
+    array = numeric_array(s.params, name, 1)
     n = c.int(2, what="IR")
     if n == 1:
         times = thermal_history(s)[0]
@@ -192,7 +190,7 @@ def vget(s: SessionState, c: Call) -> None:
         raise ApdlError(f"variable {n} is not defined (NSOL or ESOL first)")
     start = int(np.searchsorted(times, c.num(3, float(times[0]), what="TSTRT") -
                                 1e-9 * max(abs(float(times[-1])), 1.0)))
-    subs = subscripts(subs_text, s.params, s.model_functions) if subs_text else [1.0]
+    subs = start_subscripts(subs_text, s.params, s.model_functions)
     rows = array.shape[0] - element_index(name, array, subs)[0]
     store(s.params, name, subs, [float(v) for v in values[start:start + rows]])
 

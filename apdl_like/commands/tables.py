@@ -21,7 +21,9 @@ from apdl_like.params import (
     column,
     dimension,
     is_text,
+    numeric_array,
     split_target,
+    start_subscripts,
     store,
     subscripts,
     value_of,
@@ -69,7 +71,7 @@ def star_vfill(s: SessionState, c: Call) -> None:
     """*VFILL,Par(i,j),DATA,v1,v2,... or RAMP,start,increment (down the column)."""
     name, subs_text = split_target(c.raw(1))
     params, funcs = s.params, s.model_functions
-    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    subs = start_subscripts(subs_text, params, funcs)
     func = c.label(2, "DATA")
     array = params.get(name)
     if not isinstance(array, np.ndarray):
@@ -155,10 +157,8 @@ def star_voper(s: SessionState, c: Call) -> None:
     if c.given(5) or c.given(6):
         raise ApdlError("fields 5-6 (CON1, CON2) are not supported")
     name, subs_text = split_target(c.raw(1).strip())
-    result = params.get(name)
-    if not isinstance(result, np.ndarray) or result.dtype == object:
-        raise ApdlError(f"field 1: {name} is not a numeric array (define it with *DIM first)")
-    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    result = numeric_array(params, name, 1)
+    subs = start_subscripts(subs_text, params, funcs)
     operands: list[np.ndarray | float] = []
     for field in (2, 4):
         text = c.raw(field).strip()
@@ -170,8 +170,8 @@ def star_voper(s: SessionState, c: Call) -> None:
             if isinstance(array, np.ndarray):
                 if array.dtype == object:
                     raise ApdlError(f"field {field}: {ref} is a character array")
-                operands.append(np.array(column(params, ref, subscripts(
-                    ref_subs, params, funcs) if ref_subs else [1.0]), float))
+                operands.append(np.array(column(params, ref, start_subscripts(
+                    ref_subs, params, funcs)), float))
                 continue
         operands.append(c.num(field, what=f"Par{field // 2}"))
     rows = result.shape[0] - element_index(name, result, subs)[0]
@@ -209,10 +209,8 @@ def star_vscfun(s: SessionState, c: Call) -> None:
         raise ApdlError(f"field 2: *VSCFUN supports {', '.join(_VSCFUN)}, got "
                         f"{func or '(empty)'!r}")
     name, subs_text = split_target(c.raw(3).strip())
-    array = params.get(name)
-    if not isinstance(array, np.ndarray) or array.dtype == object:
-        raise ApdlError(f"field 3: {name} is not a numeric array (define it with *DIM first)")
-    subs = subscripts(subs_text, params, funcs) if subs_text else [1.0]
+    array = numeric_array(params, name, 3)
+    subs = start_subscripts(subs_text, params, funcs)
     start = element_index(name, array, subs)
     x = np.array(column(params, name, subs), float)
     if func in ("LMAX", "LMIN", "FIRST", "LAST"):
