@@ -238,8 +238,7 @@ def format_c_line(line: str, values: Sequence[float | str],
         w = int(width) if width and width != "-" else 0
         if bare_fortran and not width and decimals is None and kind in "IGC":
             if kind == "C":
-                text = str(value)
-                out[-1] += text[:8] if len(text) >= 8 else text.rjust(8)
+                out[-1] += _edit("A", 8, 0, value)  # A8
                 continue
             if isinstance(value, str):
                 raise ApdlError(f"%{kind}: {value!r} is text, a number is needed")
