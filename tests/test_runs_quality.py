@@ -303,3 +303,35 @@ def test_a_report_tells_what_a_findings_count_counts_in_files_of_any_release():
     stuck = {**held, "kind": "stuck", "count": 76}
     assert _finding_row(stuck)["count"] == "76"
     assert _finding_row({"kind": "noisy"})["count"] == ""
+
+
+def test_an_axial_probe_frozen_through_the_run_is_stuck_and_excluded(tmp_path):
+    """A probe reading 20 µm (or exactly 0: a channel logging nothing) through 25 min at
+    speed reads no drift: excluded from metrics and correction inputs as a stuck
+    thermocouple is.  A probe that drifts, one next to 0 that moves a little (a column in
+    mm, told elsewhere), and a flat probe of a spindle at rest or too short a run are
+    left as they are."""
+    cols = warmup(n=1500)
+    rise = 1.0 - np.exp(-cols["time_s"] / 600.0)
+
+    def probe(disp_um, speed=9000.0, n=1500):
+        case = {k: v[:n] for k, v in cols.items()}
+        case["speed_rpm"] = np.full(n, speed)
+        case["disp_z_um"] = np.broadcast_to(disp_um, (1500,))[:n]
+        return read_run(write(tmp_path, csv_text(case)))
+
+    for level in (20.0, 0.0):
+        run = probe(np.full(1500, level))
+        found = one(run, "stuck", "disp_z_um")
+        assert found["count"] == 1500 and found["spans_s"] == [[0.0, 1499.0]]
+        assert found["action"] == "excluded from metrics and correction inputs"
+        assert found["detail"] == (f"reads {level:g} µm throughout 25 min at speed: the nose "
+                                   "drifts micrometres in minutes")
+        assert not run.valid["disp_z_um"].any()
+    assert kinds(probe(11.0 * rise), "disp_z_um") == set()  # drifts: µm
+    assert kinds(probe(0.011 * rise), "disp_z_um") == set()  # in mm: not stuck
+    assert kinds(probe(np.full(1500, 20.0), speed=0.0), "disp_z_um") == set()  # at rest
+    assert kinds(probe(np.full(1500, 20.0), n=1100), "disp_z_um") == set()  # 18 min
+    # flat within a tenth of a micrometre of a level away from 0: stuck (logger noise)
+    run = probe(20.0 + 0.04 * np.sin(cols["time_s"]))
+    assert one(run, "stuck", "disp_z_um")["count"] == 1500

@@ -90,7 +90,7 @@ from twin.correction.rerun import (
 from twin.correction.result import Correction, Corrector
 from twin.lag import first_order_lag
 from twin.runs import TEMPERATURES, RecordedRun
-from twin.runs.quality import finding, true_runs
+from twin.runs.quality import AXIAL_PROBE, QualityConfig, finding, running_s, true_runs
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
 from twin.spindle.model import SpindleModel
 
@@ -347,9 +347,9 @@ def probe_start_reading(run: RecordedRun) -> int | None:
     in the run's first window (a probe whose log starts late, its first cells a gap too
     long to fill), else None (no probe, or none read that early: the twin's drift may have
     moved by then)."""
-    if run.disp_um is None or "disp_z_um" not in run.valid:
+    if run.disp_um is None or AXIAL_PROBE not in run.valid:
         return None
-    valid = np.flatnonzero(run.valid["disp_z_um"])
+    valid = np.flatnonzero(run.valid[AXIAL_PROBE])
     if not valid.size or run.time_s[valid[0]] - run.time_s[0] > WINDOW_S:
         return None
     return int(valid[0])
@@ -379,7 +379,7 @@ def probe_offset_findings(run: RecordedRun) -> list[dict]:
     if offset == 0.0 or i is None:
         return []
     when = "the start" if i == 0 else f"{run.time_s[i] - run.time_s[0]:g} s"
-    return [finding("disp_z_um", PROBE_NOT_ZEROED,
+    return [finding(AXIAL_PROBE, PROBE_NOT_ZEROED,
                     "scored as recorded: the twin's drift starts at 0 µm at the run start; "
                     "zero the probe there (or subtract its first reading). The estimator "
                     "reads the change from that reading",
@@ -391,34 +391,40 @@ def probe_offset_findings(run: RecordedRun) -> list[dict]:
 PROBE_IN_MM = "probe_in_mm"
 """quality.json kind of `probe_scale_findings`."""
 
-PROBE_SCALE_SPAN_UM = 0.1
-PROBE_SCALE_RUNNING_S = 1200.0
-"""A probe whose readings stay within ±`PROBE_SCALE_SPAN_UM` through this long at speed is
-told: a spindle drifts micrometres in minutes (the real machine of `examples/real` 0.9 µm
-in its first 10 min at 1250 rpm, the reference spindle 11 µm in 30 min at 9000 rpm)."""
+
+def probe_in_mm(run: RecordedRun) -> tuple[float, float] | None:
+    """(largest |reading| µm, time at speed s) of an axial probe that reads next to
+    nothing while the spindle runs (`QualityConfig.probe_flat_um` through
+    `probe_flat_running_s` at speed): a column written in mm, the twin's disp_z_um being
+    µm.  None for a probe that reads the drift (or none recorded)."""
+    if run.disp_um is None or AXIAL_PROBE not in run.valid:
+        return None
+    valid = run.valid[AXIAL_PROBE]
+    if not valid.any():
+        return None
+    cfg = QualityConfig()
+    at_speed_s = running_s(run.time_s, run.speed_rpm, valid)
+    span = float(np.max(np.abs(run.disp_um[valid, 2])))
+    if at_speed_s < cfg.probe_flat_running_s or span >= cfg.probe_flat_um:
+        return None
+    return span, at_speed_s
 
 
 def probe_scale_findings(run: RecordedRun) -> list[dict]:
-    """The quality.json finding of an axial probe that reads next to nothing while the
-    spindle runs: a column written in mm (the twin's disp_z_um is µm) scored -82 381 %
-    deformation accuracy and pulled the estimator's temperatures off (99.86 → 97.33 %)
-    without a word of the cause."""
-    if run.disp_um is None or "disp_z_um" not in run.valid:
+    """The quality.json finding of an axial probe in mm (`probe_in_mm`): it scored
+    -82 381 % deformation accuracy and, assimilated, pulled the estimator's temperatures
+    off (99.86 → 97.33 %) without a word of the cause.  Scored as recorded (the user's
+    file says so); left out of the correction inputs, as a stuck sensor is."""
+    told = probe_in_mm(run)
+    if told is None:
         return []
-    valid = run.valid["disp_z_um"]
-    if not valid.any():
-        return []
-    step = np.diff(run.time_s, append=run.time_s[-1])
-    running_s = float(step[(run.speed_rpm > 0) & valid].sum())
-    span = float(np.max(np.abs(run.disp_um[valid, 2])))
-    if running_s < PROBE_SCALE_RUNNING_S or span >= PROBE_SCALE_SPAN_UM:
-        return []
-    return [finding("disp_z_um", PROBE_IN_MM,
-                    "scored as recorded: the column is in µm (a reading in mm is 1000 times "
-                    "too small)",
-                    count=int(valid.sum()),
+    span, at_speed_s = told
+    return [finding(AXIAL_PROBE, PROBE_IN_MM,
+                    "scored as recorded, excluded from correction inputs: the column is in "
+                    "µm (a reading in mm is 1000 times too small)",
+                    count=int(run.valid[AXIAL_PROBE].sum()),
                     detail=f"every reading within ±{span:.3g} µm through "
-                           f"{running_s / 60:.0f} min at speed: in mm?")]
+                           f"{at_speed_s / 60:.0f} min at speed: in mm?")]
 
 
 def initial_temperature_C(run: RecordedRun) -> float:
@@ -489,9 +495,9 @@ def replay_method(
 
     measured_T = run.T_valid_C
     measured_drift = None
-    if run.disp_um is not None and "disp_z_um" in run.valid:
+    if run.disp_um is not None and AXIAL_PROBE in run.valid and probe_in_mm(run) is None:
         # its change since the run start where the probe was not zeroed there
-        measured_drift = np.where(run.valid["disp_z_um"],
+        measured_drift = np.where(run.valid[AXIAL_PROBE],
                                   run.disp_um[:, 2] - probe_start_offset_um(run), np.nan)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)

@@ -54,6 +54,12 @@ class QualityConfig:
     """A single speed sample unlike its two equal neighbours, which lie at most this far
     apart, is a logging glitch: no spindle stops or changes speed and comes back within
     a few seconds (it takes seconds to ramp), and thermally such a blip is nothing."""
+    probe_flat_um: float = 0.1
+    probe_flat_running_s: float = 1200.0
+    """An axial probe whose readings span less than `probe_flat_um` through this long at
+    speed does not read the nose drift: a spindle drifts micrometres in minutes (the real
+    machine of `examples/real` 0.9 µm in its first 10 min at 1250 rpm, the reference
+    spindle 11 µm in 30 min at 9000 rpm)."""
 
 
 @dataclass
@@ -404,6 +410,44 @@ def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
     return stuck, found
 
 
+AXIAL_PROBE = "disp_z_um"
+"""The displacement the twin models and the corrections read (`find_stuck_probe`)."""
+
+
+def running_s(t: np.ndarray, speed_rpm: np.ndarray, mask: np.ndarray) -> float:
+    """Time (s) at speed over the samples of `mask`, each sample holding until the next."""
+    step = np.diff(t, append=t[-1])
+    return float(step[(speed_rpm > 0) & mask].sum())
+
+
+def find_stuck_probe(t: np.ndarray, columns: dict[str, np.ndarray],
+                     valid: dict[str, np.ndarray], rows: np.ndarray,
+                     cfg: QualityConfig) -> list[dict]:
+    """An axial probe frozen through the run: its valid readings all equal, or within
+    `cfg.probe_flat_um` of one value away from 0, through `cfg.probe_flat_running_s` at
+    speed.  Its mask is cleared in `valid` (a stuck thermocouple's rule: excluded from
+    metrics and correction inputs).  Assimilated, a probe frozen at 20 µm pulled the
+    estimator's temperatures off; scored, it said nothing of the twin.  Readings next to
+    0 that do move a little are a probe in mm (`twin.loop.replay.probe_scale_findings`),
+    told and scored as recorded.  The radial columns are left alone: a radial drift can
+    stay within a tenth of a micrometre."""
+    if AXIAL_PROBE not in columns or not valid[AXIAL_PROBE].any():
+        return []
+    ok = valid[AXIAL_PROBE]
+    x = columns[AXIAL_PROBE][ok]
+    at_speed_s = running_s(t, columns[SPEED], ok)
+    if at_speed_s < cfg.probe_flat_running_s or np.ptp(x) >= cfg.probe_flat_um:
+        return []
+    level = float(np.median(x))
+    if np.ptp(x) > 0 and abs(level) < cfg.probe_flat_um:
+        return []  # next to nothing but moving: in mm, not frozen
+    valid[AXIAL_PROBE] = np.zeros(t.size, dtype=bool)
+    return [finding(AXIAL_PROBE, "stuck", "excluded from metrics and correction inputs",
+                    rows=rows[ok], spans_s=[(t[0], t[-1])], count=int(ok.sum()),
+                    detail=f"reads {level:.4g} µm throughout {at_speed_s / 60:.0f} min at "
+                           "speed: the nose drifts micrometres in minutes")]
+
+
 def _rise(t: np.ndarray, x: np.ndarray) -> float:
     """Change between the first and last 10 % of the run (medians, NaN-aware)."""
     edge = t[0] + 0.1 * (t[-1] - t[0]), t[-1] - 0.1 * (t[-1] - t[0])
@@ -465,6 +509,7 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
     findings += found
     for name, mask in stuck.items():
         valid[name] &= ~mask
+    findings += find_stuck_probe(time, columns, valid, rows, cfg)
     for name in dead:
         # A dead channel keeps its place in T1..T5, never valid.  Its values are the
         # ambient's, a finite stand-in that nothing reads (every consumer masks by
