@@ -330,8 +330,27 @@ def test_an_axial_probe_frozen_through_the_run_is_stuck_and_excluded(tmp_path):
         assert not run.valid["disp_z_um"].any()
     assert kinds(probe(11.0 * rise), "disp_z_um") == set()  # drifts: µm
     assert kinds(probe(0.011 * rise), "disp_z_um") == set()  # in mm: not stuck
-    assert kinds(probe(np.full(1500, 20.0), speed=0.0), "disp_z_um") == set()  # at rest
-    assert kinds(probe(np.full(1500, 20.0), n=1100), "disp_z_um") == set()  # 18 min
     # flat within a tenth of a micrometre of a level away from 0: stuck (logger noise)
-    run = probe(20.0 + 0.04 * np.sin(cols["time_s"]))
-    assert one(run, "stuck", "disp_z_um")["count"] == 1500
+    flat = 20.0 + 0.04 * np.sin(cols["time_s"])
+    assert one(probe(flat), "stuck", "disp_z_um")["count"] == 1500
+    assert kinds(probe(flat, speed=0.0), "disp_z_um") == set()  # at rest
+    assert kinds(probe(flat, n=1100), "disp_z_um") == set()  # 18 min
+
+
+def test_an_axial_probe_frozen_for_a_spell_is_stuck_there(tmp_path):
+    """A logger channel that holds the probe's last reading for 5 min while the
+    thermocouples warm: those samples are excluded as a stuck thermocouple's are, the rest
+    kept.  A probe that resolves 0.1 µm repeats readings for tens of seconds as the drift
+    levels off: not stuck."""
+    cols = warmup(n=1500)
+    drift = 11.0 * (1.0 - np.exp(-cols["time_s"] / 600.0))
+    frozen = drift.copy()
+    frozen[600:900] = frozen[600]
+    run = read_run(write(tmp_path, csv_text({**cols, "disp_z_um": frozen})))
+    found = one(run, "stuck", "disp_z_um")
+    assert found["spans_s"] == [[600.0, 899.0]] and found["count"] == 300
+    assert found["detail"] == "repeats one reading while the thermocouples move"
+    assert np.flatnonzero(~run.valid["disp_z_um"]).tolist() == list(range(600, 900))
+    resolved = np.round(drift, 1)
+    assert kinds(read_run(write(tmp_path, csv_text({**cols, "disp_z_um": resolved}))),
+                 "disp_z_um") == set()

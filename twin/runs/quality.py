@@ -382,19 +382,8 @@ def find_stuck(t: np.ndarray, raw: dict[str, np.ndarray], rows: np.ndarray,
     for name in names:
         others = [raw[n] for n in names if n != name]
         x = raw[name]
-        ok = np.flatnonzero(~np.isnan(x))
-        mask = np.zeros(x.size, dtype=bool)
         # (a) exactly repeated values for a long stretch while another sensor moves
-        same = np.concatenate([[False], x[ok][1:] == x[ok][:-1]])
-        for a, b in true_runs(same):
-            a -= 1  # the run starts at the first of the equal values
-            i0, i1 = ok[a], ok[b]
-            if t[i1] - t[i0] < cfg.stuck_min_s or b - a + 1 < 5:
-                continue
-            moved = max((np.nanmax(o[i0:i1 + 1]) - np.nanmin(o[i0:i1 + 1])
-                         for o in others if np.isfinite(o[i0:i1 + 1]).any()), default=0.0)
-            if moved >= cfg.stuck_others_move_C:
-                mask[i0:i1 + 1] = True
+        mask = frozen_spells(t, x, others, cfg.stuck_min_s, cfg.stuck_others_move_C)
         # (b) flat within noise over the whole run while the others warm up clearly
         rise = _rise(t, x)
         other_rises = [abs(_rise(t, o)) for o in others]
@@ -420,32 +409,66 @@ def running_s(t: np.ndarray, speed_rpm: np.ndarray, mask: np.ndarray) -> float:
     return float(step[(speed_rpm > 0) & mask].sum())
 
 
-def find_stuck_probe(t: np.ndarray, columns: dict[str, np.ndarray],
+def find_stuck_probe(t: np.ndarray, raw: dict[str, np.ndarray], columns: dict[str, np.ndarray],
                      valid: dict[str, np.ndarray], rows: np.ndarray,
                      cfg: QualityConfig) -> list[dict]:
-    """An axial probe frozen through the run: its valid readings all equal, or within
-    `cfg.probe_flat_um` of one value away from 0, through `cfg.probe_flat_running_s` at
-    speed.  Its mask is cleared in `valid` (a stuck thermocouple's rule: excluded from
-    metrics and correction inputs).  Assimilated, a probe frozen at 20 µm pulled the
-    estimator's temperatures off; scored, it said nothing of the twin.  Readings next to
-    0 that do move a little are a probe in mm (`twin.loop.replay.probe_scale_findings`),
-    told and scored as recorded.  The radial columns are left alone: a radial drift can
-    stay within a tenth of a micrometre."""
+    """An axial probe that does not read the drift, its samples cleared in `valid` (a stuck
+    thermocouple's rule: excluded from metrics and correction inputs):
+
+    - frozen through the run: its valid readings all equal, or within `cfg.probe_flat_um`
+      of one value away from 0, through `cfg.probe_flat_running_s` at speed;
+    - frozen for a spell: one reading repeated exactly while a thermocouple moves
+      (`frozen_spells`, the thermocouples' thresholds), a logger channel holding its last
+      value.
+
+    Assimilated, a probe frozen at 20 µm pulled the estimator's temperatures off; scored, it
+    said nothing of the twin.  Readings next to 0 that do move a little are a probe in mm
+    (`twin.loop.replay.probe_scale_findings`), told and scored as recorded.  The radial
+    columns are left alone: a radial drift can stay within a tenth of a micrometre."""
     if AXIAL_PROBE not in columns or not valid[AXIAL_PROBE].any():
         return []
     ok = valid[AXIAL_PROBE]
     x = columns[AXIAL_PROBE][ok]
     at_speed_s = running_s(t, columns[SPEED], ok)
-    if at_speed_s < cfg.probe_flat_running_s or np.ptp(x) >= cfg.probe_flat_um:
-        return []
     level = float(np.median(x))
-    if np.ptp(x) > 0 and abs(level) < cfg.probe_flat_um:
-        return []  # next to nothing but moving: in mm, not frozen
-    valid[AXIAL_PROBE] = np.zeros(t.size, dtype=bool)
+    if at_speed_s >= cfg.probe_flat_running_s and np.ptp(x) < cfg.probe_flat_um and (
+            np.ptp(x) == 0 or abs(level) >= cfg.probe_flat_um):  # else in mm, not frozen
+        valid[AXIAL_PROBE] = np.zeros(t.size, dtype=bool)
+        return [finding(AXIAL_PROBE, "stuck", "excluded from metrics and correction inputs",
+                        rows=rows[ok], spans_s=[(t[0], t[-1])], count=int(ok.sum()),
+                        detail=f"reads {level:.4g} µm throughout {at_speed_s / 60:.0f} min "
+                               "at speed: the nose drifts micrometres in minutes")]
+    thermocouples = [raw[n] for n in TEMPERATURES if n in raw]
+    frozen = frozen_spells(t, raw[AXIAL_PROBE], thermocouples, cfg.stuck_min_s,
+                           cfg.stuck_others_move_C) & ok
+    if not frozen.any():
+        return []
+    valid[AXIAL_PROBE] = ok & ~frozen
     return [finding(AXIAL_PROBE, "stuck", "excluded from metrics and correction inputs",
-                    rows=rows[ok], spans_s=[(t[0], t[-1])], count=int(ok.sum()),
-                    detail=f"reads {level:.4g} µm throughout {at_speed_s / 60:.0f} min at "
-                           "speed: the nose drifts micrometres in minutes")]
+                    rows=rows[frozen], spans_s=[(t[a], t[b]) for a, b in true_runs(frozen)],
+                    count=int(frozen.sum()),
+                    detail="repeats one reading while the thermocouples move")]
+
+
+def frozen_spells(t: np.ndarray, x: np.ndarray, others: list[np.ndarray], min_s: float,
+                  others_move: float) -> np.ndarray:
+    """Mask of the spells where `x` repeats one value exactly (at least 5 valid samples
+    over at least `min_s`) while one of `others` moves by `others_move` or more: a logger
+    channel frozen at its last reading.  NaN samples inside a spell neither break nor
+    join it."""
+    ok = np.flatnonzero(~np.isnan(x))
+    mask = np.zeros(x.size, dtype=bool)
+    same = np.concatenate([[False], x[ok][1:] == x[ok][:-1]])
+    for a, b in true_runs(same):
+        a -= 1  # the spell starts at the first of the equal values
+        i0, i1 = ok[a], ok[b]
+        if t[i1] - t[i0] < min_s or b - a + 1 < 5:
+            continue
+        moved = max((np.nanmax(o[i0:i1 + 1]) - np.nanmin(o[i0:i1 + 1])
+                     for o in others if np.isfinite(o[i0:i1 + 1]).any()), default=0.0)
+        if moved >= others_move:
+            mask[i0:i1 + 1] = True
+    return mask
 
 
 def _rise(t: np.ndarray, x: np.ndarray) -> float:
@@ -509,7 +532,7 @@ def repair(table: RawTable, cfg: QualityConfig | None = None) -> Repaired:
     findings += found
     for name, mask in stuck.items():
         valid[name] &= ~mask
-    findings += find_stuck_probe(time, columns, valid, rows, cfg)
+    findings += find_stuck_probe(time, raw, columns, valid, rows, cfg)
     for name in dead:
         # A dead channel keeps its place in T1..T5, never valid.  Its values are the
         # ambient's, a finite stand-in that nothing reads (every consumer masks by
