@@ -1128,6 +1128,35 @@ def test_the_estimator_reads_a_probe_not_zeroed_at_the_start_from_its_first_read
     assert off_score["deformation_accuracy_pct"] < 50.0  # scored as recorded
 
 
+def test_quality_json_tells_an_axial_probe_read_the_other_way_round(tmp_path, spindle_model):
+    """A probe that falls as the spindle warms reads the twin's drift negated (mounted or
+    logged the other way round): told, with the correlation.  Not told: a probe that grows
+    (with a stop's cooling in it), one that moves within 2 µm, one of too short a run."""
+    from twin.loop.replay import PROBE_REVERSED, probe_direction_findings
+    from twin.runs import read_run
+
+    t = np.arange(0.0, 2400.0, 2.0)
+    speed = np.where((t > 1200) & (t < 1800), 0.0, 9000.0)  # a 10-min stop
+    heat = np.cumsum(np.where(speed > 0, 1.0, -1.6)) * 2.0 / 1800.0
+    warm = np.clip(heat, 0.0, None)
+    cols = {"time_s": t, "speed_rpm": speed, "ambient_C": np.full(t.size, 22.0),
+            **{f"T{k}_C": 22.0 + amp * warm for k, amp in enumerate([8, 6, 5, 4, 1], 1)}}
+
+    def told(disp_um: np.ndarray, minutes: float = 40.0) -> list[dict]:
+        keep = t < 60.0 * minutes
+        path = tmp_path / "run.csv"
+        write_run(path, {k: v[keep] for k, v in {**cols, "disp_z_um": disp_um}.items()})
+        return probe_direction_findings(read_run(path), spindle_model)
+
+    found = told(-12.0 * warm)
+    assert [(f["kind"], f["column"], f["detail"]) for f in found] == [
+        (PROBE_REVERSED, "disp_z_um", "falls as the thermocouples warm (correlation -1.00 "
+                                      "with their mean)")]
+    assert told(12.0 * warm) == []
+    assert told(-1.5 * warm) == []  # within 2 µm: noise and offsets, nothing to tell
+    assert told(-12.0 * warm, minutes=18.0) == []
+
+
 def test_quality_json_tells_an_axial_probe_that_reads_next_to_nothing_at_speed(tmp_path):
     """A disp_z_um column written in mm (the reference spindle's 11 µm as 0.011) scored
     -82 381 % deformation accuracy and pulled the estimator's temperatures off, without a
@@ -1155,12 +1184,12 @@ def test_quality_json_tells_an_axial_probe_that_reads_next_to_nothing_at_speed(t
     assert findings(np.where(t < 1100, 0.011 * rise, np.nan)) == []  # 18 min of readings
 
 
-def test_the_estimator_leaves_out_a_probe_in_mm_and_a_frozen_one(spindle_model, tmp_path):
+def test_the_estimator_leaves_out_a_probe_in_mm_frozen_or_reversed(spindle_model, tmp_path):
     """Assimilated, a probe column in mm (1000 times too small) or one frozen at 20 µm
-    pulled the estimator's temperatures from 99.86 to 97.33 % on a bundled run: the
-    twin's drift was driven towards a flat line.  Both are now left out of its inputs:
-    its temperatures are those of the same run without a probe; the mm column is still
-    scored as recorded, the frozen one not at all."""
+    pulled the estimator's temperatures from 99.86 to 97.33 % on a bundled run (the
+    twin's drift driven towards a flat line), one negated to 97.40 %.  They are now left
+    out of its inputs: its temperatures are those of the same run without a probe; the
+    mm and negated columns are still scored as recorded, the frozen one not at all."""
     from twin.correction.methods import make_corrector
     from twin.loop.replay import replay_method
     from twin.loop.runfiles import measured_reference, method_accuracy
@@ -1171,7 +1200,7 @@ def test_the_estimator_leaves_out_a_probe_in_mm_and_a_frozen_one(spindle_model, 
     columns = {"time_s": run.time_s, "speed_rpm": run.speed_rpm, "ambient_C": run.ambient_C,
                **{f"T{i + 1}_C": run.T_C[:, i] for i in range(5)}}
     probes = {"none": None, "mm": run.disp_um[:, 2] / 1000.0,
-              "frozen": np.full(run.time_s.size, 20.0)}
+              "frozen": np.full(run.time_s.size, 20.0), "reversed": -run.disp_um[:, 2]}
     results = {}
     for name, disp in probes.items():
         write_run(tmp_path / f"{name}.csv",
@@ -1182,12 +1211,13 @@ def test_the_estimator_leaves_out_a_probe_in_mm_and_a_frozen_one(spindle_model, 
                                keep_fields=False)
         results[name] = (result, method_accuracy(result,
                                                  *measured_reference(case, result.time_s)))
-    for name in ("mm", "frozen"):
+    for name in ("mm", "frozen", "reversed"):
         np.testing.assert_allclose(results[name][0].T_twin_C, results["none"][0].T_twin_C,
                                    atol=1e-9)
     assert results["none"][1]["temperature_accuracy_pct"] > 99.7
     assert [f["kind"] for f in read_run(tmp_path / "frozen.csv").quality] == ["stuck"]
     assert results["mm"][1]["deformation_accuracy_pct"] < -1000.0  # scored as recorded
+    assert results["reversed"][1]["deformation_accuracy_pct"] < -50.0
     assert results["frozen"][1]["deformation_accuracy_pct"] is None
 
 

@@ -46,6 +46,7 @@ from twin.loop.replay import (
     held_correction_findings,
     method_replay_from_json,
     method_replay_to_json,
+    probe_direction_findings,
     probe_offset_findings,
     probe_scale_findings,
     replay_method,
@@ -224,7 +225,8 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
         _write_snapshots(out_dir, model, results[primary], snapshots, run)
     write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods),
                                         *tail_findings(run), *probe_offset_findings(run),
-                                        *probe_scale_findings(run)]),
+                                        *probe_scale_findings(run),
+                                        *probe_direction_findings(run, model)]),
                   out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
