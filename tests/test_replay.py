@@ -874,7 +874,8 @@ def test_a_logger_gap_holds_ratio_and_bpnn_and_quality_json_says_which_windows(
     such finding."""
     from twin.correction.methods import make_corrector
     from twin.data import bundled_path
-    from twin.loop.replay import HELD_CORRECTION, replay_method
+    from twin.loop.findings import HELD_CORRECTION
+    from twin.loop.replay import replay_method
     from twin.runs import read_run
 
     def gap(t, temps):
@@ -1029,7 +1030,7 @@ def test_the_report_leaves_a_gap_in_c_h_at_a_stop():
 def test_quality_json_names_the_tail_after_the_last_whole_window(runs_dir, replayed, tmp_path):
     """A replay solves and scores whole 60 s windows: a 152 s run was replayed and scored
     over 120 s, and neither quality.json nor the report said its last 32 s were left."""
-    from twin.loop.replay import NOT_REPLAYED
+    from twin.loop.findings import NOT_REPLAYED
 
     lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
     header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
@@ -1055,11 +1056,66 @@ def test_quality_json_names_the_tail_after_the_last_whole_window(runs_dir, repla
     assert not [f for f in whole if f["kind"] == NOT_REPLAYED]
 
 
+def test_quality_json_tells_a_run_that_warms_far_more_than_the_twin_at_its_speeds(
+        runs_dir, replayed, tmp_path):
+    """A speed logged in rev/s (150 for 9000 rpm) was replayed as 150 rpm, with next to no
+    bearing heat: every method scored far off and nothing said why.  Told now (the
+    thermocouples rise many times more than open loop's twin), and the speeds are still
+    replayed as recorded; the same run in rpm tells nothing."""
+    from twin.loop.findings import WARMS_UNLIKE_TWIN
+
+    lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
+    speed = lines[header].split(",").index("speed_rpm")
+
+    def in_rev_per_s(line: str) -> str:
+        cells = line.split(",")
+        cells[speed] = f"{float(cells[speed]) / 60.0:g}"
+        return ",".join(cells)
+
+    rps = tmp_path / "rps.csv"
+    rps.write_text("\n".join(lines[:header + 1] + [in_rev_per_s(line)
+                                                   for line in lines[header + 1:] if line])
+                   + "\n")
+    assert replay(rps, out=tmp_path / "out", methods="open_loop").exit_code == 0
+    findings = json.loads((tmp_path / "out" / "rps" / "quality.json").read_text())["findings"]
+    told = [f for f in findings if f["kind"] == WARMS_UNLIKE_TWIN]
+    assert [(f["column"], f["action"]) for f in told] == [
+        ("speed_rpm", "scored as recorded: every method replays the speeds as recorded")]
+    assert told[0]["detail"].endswith("speed_rpm in rpm? (a speed in rev/s reads 60 times, "
+                                      "one in krpm 1000 times too slow)")
+    whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
+    assert not [f for f in whole if f["kind"] == WARMS_UNLIKE_TWIN]
+
+
+def test_warming_is_told_only_many_times_above_the_twin_and_with_open_loop():
+    """The rule's edges on key points alone: three times the twin's rise and 3 K told,
+    just under either not; a run that starts warm (rising less than the twin) not; no
+    open loop, nothing; a dead ring sensor leaves the others' median."""
+    from twin.loop.findings import warming_findings
+
+    steps = np.linspace(0.0, 1.0, 50)[:, None]
+    start = np.full(5, 20.0)
+
+    def told(measured_rise: float, twin_rise: float, dead: bool = False) -> bool:
+        measured = 20.0 + measured_rise * steps * np.ones(5)
+        if dead:
+            measured[:, 0] = np.nan
+        twin = 20.0 + twin_rise * steps * np.ones(5)
+        return warming_findings(twin, 20.0, measured, start) != []
+
+    assert told(6.0, 2.0) and not told(5.9, 2.0)
+    assert told(3.0, 0.5) and not told(2.9, 0.5)
+    assert not told(1.0, 9.0)  # started warm: rises less, not told
+    assert told(6.0, 2.0, dead=True)
+    assert warming_findings(None, 20.0, 20.0 + 9.0 * steps * np.ones(5), start) == []
+
+
 def test_quality_json_tells_an_axial_probe_not_zeroed_at_the_start(runs_dir, replayed,
                                                                    tmp_path):
     """The twin's drift starts at 0 µm with the run; a probe zeroed elsewhere (50 µm off)
     was scored as recorded, deformation accuracy some 15 %, without a word of the cause."""
-    from twin.loop.replay import PROBE_NOT_ZEROED
+    from twin.loop.findings import PROBE_NOT_ZEROED
 
     lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
     header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
@@ -1132,7 +1188,7 @@ def test_quality_json_tells_an_axial_probe_read_the_other_way_round(tmp_path, sp
     """A probe that falls as the spindle warms reads the twin's drift negated (mounted or
     logged the other way round): told, with the correlation.  Not told: a probe that grows
     (with a stop's cooling in it), one that moves within 2 µm, one of too short a run."""
-    from twin.loop.replay import PROBE_REVERSED, probe_direction_findings
+    from twin.loop.findings import PROBE_REVERSED, probe_direction_findings
     from twin.runs import read_run
 
     t = np.arange(0.0, 2400.0, 2.0)
@@ -1161,7 +1217,7 @@ def test_quality_json_tells_an_axial_probe_that_reads_next_to_nothing_at_speed(t
     """A disp_z_um column written in mm (the reference spindle's 11 µm as 0.011) scored
     -82 381 % deformation accuracy and pulled the estimator's temperatures off, without a
     word of the cause."""
-    from twin.loop.replay import PROBE_IN_MM, probe_scale_findings
+    from twin.loop.findings import PROBE_IN_MM, probe_scale_findings
     from twin.runs import read_run
 
     t = np.arange(0.0, 1502.0, 2.0)
@@ -1227,7 +1283,7 @@ def test_a_probe_not_zeroed_whose_first_samples_are_missing_is_read_from_its_fir
     too long to fill) was taken as zeroed: no probe_not_zeroed finding, and the estimator
     assimilated it as recorded.  Its first valid reading, inside the run's first window, is
     its start reading."""
-    from twin.loop.replay import PROBE_NOT_ZEROED, probe_offset_findings, probe_start_offset_um
+    from twin.loop.findings import PROBE_NOT_ZEROED, probe_offset_findings, probe_start_offset_um
     from twin.runs import read_run
 
     t = np.arange(0.0, 600.0, 1.0)

@@ -11,6 +11,8 @@ window the transient is re-solved in `STEPS_PER_WINDOW` (15) backward-Euler step
 
 from __future__ import annotations
 
+import math
+
 SENSOR_NAMES: tuple[str, ...] = ("T1", "T2", "T3", "T4", "T5")
 """The thermocouples T1..T5, in the order of every (…, 5) temperature array."""
 
@@ -28,6 +30,13 @@ STEPS_PER_WINDOW = 15
 
 STEP_S = WINDOW_S / STEPS_PER_WINDOW
 """Solver time step (s): 4 s."""
+
+
+def windows_in(duration_s: float) -> int:
+    """Whole 60 s windows in a run of `duration_s`: a replay keeps a field at each one's
+    end, `WINDOW_S` · k for k = 1 … windows_in."""
+    return math.floor(duration_s / WINDOW_S + 1e-9)
+
 
 OPERATING_TEMPERATURE_C = (-40.0, 45.0)
 """The plausible ambient air and coolant inlet temperatures (°C, closed range): the one

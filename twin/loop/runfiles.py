@@ -37,20 +37,16 @@ from twin.contract import SENSOR_NAMES, WINDOW_S
 from twin.correction.features import first_finite
 from twin.errors import InputError
 from twin.io.atomic import write_csv, write_json, write_text
+from twin.loop.findings import replay_findings
 from twin.loop.folders import replaced_folder
 from twin.loop.metrics import accuracy_metrics
 from twin.loop.overlap import ForkedTask, ForkedTaskError
 from twin.loop.replay import (
     MethodReplay,
     deck_window_solver,
-    held_correction_findings,
     method_replay_from_json,
     method_replay_to_json,
-    probe_direction_findings,
-    probe_offset_findings,
-    probe_scale_findings,
     replay_method,
-    tail_findings,
 )
 from twin.loop.runnames import run_name
 from twin.version import code_identity
@@ -223,11 +219,10 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     plots.start(str(out_dir))
     if snapshots != "none":
         _write_snapshots(out_dir, model, results[primary], snapshots, run)
-    write_quality(replace(run, quality=[*run.quality, *held_correction_findings(run, methods),
-                                        *tail_findings(run), *probe_offset_findings(run),
-                                        *probe_scale_findings(run),
-                                        *probe_direction_findings(run, model)]),
-                  out_dir / "quality.json")
+    open_loop = results.get("open_loop")
+    told = replay_findings(run, model, methods, None if open_loop is None else open_loop.T_twin_C,
+                           first.T_initial_C, meas_T, meas_T0)
+    write_quality(replace(run, quality=[*run.quality, *told]), out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
         for w in r.windows:
@@ -301,8 +296,9 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     has are kept.  `duration_s`: the run's (accuracy.json), which sets its window ends.
     Returns how many were drawn.  InputError: a field file it needs is missing (`--fields
     end` or `none`) or damaged (the caller replays the run)."""
+    from twin.contract import windows_in
     from twin.io.vtk import read_vtu
-    from twin.loop.replay import initial_temperature_C, windows_in
+    from twin.loop.replay import initial_temperature_C
     from twin.loop.snapshot import render_snapshot, snapshot_title
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel

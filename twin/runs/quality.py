@@ -423,7 +423,7 @@ def find_stuck_probe(t: np.ndarray, raw: dict[str, np.ndarray], columns: dict[st
 
     Assimilated, a probe frozen at 20 µm pulled the estimator's temperatures off; scored, it
     said nothing of the twin.  Readings next to 0 that do move a little are a probe in mm
-    (`twin.loop.replay.probe_scale_findings`), told and scored as recorded.  The radial
+    (`twin.loop.findings.probe_scale_findings`), told and scored as recorded.  The radial
     columns are left alone: a radial drift can stay within a tenth of a micrometre."""
     if AXIAL_PROBE not in columns or not valid[AXIAL_PROBE].any():
         return []
