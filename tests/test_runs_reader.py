@@ -335,12 +335,17 @@ def test_parquet_hard_error_names_row(tmp_path):
 
 
 @pytest.mark.parametrize("separator", [";", "\t"])
-def test_a_run_separated_otherwise_than_by_commas_is_named_so(tmp_path, separator):
-    # a logger's semicolon export read as one column: "column 'time_s': missing required
-    # column", with time_s right there in the header
-    text = csv_text(warmup(), "# a: b\n").replace(",", separator)
-    err = expect_error(write(tmp_path, text), 2, None, "one column")
-    assert repr(separator) in err.reason and "comma" in err.reason
+def test_a_run_separated_otherwise_than_by_commas_is_read(tmp_path, separator):
+    # a logger's semicolon export was refused ("the header is one column holding ';'");
+    # its numbers here have decimal points, which a `;` or tab file may have too
+    clean = csv_text(warmup(), "# a: b\n")
+    a = read_run(write(tmp_path, clean, "clean.csv"))
+    b = read_run(write(tmp_path, clean.replace(",", separator)))
+    assert np.array_equal(a.T_C, b.T_C) and np.array_equal(a.time_s, b.time_s)
+    assert b.metadata == {"a": "b"}
+    name = {";": "semicolon", "\t": "tab"}[separator]
+    assert [(f["kind"], f["action"]) for f in b.quality] == [
+        ("csv_dialect", f"read as {name}-separated")]
 
 
 def test_a_folder_given_as_a_run_is_named_a_folder(tmp_path):
@@ -486,12 +491,18 @@ def test_a_spreadsheets_separator_line_is_read_past(tmp_path):
     lines[2] = "x" + lines[2][1:]
     expect_error(write(tmp_path, "SEP=,\n" + "\n".join(lines) + "\n"), 4, "time_s",
                  "cannot read 'x")  # the lines keep their editor's numbers
-    expect_error(write(tmp_path, "sep=;\n" + clean.replace(",", ";")), 1, None,
-                 "the first line says the file is separated by ';'")
-    # a tab there, Excel's hint for a tab-separated export, was stripped with the blanks
-    # and "sep=" taken for the header ("missing required column (the header has sep=)")
-    expect_error(write(tmp_path, "sep=\t\n" + clean.replace(",", "\t")), 1, None,
-                 "the first line says the file is separated by '\\t'")
+    # `sep=;` and a tab (Excel's hint for a tab-separated export) name the separator:
+    # the tab was stripped with the blanks and "sep=" taken for the header
+    for separator in (";", "\t"):
+        c = read_run(write(tmp_path, f"sep={separator}\n" + clean.replace(",", separator),
+                           "other.csv"))
+        assert np.array_equal(a.T_C, c.T_C) and np.array_equal(a.time_s, c.time_s)
+    # a hint the header belies is told at the header, naming the hint's line
+    expect_error(write(tmp_path, "# x: y\nsep=,\n" + clean.replace(",", ";")), 3, None,
+                 "the header is one column holding ';': line 2 says the file is separated "
+                 "by ','")
+    expect_error(write(tmp_path, "sep=|\n" + clean.replace(",", "|")), 1, None,
+                 "this 'sep=' line says the file is separated by '|'")
     # below the header it is a data line like any other
     expect_error(write(tmp_path, clean + "sep=,\n"), len(lines) + 1, None,
                  "expected 8 fields as in the header, found 2")

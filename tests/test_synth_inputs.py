@@ -319,7 +319,10 @@ def test_speed_profile(tmp_path):
     ("# warm start\ntime_s,speed_rpm\n60,9000\n600,12000\n", 3, "time_s"),
     ("time_s,speed_rpm\n0.5,9000\n", 2, "time_s"),
     ("time_s,speed_rpm\n", 1, None),
-    ("# from the logger\ntime_s;speed_rpm\n0;9000\n", 2, None),  # not comma-separated
+    # a `;` file reads (tests/test_csv_dialect.py); one whose header holds tabs too is
+    # told, as is "9.000" rpm where no other cell says whether '.' is a decimal mark
+    ("# from the logger\ntime_s;speed_rpm\tambient_C\n0;9000\n", 2, None),
+    ("time_s;speed_rpm\n0;0\n60;9.000\n", 3, "speed_rpm"),
     # a column named twice (or without a name) was read from its first place without a
     # word: which speed the emulated spindle ran was the reader's choice, not the file's
     ("time_s,speed_rpm,speed_rpm\n0,6000,5000\n", 1, "speed_rpm"),

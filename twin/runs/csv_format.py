@@ -2,6 +2,24 @@
 
 Line numbers are counted as an editor shows them (1-based, every physical line counts,
 metadata and blank lines included), so an error message points at the right place.
+
+Dialects.  The separator is decided once, from the header: a header that reads as more
+than one comma-separated column is comma-separated (every file that read before reads
+as it did); one that reads as a single column holding `;` or tabs is separated by them
+(Excel's export in German and most European locales, a tab-separated logger).  An Excel
+hint line above the header (`sep=,`, `sep=;`, `sep=` and a tab) decides instead: the way
+to read a header holding both `;` and tabs.  In a `;` or tab file a number's decimal
+mark may be a comma ("22,5") or a point.  Thousands separators are never read: a cell
+with both marks ("1.234,5", "9,000.5") or one mark twice ("1.234.567") is refused.  A
+cell that reads either way, 1-3 digits (not a lone 0), one mark, exactly 3 digits
+("9.000": 9000 rpm formatted with a separator, or 9.0), is read only where the file's
+other numbers show the mark to be the decimal one (they use it and never the other:
+"9.000" beside "22.5" is 9.0, "9,000" beside "22,5" too); otherwise it is refused,
+naming the cell (Excel writes 9000 rpm as "9000" unless the column is formatted with
+separators).  Rows of separators, trailing separators, the header written again and a
+units row are told for each separator as for ','; a `;` file's metadata lines may end
+in the `;` padding a spreadsheet writes.  `RawTable.dialect` says how a file other than
+a comma one was read; every file written is comma-separated, with decimal points.
 """
 
 from __future__ import annotations
@@ -9,7 +27,9 @@ from __future__ import annotations
 import csv
 import math
 import os
+import re
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,6 +43,9 @@ LINE = "line"
 """What an error calls a place in a CSV file (`RawTable.row_unit`): its line, numbered as an
 editor numbers them, not a data row (`bad.csv, line 4, column 'T1_C'`)."""
 
+SEPARATORS = {",": "comma", ";": "semicolon", "\t": "tab"}
+"""The separators a CSV file may have, by the name a message gives them."""
+
 
 def read_csv_table(path: str | os.PathLike[str],
                    keep: Callable[[str], bool] | None = None, *,
@@ -32,7 +55,8 @@ def read_csv_table(path: str | os.PathLike[str],
     `keep(name)` says which columns to read (default: the recorded-run schema); the
     others are listed in `RawTable.ignored_columns`.  `option` is the command-line option
     that named the file (a file that cannot be read names it); `max_rows` the most data
-    rows taken (None: any number; a speed profile's steps are no samples).
+    rows taken (None: any number; a speed profile's steps are no samples).  The separator
+    and decimal mark as the module says.
     """
     file = str(path)
     keep = keep or ALL_COLUMNS.__contains__
@@ -44,11 +68,14 @@ def read_csv_table(path: str | os.PathLike[str],
     metadata: dict[str, str] = {}
     header: list[str] | None = None
     header_line = 0
+    hint: tuple[str, int] | None = None  # a `sep=` line's separator and line
+    separator = ","
     data_lines: list[str] = []
     data_numbers: list[int] = []
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
-        if not stripped or is_blank_record(stripped):
+        if not stripped or is_blank_record(
+                stripped, "".join(SEPARATORS) if header is None else separator):
             continue
         if stripped.startswith("#"):
             if header is None and ":" in stripped:
@@ -56,11 +83,14 @@ def read_csv_table(path: str | os.PathLike[str],
                 if key.strip():
                     metadata[key.strip()] = value.strip()
             continue
-        if header is None and is_separator_hint(line, file, number):
-            continue
         if header is None:
+            given = separator_hint(line, file, number)
+            if given is not None:
+                hint = (given, number)
+                continue
+            separator = header_separator(line, hint, file, number)
             header = without_trailing_blanks(
-                [name.strip() for name in next(csv_records([line], file, [number]))])
+                [name.strip() for name in next(csv_records([line], file, [number], separator))])
             header_line = number
             continue
         data_lines.append(line)
@@ -68,7 +98,7 @@ def read_csv_table(path: str | os.PathLike[str],
 
     if header is None:
         raise InputError("empty file: no header row and no data", file=file)
-    check_header(header, file, header_line)
+    check_header(header, file, header_line, separator, hint)
     if not data_lines:
         raise InputError("no data rows after the header", file=file, row=header_line,
                          row_unit=LINE)
@@ -76,11 +106,15 @@ def read_csv_table(path: str | os.PathLike[str],
         raise InputError(f"{len(data_lines)} data rows; a run may hold at most {max_rows} "
                          "samples (resample it)", file=file, row=data_numbers[max_rows],
                          row_unit=LINE)
+    if separator != ",":
+        # a spreadsheet pads the metadata lines of a `;` file as it does its rows
+        metadata = {key: value.rstrip(separator + " ") for key, value in metadata.items()}
 
     known = [(i, name) for i, name in enumerate(header) if keep(name)]
     ignored = [name for name in header if not keep(name)]
     values = np.full((len(data_lines), len(known)), np.nan)
-    for k, fields in enumerate(csv_records(data_lines, file, data_numbers)):
+    marks = DecimalMarks(file) if separator != "," else None
+    for k, fields in enumerate(csv_records(data_lines, file, data_numbers, separator)):
         line = data_numbers[k]
         fields = without_trailing_blanks(fields, len(header))
         if len(fields) != len(header):
@@ -94,42 +128,69 @@ def read_csv_table(path: str | os.PathLike[str],
         row = values[k]
         for j, (i, name) in enumerate(known):
             try:
-                row[j] = parse_cell(fields[i], file, line, name, LINE)
+                row[j] = (parse_cell(fields[i], file, line, name, LINE) if marks is None
+                          else marks.read(fields[i], line, name))
             except InputError as exc:
-                if k == 0 and not any(is_number(f) for f in fields):
+                if k == 0 and not any(is_number(f, marks is not None) for f in fields):
                     raise InputError(f"{exc.reason}; no cell of line {line} is a number: a "
                                      "units row? remove it (the names carry the units: "
                                      "time_s, T1_C)", file=file, row=line, column=name,
                                      row_unit=LINE) from None
                 raise
+    dialect = ""
+    if marks is not None:
+        marks.check_undecided()
+        dialect = f"{SEPARATORS[separator]}-separated" + (
+            ", with decimal commas" if marks.read_commas() else "")
     columns = {name: values[:, j].copy() for j, (_, name) in enumerate(known)}
     return RawTable(file=file, metadata=metadata, columns=columns,
                     rows=np.asarray(data_numbers, dtype=np.int64), header_row=header_line,
-                    ignored_columns=ignored, row_unit=LINE)
+                    ignored_columns=ignored, row_unit=LINE, dialect=dialect)
 
 
-def is_separator_hint(line: str, file: str, number: int) -> bool:
-    """True for the `sep=,` line above the header that Excel reads as the separator to use
-    (some exports write it): read past.  Another separator there is an `InputError`, in the
-    words of `check_comma_separated`.  The hint was taken for the header ("line 2: expected
-    1 fields as in the header, found 12").  `line` as read: only its spaces are stripped,
-    so that a tab named there (`sep=\t`, a tab-separated export) is told, not read as the
-    header "sep=" (a missing required column)."""
+def separator_hint(line: str, file: str, number: int) -> str | None:
+    """The separator named by a `sep=,` line above the header, which Excel reads as the
+    separator to use (some exports write it), or None for another line.  A separator
+    other than `,`, `;` or a tab is an `InputError`.  Before, the hint was taken for the
+    header ("line 2: expected 1 fields as in the header, found 12").  `line` as read:
+    only its spaces are stripped, so that a tab named there (`sep=\t`) is read, not
+    taken for the header "sep=" (a missing required column)."""
     line = line.strip(" ")
     if len(line) != 5 or line[:4].lower() != "sep=":
-        return False
-    if line[4] != ",":
-        raise InputError(f"the first line says the file is separated by {line[4]!r}; write "
-                         "it comma-separated, with decimal points", file=file, row=number,
+        return None
+    if line[4] not in SEPARATORS:
+        raise InputError(f"this 'sep=' line says the file is separated by {line[4]!r}; "
+                         "separate it by commas, semicolons or tabs", file=file, row=number,
                          row_unit=LINE)
-    return True
+    return line[4]
 
 
-def is_blank_record(line: str) -> bool:
-    """True for a line of separators and blanks only (",,,,"): the rows a spreadsheet writes
-    below the data where its used range runs on, read past as blank lines are; they hold
-    no value to lose."""
-    return not line.replace(",", "").strip()
+def header_separator(line: str, hint: tuple[str, int] | None, file: str, number: int) -> str:
+    """The separator of a file whose header is `line` (line `number`): the one a `sep=`
+    line named (`hint`: separator and line), else a comma unless the header read so is
+    one column holding `;` or tabs (see the module); both is an `InputError`."""
+    if hint is not None:
+        return hint[0]
+    header = without_trailing_blanks(
+        [name.strip() for name in next(csv_records([line], file, [number]))])
+    if len(header) != 1:
+        return ","
+    held = [s for s in (";", "\t") if s in header[0]]
+    if len(held) > 1:
+        raise InputError("the header holds both ';' and tabs: which separates the columns? "
+                         "say it in a line 'sep=;' (or 'sep=' and a tab) above the header",
+                         file=file, row=number, row_unit=LINE)
+    return held[0] if held else ","
+
+
+def is_blank_record(line: str, separators: str = ",") -> bool:
+    """True for a line of `separators` and blanks only (",,,,", ";;;;" in a `;` file): the
+    rows a spreadsheet writes below the data where its used range runs on, read past as
+    blank lines are; they hold no value to lose.  Above the header, where the separator
+    is still unknown, any of `SEPARATORS`."""
+    for separator in separators:
+        line = line.replace(separator, "")
+    return not line.strip()
 
 
 def without_trailing_blanks(fields: list[str], width: int | None = None) -> list[str]:
@@ -145,10 +206,12 @@ def without_trailing_blanks(fields: list[str], width: int | None = None) -> list
     return fields
 
 
-def check_header(header: list[str], file: str, line: int) -> None:
-    """InputError unless `header` (row `line`) is comma-separated and names each column once,
-    none empty: a name given twice would leave which column is read to the reader."""
-    check_comma_separated(header, file, line)
+def check_header(header: list[str], file: str, line: int, separator: str = ",",
+                 hint: tuple[str, int] | None = None) -> None:
+    """InputError unless `header` (row `line`) is separated as `separator` says and names
+    each column once, none empty: a name given twice would leave which column is read to
+    the reader."""
+    check_separated(header, file, line, separator, hint)
     for position, name in enumerate(header, start=1):
         if not name:
             raise InputError(f"header field {position} is empty", file=file, row=line,
@@ -158,23 +221,89 @@ def check_header(header: list[str], file: str, line: int) -> None:
                              column=name, row_unit=LINE)
 
 
-def check_comma_separated(header: list[str], file: str, line: int) -> None:
-    """Refuse a header that is one column holding `;` or tabs: a logger's export with
-    another separator (often with decimal commas), which would otherwise read as one
-    column and fail as a missing `time_s`."""
-    if len(header) == 1:
-        for separator in (";", "\t"):
-            if separator in header[0]:
-                raise InputError(f"the header is one column holding {separator!r}: the file is "
-                                 f"separated by {separator!r}; write it comma-separated, with "
-                                 "decimal points", file=file, row=line, row_unit=LINE)
+def check_separated(header: list[str], file: str, line: int, separator: str,
+                    hint: tuple[str, int] | None) -> None:
+    """Refuse a header that is one column holding another separator than the `sep=` line
+    (`hint`: separator and line) named: read so, it would fail as a missing `time_s`."""
+    if len(header) != 1 or hint is None:
+        return
+    for other in SEPARATORS:
+        if other != separator and other in header[0]:
+            raise InputError(f"the header is one column holding {other!r}: line {hint[1]} "
+                             f"says the file is separated by {separator!r}; correct that "
+                             "line or remove it", file=file, row=line, row_unit=LINE)
 
 
-def csv_records(lines: list[str], file: str, numbers: list[int]) -> Iterator[list[str]]:
-    """CSV records of `lines` (`numbers`: their lines in `file`), one per line: a quoted
-    cell may not span lines (the csv module would join `"1` and `2"` into 12), and csv's
-    own errors name their line."""
-    reader = csv.reader(lines)
+_AMBIGUOUS = re.compile(r"[+-]?[1-9][0-9]{0,2}[.,][0-9]{3}")
+"""A number whose one mark reads as a thousands separator as well as a decimal one."""
+
+_GROUPED = re.compile(r"[+-]?[0-9]{1,3}(?:[.,][0-9]{3})+(?:[.,][0-9]*)?")
+"""A number with thousands separators ("1.234,5", "9,000.5", "1.234.567")."""
+
+_MARK_NAMES = {",": "comma", ".": "point"}
+
+
+@dataclass
+class DecimalMarks:
+    """The decimal marks of a `;` or tab file's number cells, noted as they are read: the
+    first cell that shows each mark to be a decimal one (`shown`), and the first that one
+    mark leaves ambiguous (`undecided`), each as (line, column, cell).  See the module."""
+
+    file: str
+    shown: dict[str, tuple[int, str, str]] = field(default_factory=dict)
+    undecided: dict[str, tuple[int, str, str]] = field(default_factory=dict)
+
+    def read(self, cell: str, line: int, column: str) -> float:
+        """`cell` as a number (`parse_cell`, a comma read as a decimal mark), its mark
+        noted; InputError for a cell with thousands separators."""
+        try:
+            value = parse_cell(cell, self.file, line, column, LINE, decimal_comma=True)
+        except InputError:
+            if _GROUPED.fullmatch(cell.strip()):
+                raise InputError(f"cannot read {cell.strip()!r} as a number (thousands "
+                                 "separators? write numbers without them: 9000, 22,5)",
+                                 file=self.file, row=line, column=column,
+                                 row_unit=LINE) from None
+            raise
+        # a number read holds one mark at most
+        mark = "," if "," in cell else "." if "." in cell else None
+        if mark is not None and not (mark in self.shown and mark in self.undecided):
+            text = cell.strip()
+            found = self.undecided if _AMBIGUOUS.fullmatch(text) else self.shown
+            found.setdefault(mark, (line, column, text))
+        return value
+
+    def read_commas(self) -> bool:
+        """Whether a cell was read with a decimal comma."""
+        return "," in self.shown or "," in self.undecided
+
+    def check_undecided(self) -> None:
+        """InputError at the first cell one mark left ambiguous that the file's other
+        numbers do not decide (their marks: that one and not the other)."""
+        refused = [place for mark, place in self.undecided.items() if set(self.shown) != {mark}]
+        if not refused:
+            return
+        line, column, text = min(refused)
+        mark = "," if "," in text else "."
+        lead, _, fraction = text.partition(mark)
+        writes = "." if set(self.shown) == {"."} else ","
+        shown = " and ".join(f"decimal {_MARK_NAMES[m]}s (line {at}, column {name!r}: "
+                             f"{cell!r})" for m, (at, name, cell) in sorted(self.shown.items()))
+        evidence = (f"the file's other numbers have {shown}" if shown else
+                    "no other number in the file has a decimal mark to tell")
+        raise InputError(f"cannot read {text!r} as a number: {lead}{fraction} with a "
+                         f"thousands separator, or {float(text.replace(',', '.')):g} with a "
+                         f"decimal {_MARK_NAMES[mark]}? {evidence}; write "
+                         f"{lead}{fraction} or {lead}{writes}{fraction.rstrip('0') or '0'}",
+                         file=self.file, row=line, column=column, row_unit=LINE)
+
+
+def csv_records(lines: list[str], file: str, numbers: list[int],
+                separator: str = ",") -> Iterator[list[str]]:
+    """CSV records of `lines` (`numbers`: their lines in `file`) separated by `separator`,
+    one per line: a quoted cell may not span lines (the csv module would join `"1` and
+    `2"` into 12), and csv's own errors name their line."""
+    reader = csv.reader(lines, delimiter=separator)
     k = 0
     while True:
         try:

@@ -20,7 +20,7 @@ finding that counts something else names it in the key instead of `count`: a rep
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -154,10 +154,8 @@ def drop_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
     if not repeated.any():
         return table, []
     keep = ~repeated
-    kept = RawTable(file=table.file, metadata=table.metadata,
-                    columns={n: v[keep] for n, v in table.columns.items()},
-                    rows=table.rows[keep], header_row=table.header_row,
-                    ignored_columns=table.ignored_columns, row_unit=table.row_unit)
+    kept = replace(table, columns={n: v[keep] for n, v in table.columns.items()},
+                   rows=table.rows[keep])
     time = table.columns[TIME]
     spans = [(float(time[a] - time[0]), float(time[b] - time[0])) for a, b in true_runs(repeated)]
     found = finding(TIME, "repeated_rows", "dropped (exact copies of earlier rows)",

@@ -25,6 +25,10 @@ from twin.runs.validate import (
     check_values,
 )
 
+CSV_DIALECT = "csv_dialect"
+"""quality.json kind of the note that a CSV file was read as other than comma-separated
+with decimal points (`RawTable.dialect`): told once, for the whole file."""
+
 # one reader and one writer per format, chosen by file suffix (meshio's registry)
 _READERS = {".csv": read_csv_table, ".parquet": read_parquet_table, ".pq": read_parquet_table}
 _WRITERS = {".csv": write_csv_table, ".parquet": write_parquet_table, ".pq": write_parquet_table}
@@ -199,8 +203,11 @@ def run_from_table(table: RawTable, config: QualityConfig | None = None,
     fixed = repair(table, config)
     check_operating_temperatures(table.file, fixed.rows, fixed.columns,
                                  row_unit=table.row_unit)
-    quality = [finding(n, "ignored_column", "column ignored (not in the run schema)",
-                       detail="unknown column name") for n in table.ignored_columns]
+    quality = [finding("", CSV_DIALECT, f"read as {table.dialect}", count=table.n_samples,
+                       detail="the twin writes its files comma-separated, with decimal points")
+               ] if table.dialect else []
+    quality += [finding(n, "ignored_column", "column ignored (not in the run schema)",
+                        detail="unknown column name") for n in table.ignored_columns]
     quality += repeats + fixed.findings
     c = fixed.columns
     disp = None

@@ -34,6 +34,9 @@ class RawTable:
     header_row: int | None = None
     ignored_columns: list[str] = field(default_factory=list)
     row_unit: str = "line"
+    dialect: str = ""
+    """How a CSV file was read where not as the plain one (comma-separated, decimal
+    points): "semicolon-separated, with decimal commas", for the command to tell once."""
 
     @property
     def n_samples(self) -> int:
@@ -59,9 +62,20 @@ MAX_NUMBER_CHARS = 64
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
-def is_number(cell: str) -> bool:
-    """Whether `cell` is a plain decimal number as `parse_cell` reads one."""
-    return _NUMBER.fullmatch(cell.strip()) is not None
+def is_number(cell: str, decimal_comma: bool = False) -> bool:
+    """Whether `cell` is a plain decimal number as `parse_cell` reads one (with a decimal
+    comma: `number_text`)."""
+    return _NUMBER.fullmatch(number_text(cell, decimal_comma)) is not None
+
+
+def number_text(cell: str, decimal_comma: bool = False) -> str:
+    """`cell` stripped, as `float` is to read it: with `decimal_comma` (a `;` or tab
+    separated file, `twin.runs.csv_format`), a comma that is the cell's one decimal mark
+    ("22,5") reads as a point; a cell holding a point too ("1.234,5") stays as it is."""
+    text = cell.strip()
+    if decimal_comma and "," in text and "." not in text and text.count(",") == 1:
+        return text.replace(",", ".")
+    return text
 
 
 _CLOCK = re.compile(r"(?:\d{1,4}[-/.]\d{1,2}[-/.]\d{1,4}[ T]?)?"  # a date,
@@ -90,16 +104,17 @@ def _hint(text: str, column: str) -> str:
     return ""
 
 
-def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str) -> float:
+def parse_cell(cell: str, file: str, row: int, column: str, row_unit: str, *,
+               decimal_comma: bool = False) -> float:
     """One cell of a run table as a float (NaN for a missing value), or `InputError` at
-    `row` (a "line" or a "row", as `RawTable.row_unit`)."""
-    text = cell.strip()
+    `row` (a "line" or a "row", as `RawTable.row_unit`); `decimal_comma` as `number_text`."""
+    text = number_text(cell, decimal_comma) if decimal_comma else cell.strip()
     if len(text) > MAX_NUMBER_CHARS:
         raise InputError(f"a cell of {len(text)} characters is not a number", file=file,
                          row=row, column=column, row_unit=row_unit)
     if text.lower() in MISSING_TOKENS:
         return math.nan
-    if not is_number(text):
+    if _NUMBER.fullmatch(text) is None:
         raise InputError(f"cannot read {cell!r} as a number{_hint(text, column)}", file=file,
                          row=row, column=column, row_unit=row_unit)
     value = float(text)
