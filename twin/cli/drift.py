@@ -67,6 +67,8 @@ def _progress(quiet: bool) -> Callable[[str], None]:
 def _report_findings(data: DriftData, quiet: bool) -> None:
     if quiet:
         return
+    for file, dialect in data.dialects.items():
+        typer.echo(f"note: {file}: read as {dialect}", err=True)
     for f in data.findings:
         typer.echo(f"note: {f['where']}: {f['repair']}", err=True)
     for name, why in data.left_out.items():

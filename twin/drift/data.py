@@ -63,7 +63,9 @@ class DriftData:
     none of them).  `segment_starts` are the first row of every file; `rows` the row of
     every sample in its file (1-based line of a CSV file).  `left_out` maps a temperature
     column not taken as a sensor (`usable_temperatures`) to the reason; `not_read` a file to
-    its columns that are none of the above (a speed named `speed`), for the user to hear.
+    its columns that are none of the above (a speed named `speed`), for the user to hear;
+    `dialects` a file read as other than comma-separated with decimal points to how it was
+    (`RawTable.dialect`).
     """
 
     files: list[str]
@@ -78,6 +80,7 @@ class DriftData:
     findings: list[dict] = field(default_factory=list)
     left_out: dict[str, str] = field(default_factory=dict)
     not_read: dict[str, list[str]] = field(default_factory=dict)
+    dialects: dict[str, str] = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
@@ -264,7 +267,8 @@ def drift_data(
         T_C=np.concatenate(temps), targets=targets, targets_um=targets_um,
         segment_starts=np.asarray(starts, dtype=np.int64), rows=np.concatenate(rows),
         findings=findings, left_out=left_out,
-        not_read={t.file: list(t.ignored_columns) for t in tables if t.ignored_columns})
+        not_read={t.file: list(t.ignored_columns) for t in tables if t.ignored_columns},
+        dialects={t.file: t.dialect for t in tables if t.dialect})
 
 
 def read_drift_data(
