@@ -4,10 +4,16 @@ decimal commas) or tabs read as the comma files they stand for (`twin.runs.csv_f
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from tests.test_runs_reader import csv_text, expect_error, warmup, write
+from twin.cli import app
+from twin.data import bundled_path
 from twin.errors import InputError
 from twin.runs import read_run
 from twin.runs.csv_format import read_csv_table
@@ -166,3 +172,129 @@ def test_a_cell_a_thousands_separator_cannot_make_is_a_decimal_comma(tmp_path, c
     table = read_csv_table(semicolon_run(tmp_path, edit))
     assert table.columns["T1_C"][5] == float(cell.replace(",", "."))
     assert table.dialect == "semicolon-separated, with decimal commas"
+
+
+# Through the commands, as a user runs them: every CSV input goes through the one reader.
+
+BUNDLED_RUN = "spindle_steps_faults_30min.csv"  # its faults: gaps, nan cells, a dead sensor
+REAL_DATA = Path(__file__).resolve().parent.parent / "examples" / "real" / "train.csv"
+
+
+def twin(*args: str):  # noqa: ANN201 - click's Result
+    return CliRunner().invoke(app, list(args))
+
+
+def copy_as(source: Path, folder: Path, separator: str, excel: bool = False) -> Path:
+    """`source` written in `separator` and decimal commas under the same name in `folder`
+    (the name a command writes into its outputs)."""
+    folder.mkdir(exist_ok=True)
+    path = folder / source.name
+    path.write_text(other_dialect(source.read_text(), separator, excel))
+    return path
+
+
+@pytest.mark.slow
+def test_replay_of_a_semicolon_or_tab_copy_of_a_bundled_run_scores_the_same(tmp_path):
+    source = bundled_path("runs", BUNDLED_RUN)
+    copies = {"comma": tmp_path / "comma" / BUNDLED_RUN,
+              # as German Excel's "CSV (Trennzeichen-getrennt)" writes General-format cells
+              "semicolon": copy_as(source, tmp_path / "semicolon", ";", excel=True),
+              # decimal commas with every digit kept: '2,000' s, which the others decide
+              "tab": copy_as(source, tmp_path / "tab", "\t")}
+    copies["comma"].parent.mkdir()
+    copies["comma"].write_bytes(source.read_bytes())
+    assert "\n2,000;" not in copies["semicolon"].read_text()  # "2;6000;24,6366;..."
+    assert "\n2,000\t6000,0\t" in copies["tab"].read_text()
+    out = {}
+    for name, path in copies.items():
+        out[name] = tmp_path / f"out_{name}" / path.stem
+        result = twin("replay", str(path), "--out", str(out[name].parent), "--snapshots",
+                      "none", "--fields", "none", "--quiet")
+        assert result.exit_code == 0, result.output
+    for name, dialect in (("semicolon", "semicolon"), ("tab", "tab")):
+        for file in ("accuracy.json", "keypoints.csv", "corrections.csv"):
+            assert (out[name] / file).read_bytes() == (out["comma"] / file).read_bytes(), file
+        quality = json.loads((out[name] / "quality.json").read_text())["findings"]
+        plain = json.loads((out["comma"] / "quality.json").read_text())["findings"]
+        assert quality[1:] == plain and quality[0]["kind"] == "csv_dialect"
+        assert quality[0]["action"] == f"read as {dialect}-separated, with decimal commas"
+    assert "csv_dialect" not in {f["kind"] for f in plain}
+
+
+@pytest.mark.parametrize(("command", "cell", "column", "words"), [
+    ("replay", "1.234,5", 6, "cannot read '1.234,5' as a number (thousands separators?"),
+    ("snapshot", "9.000", 1, "cannot read '9.000' as a number: 9000 with a thousands "
+                             "separator, or 9 with a decimal point? the file's other numbers "
+                             "have decimal commas (line 2, column 'time_s': '0,0000')"),
+    ("train", "25,5,1", 4, "cannot read '25,5,1' as a number"),
+])
+def test_a_bad_cell_of_a_semicolon_run_exits_2_naming_file_line_and_column(
+        tmp_path, command, cell, column, words):
+    path = semicolon_run(tmp_path, lambda lines: set_cell(lines, 9, column, cell))
+    before = path.read_bytes()
+    out = tmp_path / "out"
+    args = {"replay": ["--out", str(out), "--methods", "open_loop"],
+            "snapshot": ["--time", "60", "--out", str(tmp_path / "s.png")],
+            "train": ["--out", str(tmp_path / "m.safetensors")]}[command]
+    result = twin(command, str(path), *args)
+    assert result.exit_code == 2, result.output
+    name = ["time_s", "speed_rpm", "ambient_C", "T1_C", "T2_C", "T3_C", "T4_C", "T5_C"][column]
+    assert f"{path}, line 9, column '{name}': {words}" in result.output
+    assert "Traceback" not in result.output
+    assert path.read_bytes() == before
+    assert not (tmp_path / "s.png").exists() and not (tmp_path / "m.safetensors").exists()
+
+
+def test_drift_fit_on_a_semicolon_copy_of_the_real_data_writes_the_same_model(
+        tmp_path, monkeypatch):
+    comma = tmp_path / "comma"
+    comma.mkdir()
+    (comma / REAL_DATA.name).write_bytes(REAL_DATA.read_bytes())
+    copy_as(REAL_DATA, tmp_path / "semicolon", ";")
+    outputs = {}
+    for folder in ("comma", "semicolon"):
+        monkeypatch.chdir(tmp_path / folder)  # the model names its training files
+        result = twin("drift", "fit", REAL_DATA.name, "--target",
+                      "ch1_um,ch2_um,ch3_um,ch4_um,ch5_um", "--method", "ridge_dynamic",
+                      "--seed", "0", "--out", "model.safetensors")
+        assert result.exit_code == 0, result.output
+        outputs[folder] = result.output
+    model = (tmp_path / "semicolon" / "model.safetensors").read_bytes()
+    assert model == (tmp_path / "comma" / "model.safetensors").read_bytes()
+    note = "note: train.csv: read as semicolon-separated, with decimal commas"
+    assert note in outputs["semicolon"] and "read as" not in outputs["comma"]
+    # a bad cell names file, line and column there too
+    bad = tmp_path / "semicolon" / "bad.csv"
+    lines = (tmp_path / "semicolon" / REAL_DATA.name).read_text().splitlines()
+    cells = lines[40].split(";")
+    lines[40] = ";".join([cells[0], "1.000,5", *cells[2:]])
+    bad.write_text("\n".join(lines) + "\n")
+    result = twin("drift", "fit", str(bad), "--target", "ch1_um", "--out", "m.safetensors")
+    assert result.exit_code == 2, result.output
+    assert f"{bad}, line 41, column 'speed_rpm': cannot read '1.000,5'" in result.output
+
+
+def test_synth_reads_a_semicolon_speed_profile_as_the_comma_one(tmp_path, monkeypatch):
+    profiles = {"comma": "time_s,speed_rpm,ambient_C\n0,6000,24.5\n60.5,12000,24.75\n",
+                "semicolon": "sep=;\ntime_s;speed_rpm;ambient_C;;\n0;6000;24,5;;\n"
+                             "60,5;12000;24,75;;\n;;;;\n"}
+    for folder, text in profiles.items():
+        (tmp_path / folder).mkdir()
+        monkeypatch.chdir(tmp_path / folder)  # the run's metadata name the profile
+        Path("profile.csv").write_text(text)
+        result = twin("synth", "--profile", "profile.csv", "--minutes", "2", "--ambient",
+                      "24.5", "--seed", "1", "--out", "run.csv")
+        assert result.exit_code == 0, result.output
+    for file in ("run.csv", "run.truth.csv"):
+        assert (tmp_path / "semicolon" / file).read_bytes() == (
+            tmp_path / "comma" / file).read_bytes()
+    # the speed steps at 60.5 s: the decimal comma was read as one
+    run = read_run(tmp_path / "semicolon" / "run.csv")
+    assert run.speed_rpm[run.time_s < 60.5].max() == 6000.0
+    assert run.speed_rpm[run.time_s > 62].min() == 12000.0
+    Path("bad.csv").write_text("time_s;speed_rpm\n0;0\n60;9.000\n")
+    result = twin("synth", "--profile", "bad.csv", "--minutes", "2", "--ambient", "24.5",
+                  "--seed", "1", "--out", "bad_run.csv")
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "bad.csv, line 3, column 'speed_rpm': cannot read '9.000'" in result.output
+    assert not Path("bad_run.csv").exists()
