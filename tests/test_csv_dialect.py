@@ -15,6 +15,7 @@ from tests.test_runs_reader import csv_text, expect_error, warmup, write
 from twin.cli import app
 from twin.data import bundled_path
 from twin.errors import InputError
+from twin.plant.profile import read_speed_profile
 from twin.runs import read_run
 from twin.runs.csv_format import read_csv_table
 
@@ -298,3 +299,22 @@ def test_synth_reads_a_semicolon_speed_profile_as_the_comma_one(tmp_path, monkey
     assert result.exit_code == 2 and "Traceback" not in result.output
     assert "bad.csv, line 3, column 'speed_rpm': cannot read '9.000'" in result.output
     assert not Path("bad_run.csv").exists()
+
+
+SPREADSHEET = Path(__file__).resolve().parent / "data" / "spreadsheet_exports"
+
+
+def test_a_german_spreadsheets_export_reads_and_its_thousands_separators_are_refused():
+    # written by LibreOffice Calc in de-DE (tests/data/spreadsheet_exports/README.md):
+    # General-format cells have no thousands separator, and decimal commas
+    profile = read_speed_profile(SPREADSHEET / "profile_de.csv")
+    assert profile.speed_rpm.time_s.tolist() == [0.0, 600.5, 1200.0]
+    assert profile.speed_rpm(np.array([600.0, 601.0, 1300.0])).tolist() == [6000.0, 12000.0,
+                                                                             0.0]
+    assert profile.ambient_C(700.0) == 25.25
+    # the speed column formatted with separators: '6.000' is 6000 rpm here, not 6
+    with pytest.raises(InputError) as info:
+        read_speed_profile(SPREADSHEET / "profile_de_grouped.csv")
+    assert (info.value.row, info.value.column) == (2, "speed_rpm")
+    assert "cannot read '6.000' as a number: 6000 with a thousands separator, or 6" in str(
+        info.value)
