@@ -70,6 +70,11 @@ def test_a_plain_comma_file_is_read_as_before(tmp_path):
     table = read_csv_table(write(tmp_path, "time_s\n0\n1.5\n"), "time_s".__eq__)
     assert table.dialect == "" and table.columns["time_s"].tolist() == [0.0, 1.5]
     assert read_run(write(tmp_path, csv_text(warmup()), "c.csv")).quality == []
+    # a German thousands separator in a comma file (a quoted cell) is told as one there too
+    lines = csv_text(warmup()).splitlines()
+    lines[9] = '"1.234,5",' + lines[9].split(",", 1)[1]
+    expect_error(write(tmp_path, "\n".join(lines) + "\n"), 10, "time_s",
+                 "cannot read '1.234,5' as a number (a thousands separator, or a decimal comma?")
 
 
 def test_spreadsheet_rules_hold_for_each_separator(tmp_path):

@@ -37,7 +37,7 @@ from twin.errors import InputError
 from twin.io.atomic import atomic_target
 from twin.paths import read_input_text
 from twin.runs.schema import ALL_COLUMNS, MAX_SAMPLES
-from twin.runs.table import RawTable, is_number, parse_cell
+from twin.runs.table import RawTable, is_grouped, is_number, parse_cell
 
 LINE = "line"
 """What an error calls a place in a CSV file (`RawTable.row_unit`): its line, numbered as an
@@ -237,8 +237,6 @@ def check_separated(header: list[str], file: str, line: int, separator: str,
 _AMBIGUOUS = re.compile(r"[+-]?[1-9][0-9]{0,2}[.,][0-9]{3}")
 """A number whose one mark reads as a thousands separator as well as a decimal one."""
 
-_GROUPED = re.compile(r"[+-]?[0-9]{1,3}(?:[.,][0-9]{3})+(?:[.,][0-9]*)?")
-"""A number with thousands separators ("1.234,5", "9,000.5", "1.234.567")."""
 
 _MARK_NAMES = {",": "comma", ".": "point"}
 
@@ -259,7 +257,7 @@ class DecimalMarks:
         try:
             value = parse_cell(cell, self.file, line, column, LINE, decimal_comma=True)
         except InputError:
-            if _GROUPED.fullmatch(cell.strip()):
+            if is_grouped(cell):
                 raise InputError(f"cannot read {cell.strip()!r} as a number (thousands "
                                  "separators? write numbers without them: 9000, 22,5)",
                                  file=self.file, row=line, column=column,

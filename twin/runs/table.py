@@ -83,8 +83,15 @@ _CLOCK = re.compile(r"(?:\d{1,4}[-/.]\d{1,2}[-/.]\d{1,4}[ T]?)?"  # a date,
 """A date, a clock time or both, as a logger or a spreadsheet writes its time column."""
 
 
-_GROUPED = re.compile(r"[+-]?\d{1,3}(?:,\d{3})+(?:\.\d+)?")
-"""A number with thousands separators, as a spreadsheet formats it ("9,000")."""
+_GROUPED = re.compile(r"[+-]?\d{1,3}(?:[.,]\d{3})+(?:[.,]\d*)?")
+"""A number with thousands separators, as a spreadsheet formats it ("9,000", "1,234.5",
+and in German "1.234,5", "1.234.567")."""
+
+
+def is_grouped(cell: str) -> bool:
+    """Whether `cell` looks like a number with thousands separators (`_GROUPED`); a reader
+    reads none ("9,000" rpm is 9000, not 9)."""
+    return _GROUPED.fullmatch(cell.strip()) is not None
 
 
 def _hint(text: str, column: str) -> str:
@@ -93,7 +100,7 @@ def _hint(text: str, column: str) -> str:
     if column == TIME and text and _CLOCK.fullmatch(text.strip()):
         return (" (a date or clock time? time_s holds seconds from the run's start: "
                 "convert the column)")
-    if _GROUPED.fullmatch(text.strip()):  # "9,000" or "1,234.5": 9000 rpm, not 9
+    if is_grouped(text):  # "9,000" or "1,234.5": 9000 rpm, not 9
         return (" (a thousands separator, or a decimal comma? write plain numbers with a "
                 "decimal point: 9000, 25.4)")
     if is_number(text.replace(",", ".", 1)):
