@@ -132,9 +132,9 @@ def test_a_speed_that_reads_as_thousands_or_decimals_is_refused_unless_the_file_
     '9,000' is 9000 in an English one, or 9.0.  The file's other numbers tell which mark
     is the decimal one; where they do not, the cell is refused."""
     # the warm-up's other cells have decimal commas ("25,0000"): '9.000' is refused, as
-    # the first such cell
-    path = semicolon_run(tmp_path, lambda lines: [set_cell(lines, n, 1, "9.000")
-                                                  for n in (7, 9)])
+    # the first such cell, before a later bad cell (told in file order)
+    path = semicolon_run(tmp_path, lambda lines: [
+        *(set_cell(lines, n, 1, "9.000") for n in (7, 9)), set_cell(lines, 12, 3, "1.234,5")])
     expect_error(path, 7, "speed_rpm", "cannot read '9.000' as a number: 9000 with a "
                  "thousands separator, or 9 with a decimal point? the file's other numbers "
                  "have decimal commas (line 2, column 'time_s': '0,0000'); write 9000 or 9,0")

@@ -268,17 +268,21 @@ class DecimalMarks:
         if mark is not None and not (mark in self.shown and mark in self.undecided):
             text = cell.strip()
             found = self.undecided if _AMBIGUOUS.fullmatch(text) else self.shown
-            found.setdefault(mark, (line, column, text))
+            if mark not in found:
+                found[mark] = (line, column, text)
+                self.check_undecided(final=False)  # told where it is decided, in file order
         return value
 
     def read_commas(self) -> bool:
         """Whether a cell was read with a decimal comma."""
         return "," in self.shown or "," in self.undecided
 
-    def check_undecided(self) -> None:
+    def check_undecided(self, final: bool = True) -> None:
         """InputError at the first cell one mark left ambiguous that the file's other
-        numbers do not decide (their marks: that one and not the other)."""
-        refused = [place for mark, place in self.undecided.items() if set(self.shown) != {mark}]
+        numbers do not decide (their marks: that one and not the other): once read
+        (`final`), or as soon as another mark is shown a decimal one."""
+        refused = [place for mark, place in self.undecided.items()
+                   if set(self.shown) - {mark} or (final and mark not in self.shown)]
         if not refused:
             return
         line, column, text = min(refused)
