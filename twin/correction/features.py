@@ -195,6 +195,10 @@ class WindowFeatures:
     coolant_recorded: bool = True
     """Whether the run records its coolant inlet (`coolant_C`); False: the conditions
     assume the inlet at the ambient, and an estimator may estimate it."""
+    measured_coolant_C: np.ndarray | None = None
+    """(n,) the recorded coolant inlet at `measured_time_s` (None: not recorded or not
+    passed).  An estimator re-runs the window just ended with it where the inlet moved
+    inside that window."""
 
     def __post_init__(self) -> None:
         pairs = (("measured", self.measured_time_s), ("simulated", self.simulated_time_s))

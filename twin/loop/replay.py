@@ -380,6 +380,7 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
             coolant_recorded=state.coolant_C is not None,
+            measured_coolant_C=None if run.coolant_C is None else run.coolant_C[upto],
         )
         previous_end = T
         if reruns and last is not None and (
