@@ -426,3 +426,34 @@ def test_metadata_nested_too_deeply_is_bad_input(ridge_model, tmp_path):
     bad.write_bytes(len(text).to_bytes(8, "little") + text + deep[8 + size:])
     with pytest.raises(InputError, match="deep.safetensors"):
         load_drift_model(bad)
+
+
+def test_validation_picks_the_sensors_of_each_fold_on_its_training_rows(tmp_path):
+    """--sensors auto|K are chosen by their grade on the drift: picked on every row, the
+    left-out block's drift chose the sensors that predict it (a leak into the validation).
+    Here runs 0–2 follow sensor A and run 3, with a ten times larger drift, sensor B: on
+    every row B grades best, on runs 0–2 A does."""
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 2 * 3600.0, 30.0)
+    files = []
+    for k in range(4):
+        a = 20 + 5 * (1 - np.exp(-t / 1500.0)) + rng.normal(0, 0.02, t.size)
+        b = 20 + 2 * np.sin(2 * np.pi * t / 3000.0 + k) + rng.normal(0, 0.02, t.size)
+        drift = 2.0 * (a - 20) if k < 3 else 20.0 * (b - 20)
+        files.append(tmp_path / f"run{k}.csv")
+        write_csv(files[-1], {"time_s": t, "A_C": a, "B_C": b,
+                              "d_um": drift + rng.normal(0, 0.05, t.size)})
+    data = read_drift_data(files, targets=["d_um"])
+    model = fit_drift_model(data, method="mlr", sensors="1")
+    assert model.spec.sensors == ("B_C",)                # the final model: every row
+    assert model.metadata["validation"]["sensors_per_block"][3] == ["A_C"]
+    # run 3's out-of-fold prediction is that of a fit on A over runs 0–2
+    later = data.segment_ids() == 3
+    spec = FeatureSpec(("A_C",), tuple(reference_temperatures(data.T_C[:, :1])),
+                       groups=METHODS["mlr"].groups)
+    X = dynamic_features(spec, data.time_s, data.T_C[:, :1], None, data.segment_starts)
+    params = METHODS["mlr"].fit(FitRows(X[~later], data.targets_um[~later], data.time_s[~later],
+                                        data.segment_ids()[~later], 0))
+    expected, _ = METHODS["mlr"].predict(params, X[later])
+    v = model.validation
+    np.testing.assert_allclose(v["predicted_um"][v["block"] == 3], expected, rtol=1e-9)

@@ -1,10 +1,11 @@
 """Fitting a drift model (sensor choice, validation, default method) and predicting with it.
 
 `fit_drift_model` ranks the sensors, picks them (`--sensors auto|K|all|LIST`), runs the
-time-blocked validation of the candidate methods (all of them, or the one forced), fits
-the chosen method on every row with a measured drift, and keeps the interval rule from
-the out-of-fold residuals.  `DriftModel.predict` is causal: the features of a row use
-that row and earlier rows of its file only.
+time-blocked validation of the candidate methods (all of them, or the one forced; each
+fold picks its sensors on its own training rows), fits the chosen method on every row
+with a measured drift, and keeps the interval rule from the out-of-fold residuals.
+`DriftModel.predict` is causal: the features of a row use that row and earlier rows of
+its file only.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from twin.drift.data import TEMPERATURE_SUFFIX, DriftData
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
-from twin.drift.folds import block_labels
+from twin.drift.folds import block_labels, blocked_folds
 from twin.drift.intervals import apply_interval
 from twin.drift.methods import METHODS, FitRows, method_named
 from twin.drift.ranking import SensorRanking, rank_sensors
@@ -117,6 +118,30 @@ def sensor_ranking(data: DriftData) -> SensorRanking:
     return rank_sensors(data.sensors, data.T_C[rows], targets)
 
 
+def sensors_per_fold(option: str, data: DriftData, rows: np.ndarray,
+                     blocks: np.ndarray) -> list[list[str]] | None:
+    """The sensors `--sensors auto|K` picks from each validation fold's training rows
+    (`blocked_folds` order), or None for `all` or a list, which no drift decides.
+
+    Picked on every row, the left-out block's drift had its say in which sensors predict
+    it (its grade and the cluster representatives): a leak of the test targets into the
+    validation.  A fold whose sensors form fewer clusters than K asked for takes them all.
+    """
+    text = option.strip()
+    if text != "auto" and not text.isdigit():
+        return None
+    k = None if text == "auto" else int(text)
+    picked = []
+    with np.errstate(invalid="ignore", divide="ignore"):  # a probe still in a fold: NaN
+        for train, _ in blocked_folds(rows.size, blocks):
+            fit_rows = rows[train]
+            ranking = rank_sensors(data.sensors, data.T_C[fit_rows],
+                                   {t: data.targets_um[fit_rows, j]
+                                    for j, t in enumerate(data.targets)})
+            picked.append(ranking.pick(k))
+    return picked
+
+
 MIN_MEASURED_ROWS = 20
 
 
@@ -197,26 +222,38 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
     names = [method] if method else list(candidates or METHODS)
     if data.speed_rpm is None:
         names = _methods_without_speed(names, method, data, progress)
-    features: dict[tuple[str, ...], np.ndarray] = {}
+    features: dict[tuple[tuple[str, ...], tuple[str, ...]], np.ndarray] = {}
+
+    def features_of(sensor_names: Sequence[str], groups: tuple[str, ...]) -> np.ndarray:
+        key = (tuple(sensor_names), groups)
+        if key not in features:
+            cols = [data.sensors.index(s) for s in sensor_names]
+            spec = FeatureSpec(key[0], tuple(float(v) for v in reference_temperatures(
+                data.T_C[:, cols])), groups=groups)
+            features[key] = dynamic_features(spec, data.time_s, data.T_C[:, cols],
+                                             data.speed_rpm, data.segment_starts)[rows]
+        return features[key]
+
+    fold_sensors = sensors_per_fold(sensors, data, rows, blocks)
     results: list[MethodValidation] = []
     for name in names:
-        spec = FeatureSpec(tuple(chosen_sensors), reference, groups=METHODS[name].groups)
-        if spec.groups not in features:
-            features[spec.groups] = dynamic_features(spec, data.time_s, T, data.speed_rpm,
-                                                     data.segment_starts)[rows]
-        results.append(validate_method(name, features[spec.groups], Y, data.time_s[rows],
-                                       blocks, seed, progress))
+        groups = METHODS[name].groups
+        fold_X = None if fold_sensors is None else [features_of(s, groups)
+                                                    for s in fold_sensors]
+        results.append(validate_method(name, features_of(chosen_sensors, groups), Y,
+                                       data.time_s[rows], blocks, seed, progress, fold_X))
     best = method or choose_default(results)
     result = next(r for r in results if r.name == best)
     spec = FeatureSpec(tuple(chosen_sensors), reference, groups=METHODS[best].groups)
     if progress:
         progress(f"fitting {best} on all rows")
-    params = METHODS[best].fit(FitRows(features[spec.groups], Y, data.time_s[rows], blocks,
-                                       seed, progress))
+    params = METHODS[best].fit(FitRows(features_of(chosen_sensors, spec.groups), Y,
+                                       data.time_s[rows], blocks, seed, progress))
     metadata = {
         "training_files": list(data.files), "n_rows": int(rows.size), "seed": seed,
         "sensors_option": sensors, "ranking": ranking.to_json(),
         "validation": {"blocks": int(np.unique(blocks).size), "chosen": best,
+                       "sensors_per_block": fold_sensors,
                        "methods": {r.name: r.to_json(data.targets) for r in results}},
         "data_findings": data.findings,
     }
