@@ -550,3 +550,21 @@ def test_a_stretch_of_time_without_rows_is_told(tmp_path):
     result = run("fit", str(path), "--target", "drift_um", "--out",
                  str(tmp_path / "m.safetensors"), "--method", "mlr")
     assert result.exit_code == 0 and "without rows" not in result.output
+
+
+def test_fit_tells_the_worst_blocks_coverage_and_older_models_still_report(machine, tmp_path):
+    folder, data, _ = machine
+    model = tmp_path / "m.safetensors"
+    result = run("fit", str(data), "--target", "drift_um", "--out", str(model), "--method",
+                 "mlr", "--sensors", "all")
+    assert result.exit_code == 0, result.output
+    line = next(x for x in result.output.splitlines() if x.lstrip().startswith("mlr"))
+    assert "worst" in line
+    from twin.drift.modelfile import load_drift_model, save_drift_model
+
+    fitted = load_drift_model(model)                  # as written before the per-block shares
+    del fitted.metadata["validation"]["methods"]["mlr"]["coverage_90_pct_per_block"]
+    save_drift_model(fitted, tmp_path / "old.safetensors")
+    result = run("report", str(tmp_path / "old.safetensors"), str(data), "--out",
+                 str(tmp_path / "report"))
+    assert result.exit_code == 0, result.output

@@ -29,6 +29,8 @@ class MethodValidation:
     interval: dict                 # the 90 % interval rule fitted on all residuals
     coverage_pct: list[float]      # per target, interval calibrated without the block
     posterior_coverage_pct: list[float] | None  # per target, uncalibrated posterior
+    coverage_per_block_pct: np.ndarray  # (n_blocks, p): the pooled share hides a block
+    # whose band misses most of it behind blocks covered whole
 
     pooled_rmse_um: np.ndarray     # (p,) over every out-of-fold row
     lo: np.ndarray                 # (n, p) the interval calibrated without the row's block
@@ -45,6 +47,8 @@ class MethodValidation:
                 "rmse_um": {t: float(self.pooled_rmse_um[j]) for j, t in enumerate(targets)},
                 "mean_rmse_um": self.mean_rmse_um,
                 "coverage_90_pct": dict(zip(targets, self.coverage_pct, strict=True)),
+                "coverage_90_pct_per_block": {t: self.coverage_per_block_pct[:, j].tolist()
+                                              for j, t in enumerate(targets)},
                 "posterior_coverage_90_pct": None if self.posterior_coverage_pct is None
                 else dict(zip(targets, self.posterior_coverage_pct, strict=True))}
 
@@ -91,13 +95,15 @@ def validate_method(
         sd = None if std is None else std[labels == k]
         lo[labels == k], hi[labels == k] = apply_interval(rule, predicted[labels == k], sd)
     coverage = [coverage_pct(Y[:, j], lo[:, j], hi[:, j]) for j in range(Y.shape[1])]
+    per_block = np.array([[coverage_pct(Y[test, j], lo[test, j], hi[test, j])
+                           for j in range(Y.shape[1])] for _, test in folds])
     posterior = None
     if std is not None:
         posterior = [coverage_pct(Y[:, j], predicted[:, j] - Z90 * std[:, j],
                                   predicted[:, j] + Z90 * std[:, j]) for j in range(Y.shape[1])]
     pooled = np.sqrt(np.mean((predicted - Y) ** 2, axis=0))
     return MethodValidation(name, predicted, std, rmse, interval_rule(predicted, std, Y),
-                            coverage, posterior, pooled, lo, hi)
+                            coverage, posterior, per_block, pooled, lo, hi)
 
 
 def choose_default(results: Sequence[MethodValidation]) -> str:
