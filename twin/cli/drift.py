@@ -200,6 +200,14 @@ def report(
         for t, m in metrics["targets"].items():
             typer.echo(f"{t:12s} RMSE {m['rmse_um']:.2f} µm, 90 % interval coverage "
                        f"{m['coverage_90_pct']:.1f} %")
+        fitted = metrics["fitted_rows_pct"]
+        if fitted:
+            validation = model.metadata.get("validation", {})
+            chosen = validation.get("methods", {}).get(validation.get("chosen"), {})
+            unseen = (f" (time-blocked validation at fitting: {chosen['mean_rmse_um']:.2f} µm "
+                      "mean RMSE on unseen blocks)" if "mean_rmse_um" in chosen else "")
+            typer.echo(f"note: in-sample: {fitted:.0f} % of these rows are from data the "
+                       f"model was fitted on, so these figures flatter it{unseen}")
         typer.echo(f"wrote {metrics_path} and {html_path}")
 
 

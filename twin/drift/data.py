@@ -19,6 +19,7 @@ lines.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -52,6 +53,17 @@ def temperature_columns(table: RawTable) -> list[str]:
 
 def displacement_columns(table: RawTable) -> list[str]:
     return [n for n in table.columns if n.endswith(DISPLACEMENT_SUFFIX)]
+
+
+def array_digest(arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 of named arrays: names sorted, each name, shape and little-endian float64
+    bytes (the drift model file's tensor checksum, and what identifies fitting data)."""
+    h = hashlib.sha256()
+    for name in sorted(arrays):
+        h.update(name.encode())
+        h.update(str(arrays[name].shape).encode())
+        h.update(np.ascontiguousarray(arrays[name], dtype="<f8").tobytes())
+    return h.hexdigest()
 
 
 @dataclass(frozen=True)
@@ -91,6 +103,23 @@ class DriftData:
         ids = np.zeros(self.n_samples, dtype=np.int64)
         ids[self.segment_starts[1:]] = 1
         return np.cumsum(ids)
+
+    def segment_digests(self, sensors: Sequence[str], speed: bool) -> list[str]:
+        """Per file, the digest of what a model of `sensors` (and the speed) reads of it as
+        read (copies dropped, gaps bridged): time, temperatures, speed, targets.  The
+        same data under another name or in the other format has the same digest."""
+        columns = [self.sensors.index(s) for s in sensors]
+        ids = self.segment_ids()
+        out = []
+        for k in range(len(self.files)):
+            rows = ids == k
+            arrays = {"time_s": self.time_s[rows], "T_C": self.T_C[rows][:, columns]}
+            if speed and self.speed_rpm is not None:
+                arrays["speed_rpm"] = self.speed_rpm[rows]
+            if self.targets_um is not None:
+                arrays["targets_um"] = self.targets_um[rows]
+            out.append(array_digest(arrays))
+        return out
 
 
 def _has_values(table: RawTable, name: str) -> bool:

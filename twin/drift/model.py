@@ -251,6 +251,8 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
                                        data.time_s[rows], blocks, seed, progress))
     metadata = {
         "training_files": list(data.files), "n_rows": int(rows.size), "seed": seed,
+        # what `report` tells in-sample data by, whatever the file is called now
+        "training_digests": data.segment_digests(chosen_sensors, spec.uses_speed),
         "sensors_option": sensors, "ranking": ranking.to_json(),
         "validation": {"blocks": int(np.unique(blocks).size), "chosen": best,
                        "sensors_per_block": fold_sensors,

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
+from twin.drift.data import array_digest
 from twin.drift.features import FeatureSpec
 from twin.drift.methods import METHODS
 from twin.drift.model import DriftModel
@@ -36,15 +37,6 @@ VERSION = DRIFT.version
 METADATA_KEY = DRIFT.key
 VALIDATION = "validation."
 """Prefix of the tensors holding the out-of-fold validation (shown by `twin drift report`)."""
-
-
-def _digest(tensors: dict[str, np.ndarray]) -> str:
-    h = hashlib.sha256()
-    for name in sorted(tensors):
-        h.update(name.encode())
-        h.update(str(tensors[name].shape).encode())
-        h.update(np.ascontiguousarray(tensors[name], dtype="<f8").tobytes())
-    return h.hexdigest()
 
 
 def _metadata_digest(doc: dict) -> str:
@@ -62,7 +54,7 @@ def save_drift_model(model: DriftModel, path: str | os.PathLike[str]) -> Path:
                     for k, v in model.validation.items()})
     doc = {"format": FORMAT, "version": VERSION, "method": model.method,
            "targets": model.targets, "features": model.spec.to_json(),
-           "interval": model.interval, "metadata": model.metadata, "sha256": _digest(tensors)}
+           "interval": model.interval, "metadata": model.metadata, "sha256": array_digest(tensors)}
     doc["metadata_sha256"] = _metadata_digest(doc)
     data = save(tensors, metadata={METADATA_KEY: json.dumps(doc, sort_keys=True,
                                                              allow_nan=True)})
@@ -78,7 +70,7 @@ def load_drift_model(path: str | os.PathLike[str]) -> DriftModel:
     for name, array in tensors.items():
         if array.dtype != np.float64 or not np.all(np.isfinite(array)):
             raise InputError(f"tensor {name!r} is not finite float64", file=file)
-    if doc.get("sha256") != _digest(tensors):
+    if doc.get("sha256") != array_digest(tensors):
         raise InputError("checksum mismatch: the weights were modified or damaged", file=file)
     if "metadata_sha256" in doc and doc["metadata_sha256"] != _metadata_digest(doc):
         raise InputError("checksum mismatch: the metadata (sensors, reference temperatures, "

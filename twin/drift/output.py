@@ -51,6 +51,20 @@ def _finite_mean(values: list[float]) -> float:
     return float(finite.mean()) if finite.size else float("nan")
 
 
+def fitted_share_pct(model: DriftModel, data: DriftData) -> float | None:
+    """Share (%) of the data's rows in files the model was fitted on (the same time,
+    temperatures, speed and drifts, `DriftData.segment_digests`), None for a model that
+    does not record its data's digests: `report` on the fitting data gave 0.3 µm RMSE on
+    the real step tests beside a validation of 3 µm, and only a sentence starting 'if'
+    told which is which."""
+    known = model.metadata.get("training_digests")
+    if not isinstance(known, list):
+        return None
+    digests = data.segment_digests(model.spec.sensors, model.spec.uses_speed)
+    fitted = np.isin(data.segment_ids(), [k for k, d in enumerate(digests) if d in known])
+    return 100.0 * float(np.mean(fitted))
+
+
 def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
                   hi: np.ndarray) -> dict:
     """metrics.json: per target rmse_um, mae_um, max_abs_um, r2, coverage_90_pct."""
@@ -64,6 +78,7 @@ def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.n
     return _finite_or_none({
         "method": model.method, "files": list(data.files), "n_rows": data.n_samples,
         "sensors": list(model.spec.sensors), "targets": per_target, "mean": mean_of,
+        "fitted_rows_pct": fitted_share_pct(model, data),
         "interval": model.interval, "data_findings": data.findings,
         "validation": validation})
 
