@@ -602,3 +602,18 @@ def test_fit_tells_the_worst_blocks_coverage_and_older_models_still_report(machi
     result = run("report", str(tmp_path / "old.safetensors"), str(data), "--out",
                  str(tmp_path / "report"))
     assert result.exit_code == 0, result.output
+
+
+def test_a_one_row_file_is_refused_for_its_length(tmp_path):
+    """It was 'every temperature column reads one value throughout', true of one row and
+    no help: the file is too short."""
+    data = tmp_path / "one.csv"
+    write_csv(data, {k: v[:1] for k, v in synthetic_columns(hours=0.5).items()})
+    for args in (["fit", str(data), "--out", str(tmp_path / "m.safetensors")],
+                 ["select", str(data)]):
+        result = run(*args, "--target", "drift_um")
+        assert result.exit_code == 2
+        assert result.output.strip().splitlines()[-1] == (
+            f"error: {data}, column 'drift_um': only 1 sample holds every target; need at "
+            "least 20")
+

@@ -220,6 +220,10 @@ def usable_temperatures(tables: Sequence[RawTable]) -> tuple[list[str], dict[str
     left_out = {n: "not in " + ", ".join(t.file for t, names in zip(tables, held, strict=True)
                                          if n not in names) + " (a sensor is in every file)"
                 for names in held for n in names if n not in common}
+    if sum(t.n_samples for t in tables) < 2:
+        # one sample shows no column change: refused for its length where the rows with a
+        # drift are counted (it was 'every temperature column reads one value throughout')
+        return common, left_out
     constant = {n: v for n in common if (v := _constant_value(tables, n)) is not None}
     if len(constant) == len(common):
         raise InputError(f"every temperature column ({', '.join(common)}) reads one value "
