@@ -617,3 +617,16 @@ def test_a_one_row_file_is_refused_for_its_length(tmp_path):
             f"error: {data}, column 'drift_um': only 1 sample holds every target; need at "
             "least 20")
 
+
+def test_no_temperature_column_tells_what_the_header_has(tmp_path):
+    """A logger's own names ('T front bearing') are not read: the message lists them."""
+    columns = synthetic_columns(hours=0.5)
+    data = tmp_path / "logger.csv"
+    write_csv(data, {"time_s": columns["time_s"], "T front bearing": columns["A_C"],
+                     "drift_um": columns["drift_um"]})
+    result = run("fit", str(data), "--target", "drift_um", "--out",
+                 str(tmp_path / "m.safetensors"))
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert result.output.strip().splitlines()[-1] == (
+        f"error: {data}, line 1: no temperature columns (names ending in _C) (the header has "
+        "time_s, drift_um, T front bearing)")

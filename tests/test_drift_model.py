@@ -140,12 +140,13 @@ def test_drift_data_errors_name_a_csv_files_line_and_a_parquet_files_row(tmp_pat
                               f"({before}) to 120 s; samples must be in time order")
     del columns["A_C"], columns["B_C"], columns["C_C"]
     path.unlink()
+    held = "(the header has time_s, speed_rpm, drift_um)"
     if suffix == ".csv":  # the header's line; a Parquet file has none to name
         write_csv(path, columns, metadata="# machine: m1\n")
-        message = f"{path}, line 2: no temperature columns (names ending in _C)"
+        message = f"{path}, line 2: no temperature columns (names ending in _C) {held}"
     else:
         pq.write_table(pa.table(columns), path)
-        message = f"{path}: no temperature columns (names ending in _C)"
+        message = f"{path}: no temperature columns (names ending in _C) {held}"
     with pytest.raises(InputError) as err:
         read_drift_data([path], targets=["drift_um"])
     assert str(err.value) == message

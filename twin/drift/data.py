@@ -31,7 +31,7 @@ from twin.runs import read_table
 from twin.runs.quality import drop_repeated_rows, true_runs
 from twin.runs.schema import SPEED, TIME
 from twin.runs.table import RawTable, check_distinct_tables
-from twin.runs.validate import checked_time, column_with_values, required_column
+from twin.runs.validate import checked_time, column_with_values, header_hint, required_column
 
 TEMPERATURE_SUFFIX = "_C"
 DISPLACEMENT_SUFFIX = "_um"
@@ -193,7 +193,9 @@ def _without_repeated_rows(table: RawTable) -> tuple[RawTable, list[dict]]:
 def _check_temperatures(table: RawTable) -> list[str]:
     names = temperature_columns(table)
     if not names:
-        raise table.error("no temperature columns (names ending in _C)", table.header_row)
+        # a logger's 'T front bearing' or 'Temp1 [°C]' is not read: say what the file holds
+        raise table.error(f"no temperature columns (names ending in _C) {header_hint(table)}",
+                          table.header_row)
     return names
 
 

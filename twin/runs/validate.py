@@ -48,12 +48,14 @@ def required_column(table: RawTable, name: str) -> np.ndarray:
     the header has instead: a logger's `TIME_S` or `timestamp` was told only as a missing
     `time_s`."""
     if name not in table.columns:
-        raise table.error(f"missing required column {_header_hint(table, name)}",
+        raise table.error(f"missing required column {header_hint(table, name)}",
                           table.header_row, name)
     return table.columns[name]
 
 
-def _header_hint(table: RawTable, name: str) -> str:
+def header_hint(table: RawTable, name: str = "") -> str:
+    """'(the header has …)': the file's column names, or the one spelt like `name` but for
+    its case."""
     header = [*table.columns, *table.ignored_columns]
     near = [h for h in header if h.strip().lower() == name.lower()]
     if near:
