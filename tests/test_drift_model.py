@@ -475,3 +475,26 @@ def test_validation_tells_the_interval_coverage_of_every_block(ridge_model):
         assert share == pytest.approx(100.0 * np.mean(inside))
     assert np.average(per_block, weights=np.bincount(block)) == pytest.approx(
         v["coverage_90_pct"]["drift_um"])
+
+
+@pytest.mark.parametrize("method", ["mlr", "ridge_lagged", "ridge_dynamic", "bp", "bayes",
+                                    "stack"])
+def test_a_rows_prediction_does_not_change_when_later_rows_are_cut(data_file, tmp_path,
+                                                                   method):
+    """DESIGN: the prediction at a row uses rows up to it only.  Cut the file after a row:
+    the predictions and bands up to it stay (to rounding: a batch of other length sums in
+    another order, ~1e-7 µm of the Bayesian band in single precision)."""
+    data = read_drift_data([data_file], targets=["drift_um"])
+    model = fit_drift_model(data, method=method, sensors="all", seed=0)
+    path = save_drift_model(model, tmp_path / "m.safetensors")
+    full = [a.copy() for a in load_drift_model(path).predict(data)]
+    lines = data_file.read_text().splitlines(keepends=True)
+    header = next(k for k, line in enumerate(lines) if not line.startswith("#"))
+    for n in (1, 2, 37, 500):
+        cut = tmp_path / f"first{n}.csv"
+        cut.write_text("".join(lines[: header + 1 + n]))
+        part = model.predict(read_drift_data([cut], sensors=list(model.spec.sensors),
+                                             require_targets=False))
+        for whole, head in zip(full, part, strict=True):
+            assert head.shape == (n, 1)
+            np.testing.assert_allclose(head, whole[:n], rtol=0, atol=1e-6)
