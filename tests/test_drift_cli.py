@@ -630,3 +630,25 @@ def test_no_temperature_column_tells_what_the_header_has(tmp_path):
     assert result.output.strip().splitlines()[-1] == (
         f"error: {data}, line 1: no temperature columns (names ending in _C) (the header has "
         "time_s, drift_um, T front bearing)")
+
+
+def test_rows_without_a_measured_drift_are_told(machine, tmp_path):
+    """A probe's dropout left its rows out of fitting and of the metrics without a word."""
+    _, _, model = machine
+    columns = synthetic_columns(hours=1.0)
+    columns["drift_um"][30:41] = np.nan                   # samples 31-41: lines 32-42
+    data = tmp_path / "dropout.csv"
+    write_csv(data, columns)
+    note = (f"note: {data}, lines 32–42, column 'drift_um': no drift measured: left out of "
+            "fitting and of the metrics")
+    result = run("fit", str(data), "--target", "drift_um", "--method", "mlr", "--out",
+                 str(tmp_path / "m.safetensors"))
+    assert result.exit_code == 0, result.output
+    assert note in result.output.splitlines()
+    result = run("report", str(model), str(data), "--out", str(tmp_path / "report"))
+    assert note in result.output.splitlines()
+    metrics = json.loads((tmp_path / "report" / "metrics.json").read_text())
+    assert metrics["targets"]["drift_um"]["n"] == columns["time_s"].size - 11
+    # predict reads no drift: nothing to tell
+    result = run("predict", str(model), str(data), "--out", str(tmp_path / "p.csv"))
+    assert "no drift measured" not in result.output

@@ -288,6 +288,11 @@ def drift_data(
             # predict reads no target: a column left blank for the drift to come is none
             drifts.append(np.stack([column_with_values(table, name) if require_targets
                                     else table.columns[name] for name in targets], axis=1))
+            if require_targets:  # a probe's dropout left rows out of fitting unsaid
+                for j, name in enumerate(targets):
+                    findings += _gap_findings(
+                        table, name, true_runs(np.isnan(drifts[-1][:, j])),
+                        "no drift measured: left out of fitting and of the metrics")
         else:
             drifts.append(np.full((t.size, len(targets)), np.nan))
         times.append(t)
