@@ -652,3 +652,8 @@ def test_rows_without_a_measured_drift_are_told(machine, tmp_path):
     # predict reads no drift: nothing to tell
     result = run("predict", str(model), str(data), "--out", str(tmp_path / "p.csv"))
     assert "no drift measured" not in result.output
+
+
+def test_fit_help_says_what_a_validation_block_is():
+    text = " ".join(result_text(run("fit", "--help")).split())
+    assert "A block is a file, or a quarter of the rows when one file is given" in text

@@ -104,7 +104,12 @@ def fit(
                              help="Seed of the network weights and k-means."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress output."),
 ) -> None:
-    """Fit a drift model; validation leaves one time block out at a time (never shuffled)."""
+    """Fit a drift model; validation leaves one time block out at a time (never shuffled).
+
+    A block is a file, or a quarter of the rows when one file is given; the
+    sensors are picked again on the other blocks, and the interval is calibrated
+    on them.
+    """
     from twin.cli.inputs import check_not_bundled_model
     from twin.drift.data import read_drift_data
     from twin.drift.methods import method_named
