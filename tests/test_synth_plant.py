@@ -199,3 +199,22 @@ def test_cli(tmp_path):
         bad = runner.invoke(app, argv)
         assert bad.exit_code == 2, (args, bad.output)
     assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize("ambient", ["45", "-40"])
+def test_a_run_emulated_at_a_bound_of_the_range_replays(tmp_path, ambient):
+    """--ambient 45 and -40 lie in the range every reader accepts, but the air and inlet
+    readings' noise crossed it: the run was emulated and then refused ("would be refused
+    by replay", at 45 as "looks like Fahrenheit").  The readings now stay in the range."""
+    from twin.cli import app
+    from twin.contract import OPERATING_TEMPERATURE_C
+
+    out = tmp_path / "bound.csv"
+    done = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "3", "--ambient",
+                                    ambient, "--seed", "900999", "--out", str(out), "--quiet"])
+    assert done.exit_code == 0, done.output
+    run = read_run(out)
+    lo, hi = OPERATING_TEMPERATURE_C
+    for reading in (run.ambient_C, run.coolant_C):
+        assert lo <= reading.min() and reading.max() <= hi
+        assert np.ptp(reading) > 0.0  # a reading still, noise and all, inside

@@ -209,8 +209,9 @@ def analyse_run(run_csv: Path, replay_dir: Path, method: str) -> dict:
         "def": (e["deformation_accuracy_pct"] or 0.0) >= 96.0,
         "rmse": mean_rmse(e) <= mean_rmse(o) / 3,
         "drift": e["rmse_um"] is not None and e["rmse_um"] <= o["rmse_um"] / 2,
-        "coverage": 70.0 <= (e["band_coverage_pct"] or 0.0) <= 99.0,
     }
+    if e["band_coverage_pct"] is not None:  # a method with a band (bpnn, ratio have none)
+        res["criteria"]["coverage"] = 70.0 <= e["band_coverage_pct"] <= 99.0
     res["rmse_ratio"] = mean_rmse(e) / mean_rmse(o)
     res["drift_ratio"] = e["rmse_um"] / o["rmse_um"] if e["rmse_um"] else np.nan
     res["coverage"] = e["band_coverage_pct"]
@@ -228,11 +229,12 @@ def summary_lines(results: list[dict], method: str) -> list[str]:
     T = np.array([r[method]["T"] for r in results])
     D = np.array([r[method]["def"] for r in results])
     counts = {c: sum(r["criteria"][c] for r in results) for c in results[0]["criteria"]}
-    cov = [r["coverage"] for r in results]
+    cov = [r["coverage"] for r in results if r["coverage"] is not None]
+    coverage = f"; coverage {min(cov):.1f}–{max(cov):.1f} %" if cov else "; no band"
     return [f"{method}: temperature {np.median(T):.2f} / {T.min():.2f} (median / worst), "
             f"deformation {np.median(D):.2f} / {D.min():.2f}; runs meeting "
             + " · ".join(f"{c} {n}" for c, n in counts.items())
-            + f" of {len(results)}; coverage {min(cov):.1f}–{max(cov):.1f} %",
+            + f" of {len(results)}" + coverage,
             "causal oracle (a ceiling): runs meeting T "
             f"{sum(r['oracle']['T'] >= 99.5 for r in results)} · def "
             f"{sum(r['oracle']['def'] >= 96.0 for r in results)} · rmse "

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from twin.contract import SENSOR_NAMES
+from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
 from twin.lag import first_order_lag
 from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
@@ -277,13 +277,18 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         x_true, y_true = (np.interp(t_out, truth.time_s, axis) for axis in xy)
     else:  # a scenario's prescribed [xy_drift]
         x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
+    # the air and inlet readings stay in the range every reader accepts: at --ambient 45
+    # (a bound) their noise crossed it, and the run emulated was refused by replay
+    ambient_read = add_noise(rng, tables.ambient_C(t_out), sensors.noise_C)
+    T_read = {f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
+              for j, s in enumerate(SENSOR_NAMES)}
+    coolant_read = add_noise(rng, tables.coolant_C(t_out), sensors.noise_C)
     columns = {
         "time_s": t_out,
         "speed_rpm": speed(t_out).astype(float),
-        "ambient_C": add_noise(rng, tables.ambient_C(t_out), sensors.noise_C),
-        **{f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
-           for j, s in enumerate(SENSOR_NAMES)},
-        "coolant_C": add_noise(rng, tables.coolant_C(t_out), sensors.noise_C),
+        "ambient_C": np.clip(ambient_read, *OPERATING_TEMPERATURE_C),
+        **T_read,
+        "coolant_C": np.clip(coolant_read, *OPERATING_TEMPERATURE_C),
         "disp_x_um": add_noise(rng, x_true, sensors.noise_um),
         "disp_y_um": add_noise(rng, y_true, sensors.noise_um),
         "disp_z_um": add_noise(rng, disp_z, sensors.noise_um),
