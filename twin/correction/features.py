@@ -182,8 +182,9 @@ class WindowFeatures:
     """The twin's field and conditions at the window start (set by the loop)."""
     measured_drift_um: np.ndarray | None = None
     """(n,) the recorded axial nose drift at `measured_time_s` (NaN: invalid; None: not
-    recorded), less the probe's start reading where it was not zeroed at the run start
-    (`twin.loop.replay.probe_start_offset_um`).  Only an estimator told to assimilate it
+    recorded, or left out as in mm or reversed: `twin.loop.findings.probe_left_out`), less
+    the probe's start reading where it was not zeroed at the run start
+    (`twin.loop.findings.probe_start_offset_um`).  Only an estimator told to assimilate it
     reads it."""
     measured_speed_rpm: np.ndarray | None = None
     """(n,) the recorded speed at `measured_time_s` (None: not passed).  An estimator

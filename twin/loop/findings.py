@@ -11,7 +11,7 @@ quality.json findings that need the loop's own rules or the twin.
 - `warms_unlike_twin`: the thermocouples warm many times more than the open-loop twin at
   the recorded speeds (a speed column in rev/s or krpm).
 
-Every finding is told and changes no score: the metrics compare with the readings as
+Every finding is told; none changes what the metrics compare with: the readings as
 recorded (DESIGN.md), the quality check's exclusions aside.
 """
 

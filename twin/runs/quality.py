@@ -15,7 +15,7 @@ finding is a plain JSON-serialisable dict:
 `rows` are 1-based file lines (CSV) or data rows (Parquet), at most `MAX_LISTED` of them;
 `count` is the number of samples concerned; `spans_s` are time spans in run time.  A
 finding that counts something else names it in the key instead of `count`: a replay's
-`correction_held` (`twin.loop.replay.held_correction_findings`) has `count_windows`.
+`correction_held` (`twin.loop.findings.held_correction_findings`) has `count_windows`.
 """
 
 from __future__ import annotations
