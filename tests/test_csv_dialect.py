@@ -180,6 +180,23 @@ def test_a_cell_a_thousands_separator_cannot_make_is_a_decimal_comma(tmp_path, c
     assert table.dialect == "semicolon-separated, with decimal commas"
 
 
+def test_a_temperature_with_three_decimals_is_a_decimal_and_a_refusal_says_what_decides(
+        tmp_path):
+    """A ';' logger writing integer times and speeds and three-decimal temperatures had
+    every '22,125' refused (no other number showed the mark), and the message's way out
+    was the refused cell itself.  A temperature is never grouped: read as 22.125 °C.  A
+    speed still is refused, and told a fourth decimal decides."""
+    text = ("time_s;speed_rpm;ambient_C;T1_C;T2_C;T3_C;T4_C;T5_C\n"
+            + "".join(f"{60 * k};9000;22,125;{22 + k},125;22,250;22,375;22,500;22,625\n"
+                      for k in range(4)))
+    table = read_csv_table(write(tmp_path, text, "three.csv"))
+    assert table.columns["T1_C"].tolist() == [22.125, 23.125, 24.125, 25.125]
+    assert table.columns["ambient_C"][0] == 22.125
+    profile = write(tmp_path, "time_s;speed_rpm\n0;0\n60;9,125\n120;0\n", "profile.csv")
+    with pytest.raises(InputError, match="tell; write 9125 or 9,1250$"):
+        read_csv_table(profile, max_rows=None)
+
+
 # Through the commands, as a user runs them: every CSV input goes through the one reader.
 
 BUNDLED_RUN = "spindle_steps_faults_30min.csv"  # its faults: gaps, nan cells, a dead sensor

@@ -351,6 +351,28 @@ def test_an_axial_probe_frozen_for_a_spell_is_stuck_there(tmp_path):
     assert found["spans_s"] == [[600.0, 899.0]] and found["count"] == 300
     assert found["detail"] == "repeats one reading while the thermocouples move"
     assert np.flatnonzero(~run.valid["disp_z_um"]).tolist() == list(range(600, 900))
-    resolved = np.round(drift, 1)
-    assert kinds(read_run(write(tmp_path, csv_text({**cols, "disp_z_um": resolved}))),
-                 "disp_z_um") == set()
+    for step_um in (0.1, 0.5, 1.0):  # a probe logged in steps repeats its readings
+        resolved = step_um * np.round(drift / step_um)
+        assert kinds(read_run(write(tmp_path, csv_text({**cols, "disp_z_um": resolved}))),
+                     "disp_z_um") == set(), step_um
+
+
+def test_a_flat_probe_is_frozen_or_in_mm_by_one_rule_and_a_log_gap_is_no_time_at_speed(
+        tmp_path):
+    """A probe in mm off 0 by 0.095 mm (0.095 to 0.106 in the column) was taken for stuck,
+    the rules for 'stuck' and 'in mm' measuring it apart; and 20 min at speed could be 5
+    min of samples and a gap in the log."""
+    from twin.runs.quality import FLAT_FROZEN, FLAT_IN_MM, QualityConfig, flat_probe
+
+    cfg = QualityConfig()
+    t = np.arange(0.0, 1500.0, 1.0)
+    speed, ok = np.full(t.size, 9000.0), np.ones(t.size, dtype=bool)
+    drift_mm = 0.011 * (1.0 - np.exp(-t / 600.0))
+    assert flat_probe(t, 0.095 + drift_mm, speed, ok, cfg)[0] == FLAT_IN_MM
+    assert flat_probe(t, drift_mm, speed, ok, cfg)[0] == FLAT_IN_MM
+    assert flat_probe(t, np.full(t.size, 0.0), speed, ok, cfg)[0] == FLAT_FROZEN
+    assert flat_probe(t, 20.0 + 0.04 * np.sin(t), speed, ok, cfg)[0] == FLAT_FROZEN
+    assert flat_probe(t, 11e3 * drift_mm, speed, ok, cfg) is None  # a drift in µm
+    gap = np.r_[np.arange(0.0, 300.0, 1.0), np.arange(1500.0, 1800.0, 1.0)]
+    assert flat_probe(gap, np.zeros(gap.size), np.full(gap.size, 9000.0),
+                      np.ones(gap.size, dtype=bool), cfg) is None  # 10 min seen, not 30

@@ -32,7 +32,15 @@ from twin.correction.features import (
     window_observed,
 )
 from twin.runs import TEMPERATURES, RecordedRun
-from twin.runs.quality import AXIAL_PROBE, QualityConfig, finding, running_s, true_runs
+from twin.runs.quality import (
+    AXIAL_PROBE,
+    FLAT_IN_MM,
+    QualityConfig,
+    finding,
+    flat_probe,
+    running_s,
+    true_runs,
+)
 
 if TYPE_CHECKING:
     from twin.spindle.model import SpindleModel
@@ -167,20 +175,16 @@ PROBE_IN_MM = "probe_in_mm"
 
 def probe_in_mm(run: RecordedRun) -> tuple[float, float] | None:
     """(largest |reading| µm, time at speed s) of an axial probe that reads next to
-    nothing while the spindle runs (`QualityConfig.probe_flat_um` through
-    `probe_flat_running_s` at speed): a column written in mm, the twin's disp_z_um being
-    µm.  None for a probe that reads the drift (or none recorded)."""
+    nothing while the spindle runs (`twin.runs.quality.flat_probe`, `FLAT_IN_MM`): a
+    column written in mm, the twin's disp_z_um being µm.  None for a probe that reads the
+    drift (or none recorded; a frozen one the quality check excluded)."""
     if run.disp_um is None or AXIAL_PROBE not in run.valid:
         return None
     valid = run.valid[AXIAL_PROBE]
-    if not valid.any():
+    flat = flat_probe(run.time_s, run.disp_um[:, 2], run.speed_rpm, valid, QualityConfig())
+    if flat is None or flat[0] != FLAT_IN_MM:
         return None
-    cfg = QualityConfig()
-    at_speed_s = running_s(run.time_s, run.speed_rpm, valid)
-    span = float(np.max(np.abs(run.disp_um[valid, 2])))
-    if at_speed_s < cfg.probe_flat_running_s or span >= cfg.probe_flat_um:
-        return None
-    return span, at_speed_s
+    return float(np.max(np.abs(run.disp_um[valid, 2]))), flat[2]
 
 
 def probe_scale_findings(run: RecordedRun) -> list[dict]:
@@ -221,12 +225,13 @@ def probe_reversed(run: RecordedRun, model: SpindleModel) -> float | None:
     if run.disp_um is None or AXIAL_PROBE not in run.valid:
         return None
     valid = run.valid[AXIAL_PROBE]
+    cfg = QualityConfig()
     T = run.T_valid_C
     read = np.isfinite(T).sum(axis=1)
     T_mean = np.where(read > 0, np.nansum(T, axis=1) / np.maximum(read, 1), np.nan)
     both = valid & (read > 0)
-    if both.sum() < 3 or running_s(run.time_s, run.speed_rpm, both) < \
-            QualityConfig().probe_flat_running_s:
+    if both.sum() < 3 or running_s(run.time_s, run.speed_rpm, both, cfg.max_gap_s) < \
+            cfg.probe_flat_running_s:
         return None
     x = run.disp_um[both, 2]
     if np.ptp(x) <= PROBE_ZERO_TOLERANCE_UM or np.ptp(T_mean[both]) == 0:

@@ -327,6 +327,9 @@ def replay_method(
         # its change since the run start where the probe was not zeroed there
         measured_drift = np.where(run.valid[AXIAL_PROBE],
                                   run.disp_um[:, 2] - probe_start_offset_um(run), np.nan)
+    recorded_coolant = None  # the inlet as measured: NaN where the quality check filled
+    if run.coolant_C is not None:  # a long dropout from a reading after it
+        recorded_coolant = np.where(run.valid.get("coolant_C", True), run.coolant_C, np.nan)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)
     starts = WINDOW_S * np.arange(windows)
@@ -380,7 +383,7 @@ def replay_method(
             measured_speed_rpm=run.speed_rpm[upto],
             previous_factors=tuple(factors),
             coolant_recorded=state.coolant_C is not None,
-            measured_coolant_C=None if run.coolant_C is None else run.coolant_C[upto],
+            measured_coolant_C=None if recorded_coolant is None else recorded_coolant[upto],
         )
         previous_end = T
         if reruns and last is not None and (

@@ -12,7 +12,8 @@ to read a header holding both `;` and tabs.  In a `;` or tab file a number's dec
 mark may be a comma ("22,5") or a point.  Thousands separators are never read: a cell
 with both marks ("1.234,5", "9,000.5") or one mark twice ("1.234.567") is refused.  A
 cell that reads either way, 1-3 digits (not a lone 0), one mark, exactly 3 digits
-("9.000": 9000 rpm formatted with a separator, or 9.0), is read only where the file's
+("9.000": 9000 rpm formatted with a separator, or 9.0), is read in a temperature
+column (`*_C`: no temperature is grouped) and elsewhere only where the file's
 other numbers show the mark to be the decimal one (they use it and never the other:
 "9.000" beside "22.5" is 9.0, "9,000" beside "22,5" too); otherwise it is refused,
 naming the cell (Excel writes 9000 rpm as "9000" unless the column is formatted with
@@ -267,7 +268,10 @@ class DecimalMarks:
         mark = "," if "," in cell else "." if "." in cell else None
         if mark is not None and not (mark in self.shown and mark in self.undecided):
             text = cell.strip()
-            found = self.undecided if _AMBIGUOUS.fullmatch(text) else self.shown
+            # a temperature is never grouped: '22,125' in a *_C column is 22.125 °C (a
+            # logger writing three decimals had every cell refused, the file unreadable)
+            ambiguous = _AMBIGUOUS.fullmatch(text) and not column.endswith("_C")
+            found = self.undecided if ambiguous else self.shown
             if mark not in found:
                 found[mark] = (line, column, text)
                 self.check_undecided(final=False)  # told where it is decided, in file order
@@ -293,10 +297,13 @@ class DecimalMarks:
                              f"{cell!r})" for m, (at, name, cell) in sorted(self.shown.items()))
         evidence = (f"the file's other numbers have {shown}" if shown else
                     "no other number in the file has a decimal mark to tell")
+        decimal = f"{lead}{writes}{fraction.rstrip('0') or '0'}"
+        if decimal == text:  # the refused cell itself: a fourth decimal decides
+            decimal = f"{lead}{writes}{fraction}0"
         raise InputError(f"cannot read {text!r} as a number: {lead}{fraction} with a "
                          f"thousands separator, or {float(text.replace(',', '.')):g} with a "
                          f"decimal {_MARK_NAMES[mark]}? {evidence}; write "
-                         f"{lead}{fraction} or {lead}{writes}{fraction.rstrip('0') or '0'}",
+                         f"{lead}{fraction} or {decimal}",
                          file=self.file, row=line, column=column, row_unit=LINE)
 
 
