@@ -70,6 +70,27 @@ def test_long_dropout_excluded(tmp_path):
     assert s.valid["T4_C"].tolist() == [True, False, True]
 
 
+@pytest.mark.parametrize("name", ["coolant_C", "ambient_C"])
+def test_the_air_and_coolant_hold_their_last_reading_through_a_gap(tmp_path, name):
+    """The twin runs its boundaries at these: filled linearly, a 10-min gap in a coolant
+    log ramped the inlet a window's forecast ran at towards a reading made after the
+    window, which no causal twin has.  Held, as the speed is; a thermocouple's gap is
+    still interpolated."""
+    cols = warmup(n=900)
+    cols["coolant_C"] = np.where(cols["time_s"] < 600.0, 22.0, 25.0)
+    cols[name][300:600] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols)))
+    f = one(run, "long_dropout", name)
+    assert f["action"] == "held at the last reading for continuity; excluded from metrics"
+    filled = run.coolant_C if name == "coolant_C" else run.ambient_C
+    assert np.all(filled[300:600] == filled[299])
+    assert not run.valid[name][300:600].any()
+    cols["T3_C"][300:600] = np.nan
+    run = read_run(write(tmp_path, csv_text(cols), "t3.csv"))
+    assert one(run, "long_dropout", "T3_C")["action"] == (
+        "linearly interpolated in time for continuity; excluded from metrics")
+
+
 def test_leading_dropout_held_and_flagged(tmp_path):
     cols = warmup()
     cols["T5_C"][:5] = np.nan

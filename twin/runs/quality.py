@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from twin.runs.schema import AMBIENT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
+from twin.runs.schema import AMBIENT, COOLANT, DISPLACEMENTS, SPEED, TEMPERATURES, TIME
 from twin.runs.table import RawTable
 
 MAX_LISTED = 20
@@ -281,10 +281,18 @@ def repair_speed_glitches(t: np.ndarray, x: np.ndarray, rows: np.ndarray,
                                 f"{cfg.speed_glitch_max_s:g} s apart")]
 
 
+HELD_INPUTS = (SPEED, AMBIENT, COOLANT)
+"""The recorded columns the twin runs on (`fill_dropouts` holds them through a gap)."""
+
+
 def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
                   cfg: QualityConfig) -> tuple[np.ndarray, np.ndarray, list[dict]]:
-    """Interpolate NaN runs linearly in time (a speed, a command that holds until the
-    next, keeps its last value); runs longer than `max_gap_s` are excluded."""
+    """Interpolate NaN runs linearly in time; runs longer than `max_gap_s` are excluded.
+    The twin's inputs (`HELD_INPUTS`: the speed, a command that holds until the next, and
+    the air and coolant temperatures its boundaries run at) keep their last value instead:
+    a linear fill reads a value measured after the gap, and a window's loads may use only
+    what was measured before it starts (DESIGN.md).  Until 2026-11-27 a coolant log with a
+    10-min gap ramped the inlet the replay ran at towards the reading after it."""
     valid = np.ones(x.size, dtype=bool)
     missing = np.isnan(x)
     if not missing.any():
@@ -293,13 +301,14 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     out = x.copy()
     # Beyond the first/last value the nearest value is held (np.interp clamps).
     out[missing] = np.interp(t[missing], t[ok], x[ok])
-    if name == SPEED:
+    if name in HELD_INPUTS:
         # a linear fill would ramp across a step the gap hides; the last value holds
         # (before the first value, the first, as above)
         last = np.maximum.accumulate(np.where(ok, np.arange(x.size), -1))
         held = missing & (last >= 0)
         out[held] = x[last[held]]
-    how = "held at the last speed" if name == SPEED else "linearly interpolated in time"
+    how = ("held at the last speed" if name == SPEED else "held at the last reading"
+           if name in HELD_INPUTS else "linearly interpolated in time")
     short_rows, long_rows, short_spans, long_spans = [], [], [], []
     for a, b in true_runs(missing):
         left = t[a - 1] if a > 0 else t[a]
@@ -320,7 +329,7 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     if long_rows:
         r = np.concatenate(long_rows)
         found.append(finding(name, "long_dropout",
-                             "interpolated for continuity; excluded from metrics", rows=r,
+                             f"{how} for continuity; excluded from metrics", rows=r,
                              spans_s=long_spans, count=r.size,
                              detail=f"missing values over more than {cfg.max_gap_s:g} s"))
     return out, valid, found
