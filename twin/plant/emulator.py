@@ -279,16 +279,15 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
     # the air and inlet readings stay in the range every reader accepts: at --ambient 45
     # (a bound) their noise crossed it, and the run emulated was refused by replay
-    ambient_read = add_noise(rng, tables.ambient_C(t_out), sensors.noise_C)
-    T_read = {f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
-              for j, s in enumerate(SENSOR_NAMES)}
-    coolant_read = add_noise(rng, tables.coolant_C(t_out), sensors.noise_C)
     columns = {
         "time_s": t_out,
         "speed_rpm": speed(t_out).astype(float),
-        "ambient_C": np.clip(ambient_read, *OPERATING_TEMPERATURE_C),
-        **T_read,
-        "coolant_C": np.clip(coolant_read, *OPERATING_TEMPERATURE_C),
+        "ambient_C": np.clip(add_noise(rng, tables.ambient_C(t_out), sensors.noise_C),
+                             *OPERATING_TEMPERATURE_C),
+        **{f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
+           for j, s in enumerate(SENSOR_NAMES)},
+        "coolant_C": np.clip(add_noise(rng, tables.coolant_C(t_out), sensors.noise_C),
+                             *OPERATING_TEMPERATURE_C),
         "disp_x_um": add_noise(rng, x_true, sensors.noise_um),
         "disp_y_um": add_noise(rng, y_true, sensors.noise_um),
         "disp_z_um": add_noise(rng, disp_z, sensors.noise_um),
