@@ -604,13 +604,14 @@ class EnsembleEstimator:
         changed_s = speed_change_s(f, self._forecast_speed_rpm)
         first = (cfg.rerun_first_window and not cfg.loads_follow_rings
                  and first_window_at_speed(f, self._forecast_speed_rpm))
-        rerun = changed_s is not None or first or self._moved_inlet(f, start) is not None
+        inlet = self._moved_inlet(f, start)  # the same for every start moved from it
+        rerun = changed_s is not None or first or inlet is not None
         if rerun:
             # the speed changed inside the window just ended, after its loads were fixed:
             # that window is re-run with the speed it really had (all measured before now)
             # so the innovations and the analysed field are free of the unforeseen input;
             # so is a run's first window (its held cold-start heat, `twin.correction.rerun`)
-            sim_C, prior.field_mean, fc = self._rerun(f, fc, start)
+            sim_C, prior.field_mean, fc = self._rerun(f, fc, start, inlet)
         if f.window > 1:  # window 0 missed by the prior's error: not the band's to learn
             self._calibrate_band(f, sim_C, fc)
         obs = self._observations(f, fc, sim_C, start)
@@ -648,7 +649,7 @@ class EnsembleEstimator:
                 with threadpool_limits(1):
                     fc, _ = self._forecast_from(moved)
                 if rerun:  # the mean again at the recorded speed, as the first pass
-                    sim_C, fc.end.field_mean, fc = self._rerun(f, fc, moved)
+                    sim_C, fc.end.field_mean, fc = self._rerun(f, fc, moved, inlet)
                 else:
                     sim_C = np.asarray(f.simulated_C, float).copy()
                     sim_C[-cfg.steps_per_window:] = fc.sensors_mean_C
@@ -800,8 +801,8 @@ class EnsembleEstimator:
         return bc.with_values(**bearing_values_at(self.model, bc.speed_rpm,
                                                   self._sensors @ field_C))
 
-    def _rerun(self, f: WindowFeatures, fc: WindowForecast, start: WindowStart
-               ) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
+    def _rerun(self, f: WindowFeatures, fc: WindowForecast, start: WindowStart,
+               inlet: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, WindowForecast]:
         """The window just ended re-run from its start field, each solver step at the speed
         recorded at its midpoint, with the nominal bearing heat and contact resistance
         re-evaluated every solver step at the re-run's own ring and sleeve temperatures, as the
@@ -809,7 +810,8 @@ class EnsembleEstimator:
         at the current speed, nominal conditions for any other speed (a step up and a stop
         inside one window), all with the same factors (`start`'s).  Returns T1..T5 history
         with the window replaced, the end field and the forecast with that mean (the
-        members' anomalies are kept)."""
+        members' anomalies are kept).  `inlet`: the recorded coolant inlet per solver step
+        where it moved inside the window (`_moved_inlet`), else None."""
         from twin.spindle.conditions import nominal_conditions
 
         cfg = self.config
@@ -818,7 +820,6 @@ class EnsembleEstimator:
         offset = coolant_offset_of(self._names, start.ensemble.log_factor_mean)
         current = f.twin_state.conditions
         steps = cfg.steps_per_window
-        inlet = self._moved_inlet(f, start)
         window_start_s = f.start_s - cfg.window_s
 
         def advance(speed: float, T: np.ndarray, n: int, start_s: float) -> np.ndarray:
