@@ -46,6 +46,9 @@ if TYPE_CHECKING:
     from twin.spindle.model import SpindleModel
 
 
+RING_AND_SLEEVE = tuple(sorted({*RING_SENSOR.values(), *SLEEVE_SENSOR.values()}))
+"""T1..T4 by index: the thermocouples the bearing values are corrected by."""
+
 HELD_CORRECTION = "correction_held"
 """quality.json kind of `held_correction_findings`."""
 HOLDING_METHODS = ("ratio", "bpnn")
@@ -78,7 +81,7 @@ def held_correction_findings(run: RecordedRun, methods: Sequence[str]) -> list[d
     unseen = np.array([~window_observed(run.time_s[rows], measured[rows], end)
                        for rows, end in zip(spans, ends, strict=True)]).reshape(-1, 5)
     found = []
-    for column in sorted({*RING_SENSOR.values(), *SLEEVE_SENSOR.values()}):
+    for column in RING_AND_SLEEVE:
         stretches = true_runs(unseen[:, column])
         if not stretches:
             continue
@@ -292,10 +295,8 @@ def warming_findings(open_loop_C: np.ndarray | None, open_loop_start_C: float,
     (5,) their first."""
     if open_loop_C is None:
         return []
-    rings = [RING_SENSOR[b] for b in sorted(RING_SENSOR)] + \
-        [SLEEVE_SENSOR[b] for b in sorted(SLEEVE_SENSOR)]
     measured_rise, twin_rise = [], []
-    for k in rings:
+    for k in RING_AND_SLEEVE:
         column = measured_C[:, k] - measured_start_C[k]
         if not np.isfinite(column).any():
             continue

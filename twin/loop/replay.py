@@ -327,8 +327,8 @@ def replay_method(
         # its change since the run start where the probe was not zeroed there
         measured_drift = np.where(run.valid[AXIAL_PROBE],
                                   run.disp_um[:, 2] - probe_start_offset_um(run), np.nan)
-    recorded_coolant = None  # the inlet as measured: NaN where the quality check filled
-    if run.coolant_C is not None:  # a long dropout from a reading after it
+    recorded_coolant = None  # the inlet as measured: NaN through a long dropout, which
+    if run.coolant_C is not None:  # the quality check holds at its last reading
         recorded_coolant = np.where(run.valid.get("coolant_C", True), run.coolant_C, np.nan)
     n_steps = windows * STEPS_PER_WINDOW
     time_s = STEP_S * np.arange(1, n_steps + 1)
