@@ -173,18 +173,17 @@ class Session:
         """Run one window deck from temperature `T` (thermal dofs, °C) at `start_s`.
 
         Returns the temperature after every substep of the deck's load step, shape
-        (n_substeps, n_dofs).  At `start_s` = 0 the deck is a new analysis (ANTYPE,TRANS),
-        which starts from TUNIF: `T` must then be uniform and becomes TUNIF.  The session's
-        results are this deck's only (`results`).
+        (n_substeps, n_dofs).  At `start_s` = 0 a uniform `T` becomes TUNIF, which a new
+        analysis (ANTYPE,TRANS) starts from; a non-uniform one is the state a restart
+        (ANTYPE,TRANS,REST) continues from, as at a later start.  The session's results are
+        this deck's only (`results`).
         """
         T = np.asarray(T, float)
         # the deck needs no earlier deck's result (its start state is handed in): kept, a
         # replay's session held one result per solver step (about 35 kB each) and every
         # SOLVE counted its load step through all of them
         self.state.solution.results = []
-        if start_s == 0.0:
-            if T.size and np.any(T != T[0]):
-                raise ValueError("a window at t = 0 starts from a uniform temperature (TUNIF)")
+        if start_s == 0.0 and T.size and np.all(T == T[0]):
             self.state.db.settings.tunif = float(T[0])
         else:
             self.set_state(T, start_s)

@@ -91,7 +91,7 @@ HOW_TO_RUN = (
 def window_deck(loads: LoadSet, layout: DeckLayout,
                 start_temperature_C: float | None = None,
                 load_step: tuple[int, int] | None = None, notes: tuple[str, ...] = (),
-                after: LoadSet | None = None) -> str:
+                after: LoadSet | None = None, from_state: bool = False) -> str:
     """The APDL text of one window, or of one load step of a window written as several.
 
     start_temperature_C  the uniform field a run's first window (start 0 s) starts from,
@@ -105,7 +105,13 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
                          (i > 1): a load it holds with the same value is not restated, as
                          loads stay until changed (in MAPDL and here).  Where the two name
                          different regions, boundaries or interfaces, all is written.
+    from_state           a run's first window (start 0 s) that starts from a non-uniform
+                         field handed in (a recording that begins on a warm spindle): a
+                         restart (ANTYPE,TRANS,REST) from that state, as a later window's,
+                         run with `--start window_000_start.vtu`
     """
+    if from_state and start_temperature_C is not None:
+        raise ValueError("a window starts either from a uniform TUNIF or from a state")
     for name in loads.heat_generation:
         if name not in layout.regions:
             raise ValueError(f"heat generation on unknown region {name!r}")
@@ -149,7 +155,7 @@ def window_deck(loads: LoadSet, layout: DeckLayout,
         "/SOLU",
         f"WINDOW = {loads.window}",
         f"T_START = {_num(loads.start_s)}",
-        "ANTYPE,TRANS,REST" if loads.start_s > 0.0 else "ANTYPE,TRANS",
+        "ANTYPE,TRANS,REST" if loads.start_s > 0.0 or from_state else "ANTYPE,TRANS",
         *([f"TUNIF,{_num(start_temperature_C)}   ! C, the uniform start field"]
           if start_temperature_C is not None and loads.start_s == 0.0 else []),
         "TIMINT,ON",

@@ -1102,13 +1102,13 @@ def test_warming_is_told_only_many_times_above_the_twin_and_with_open_loop():
         if dead:
             measured[:, 0] = np.nan
         twin = 20.0 + twin_rise * steps * np.ones(5)
-        return warming_findings(twin, 20.0, measured, start) != []
+        return warming_findings(twin, np.full(5, 20.0), measured, start) != []
 
     assert told(6.0, 2.0) and not told(5.9, 2.0)
     assert told(3.0, 0.5) and not told(2.9, 0.5)
     assert not told(1.0, 9.0)  # started warm: rises less, not told
     assert told(6.0, 2.0, dead=True)
-    assert warming_findings(None, 20.0, 20.0 + 9.0 * steps * np.ones(5), start) == []
+    assert warming_findings(None, np.full(5, 20.0), 20.0 + 9.0 * steps * np.ones(5), start) == []
 
 
 def test_quality_json_tells_an_axial_probe_not_zeroed_at_the_start(runs_dir, replayed,

@@ -52,7 +52,7 @@ def snapshot(
         out,
         field=field.value,
         section=section,
-        T_initial_C=r.T_initial_C,
+        T_initial_C=r.start_reference_C,
         title=snapshot_title(recorded.name, method_name, t, recorded),
     )
     typer.echo(f"wrote {out}")

@@ -9,7 +9,9 @@ quality.json findings that need the loop's own rules or the twin.
   its change from its start reading), `probe_in_mm` and `probe_reversed` (they leave it
   out; `probe_left_out`);
 - `warms_unlike_twin`: the thermocouples warm many times more than the open-loop twin at
-  the recorded speeds (a speed column in rev/s or krpm).
+  the recorded speeds (a speed column in rev/s or krpm);
+- `warm_start`: the recording begins on a warm spindle, and the replay starts from a field
+  fitted to the first readings (`twin.loop.start_field`).
 
 Every finding is told; none changes what the metrics compare with: the readings as
 recorded (DESIGN.md), the quality check's exclusions aside.
@@ -31,6 +33,7 @@ from twin.correction.features import (
     rows_between,
     window_observed,
 )
+from twin.loop.start_field import WARM_START_SPREAD_K, StartField
 from twin.runs import TEMPERATURES, RecordedRun
 from twin.runs.quality import (
     AXIAL_PROBE,
@@ -283,16 +286,16 @@ thermocouples) the ratio lay between 0.65 and 1.56, none told; the bundled 9000 
 speed logged in rev/s gave 21, in krpm 28."""
 
 
-def warming_findings(open_loop_C: np.ndarray | None, open_loop_start_C: float,
+def warming_findings(open_loop_C: np.ndarray | None, open_loop_start_C: np.ndarray,
                      measured_C: np.ndarray, measured_start_C: np.ndarray) -> list[dict]:
     """The quality.json finding of a run whose thermocouples warm many times more than the
     open-loop twin at its recorded speeds (`WARMING_RATIO`): a speed logged in rev/s or
     krpm (150 or 9 for 9000 rpm) replayed as rpm with next to no bearing heat, every
     method scoring 79 % temperature accuracy without a word of the cause.
     `open_loop_C` (k, 5): the open-loop twin's T1..T5 at the replay's steps from its
-    uniform start field at `open_loop_start_C` (None: open loop not replayed, nothing
-    told); `measured_C` (k, 5) the readings then (NaN where invalid), `measured_start_C`
-    (5,) their first."""
+    start field, whose T1..T5 are `open_loop_start_C` (5,) (None: open loop not replayed,
+    nothing told); `measured_C` (k, 5) the readings then (NaN where invalid),
+    `measured_start_C` (5,) their first."""
     if open_loop_C is None:
         return []
     measured_rise, twin_rise = [], []
@@ -301,7 +304,7 @@ def warming_findings(open_loop_C: np.ndarray | None, open_loop_start_C: float,
         if not np.isfinite(column).any():
             continue
         measured_rise.append(float(np.nanmax(column)))
-        twin_rise.append(float(np.max(open_loop_C[:, k]) - open_loop_start_C))
+        twin_rise.append(float(np.max(open_loop_C[:, k]) - open_loop_start_C[k]))
     if not measured_rise:
         return []
     measured, twin = float(np.median(measured_rise)), float(np.median(twin_rise))
@@ -316,13 +319,35 @@ def warming_findings(open_loop_C: np.ndarray | None, open_loop_start_C: float,
                            "slow)")]
 
 
+WARM_START = "warm_start"
+"""quality.json kind of `start_findings`."""
+
+
+def start_findings(run: RecordedRun, start: StartField) -> list[dict]:
+    """The quality.json finding of a recording that begins on a warm spindle: the replay
+    starts from a field fitted to the first readings, not from a uniform one."""
+    if start.uniform:
+        return []
+    scales = ", ".join(f"{name} {a:.2f}" for name, a in zip(
+        ("front bearing", "rear bearing", "motor"), start.scales, strict=True))
+    return [finding(TEMPERATURES[0], WARM_START,
+                    "the replay starts from a field fitted to the first readings (every "
+                    "method); the drift is taken from there",
+                    rows=run.rows[:1],
+                    detail=f"the first T1..T5 spread more than {WARM_START_SPREAD_K:g} K: "
+                           f"fitted as {start.history} (source scales {scales}), "
+                           f"T1..T5 within {start.misfit_K:.2f} K RMS")]
+
+
 def replay_findings(run: RecordedRun, model: SpindleModel, methods: Sequence[str],
-                    open_loop_C: np.ndarray | None, open_loop_start_C: float,
-                    measured_C: np.ndarray, measured_start_C: np.ndarray) -> list[dict]:
+                    open_loop_C: np.ndarray | None, open_loop_start_C: np.ndarray,
+                    measured_C: np.ndarray, measured_start_C: np.ndarray,
+                    start: StartField | None = None) -> list[dict]:
     """Every finding of this module for a replay of `run` with `methods` (the open-loop
-    twin's key points as `warming_findings` reads them), in the order quality.json lists
-    them after the quality check's."""
-    return [*held_correction_findings(run, methods), *tail_findings(run),
+    twin's key points as `warming_findings` reads them; `start` the replay's start
+    field), in the order quality.json lists them after the quality check's."""
+    return [*(start_findings(run, start) if start is not None else []),
+            *held_correction_findings(run, methods), *tail_findings(run),
             *probe_offset_findings(run), *probe_scale_findings(run),
             *probe_direction_findings(run, model),
             *warming_findings(open_loop_C, open_loop_start_C, measured_C, measured_start_C)]

@@ -50,8 +50,9 @@ the field window k's deck starts from, so the decks reproduce both the reported 
 and the carried state.
 
 The run starts from a uniform field at the mean of the first measured T1..T5 (a spindle
-at rest has equalised), which is also the zero of the drift: the recorded drift is taken
-as measured from the start.
+at rest has equalised) or, where those spread more than a kelvin (a recording that begins
+on a warm spindle), from a field fitted to them (`twin.loop.start_field`).  The start field
+is the zero of the drift: the recorded drift is taken as measured from the start.
 """
 
 from __future__ import annotations
@@ -84,6 +85,7 @@ from twin.correction.rerun import (
 from twin.correction.result import Correction, Corrector
 from twin.lag import first_order_lag
 from twin.loop.findings import probe_left_out, probe_start_offset_um
+from twin.loop.start_field import StartField, start_field
 from twin.runs import RecordedRun
 from twin.runs.quality import AXIAL_PROBE
 from twin.spindle.conditions import BoundaryConditions, nominal_conditions
@@ -137,10 +139,24 @@ class MethodReplay:
     windows: list[WindowRecord]
     fields: dict[float, np.ndarray] = field(default_factory=dict)  # window-end T fields
     T_initial_C: float = 20.0
+    """The uniform start temperature, °C; where `start_C` is given, its mean."""
     wall_s: float = 0.0
     band_sd: np.ndarray | None = None
     """(k, 6) forecast spread (1 σ) of T1..T5 (°C) and the axial drift (µm), for methods
     with uncertainty (the estimator); None otherwise."""
+    start_C: np.ndarray | None = None
+    """The non-uniform field (thermal dofs, °C) a warm start begins from
+    (`twin.loop.start_field`); None: uniform at `T_initial_C`."""
+
+    @property
+    def start_reference_C(self) -> float | np.ndarray:
+        """The field the run started from, the zero of its displacements: `start_C`, or
+        the uniform `T_initial_C`."""
+        return self.T_initial_C if self.start_C is None else self.start_C
+
+    def start_key_points_C(self, model: SpindleModel) -> np.ndarray:
+        """T1..T5 of the start field (the metal at the sensor points), °C."""
+        return model.sensor_matrix @ np.broadcast_to(self.start_reference_C, (model.n_dofs,))
 
 
 WindowSolver = Callable[..., tuple]
@@ -225,14 +241,18 @@ def deck_window_solver(model: SpindleModel, session: Session | None = None) -> W
             contact_resistance=loads.contact_resistance,
         )
         # a run's first window starts from a uniform field: the deck says which, so that
-        # it runs alone too
+        # it runs alone too (a warm start's field is written beside the deck)
         after = None
         if load_step is not None and last[0] is not None:
             k, (i, n), previous = last[0]
             if k == window and load_step == (i + 1, n):
                 after = previous
+        # a warm start (`twin.loop.start_field`) restarts from the field handed in
+        warm_start = start_s == 0.0 and not bool(np.all(T == T[0]))
         deck = window_deck(load_set, session.layout,
-                           start_temperature_C=float(T[0]) if start_s == 0.0 else None,
+                           start_temperature_C=float(T[0]) if start_s == 0.0 and not warm_start
+                           else None,
+                           from_state=warm_start,
                            load_step=load_step, notes=notes, after=after)
         last[0] = None  # until this deck has run
         steps = session.advance(T, start_s, deck, file=f"window_{window:03d}.inp")
@@ -253,14 +273,6 @@ def check_field_time(run: RecordedRun, time_s: float) -> None:
     span_s = n_windows(run) * WINDOW_S
     if not 0.0 < time_s <= span_s:
         raise ValueError(f"time {time_s:g} s is outside the replayed span (0, {span_s:g}] s")
-
-
-def initial_temperature_C(run: RecordedRun) -> float:
-    first = run.before(np.array([run.time_s[0]]))
-    T0 = first.T_valid_C[0]
-    if not np.any(np.isfinite(T0)):
-        return float(first.ambient_C[0])
-    return float(np.nanmean(T0))
 
 
 def twin_conditions(model: SpindleModel, speed_rpm: float, ambient_C: float,
@@ -302,11 +314,14 @@ def replay_method(
     keep_fields: bool = True,
     on_window: Callable[[int, int], None] | None = None,
     field_at_s: float | None = None,
+    start: StartField | None = None,
 ) -> MethodReplay:
     """Replay `run` with one correction method; see the module doc.
 
     keep_fields  keep the temperature field at every window end
     field_at_s   instead, stop at the solver step nearest this time and keep that field
+    start        the run's start field (`twin.loop.start_field.start_field`, found here
+                 if not given: a caller replaying several methods finds it once)
     """
     t_wall = time.perf_counter()
     solver = solver or deck_window_solver(model)
@@ -318,8 +333,9 @@ def replay_method(
         check_field_time(run, field_at_s)
         field_step = max(1, int(round(field_at_s / STEP_S)))  # 1-based solver step
         windows = int(np.ceil(field_step / STEPS_PER_WINDOW))
-    T0 = initial_temperature_C(run)
-    T = np.full(model.n_dofs, T0)
+    initial = start or start_field(model, run)
+    T0 = initial.field_C  # the zero of the drift
+    T = T0.copy()
 
     measured_T = run.T_valid_C
     measured_drift = None
@@ -392,7 +408,8 @@ def replay_method(
                 or speed_change_s(features, last.bc.speed_rpm) is not None):
             rerun, records[-1].rerun_deck = _rerun(model, solver, last, features, factors,
                                                    conditions)
-            if records[-1].start_C is None and last.start_s > 0.0:  # the re-run starts there
+            if records[-1].start_C is None and (last.start_s > 0.0 or not initial.uniform):
+                # the re-run starts there
                 records[-1].start_C = last.T_start.copy()
             # the twin's state is the re-run's: it starts the window, its key points over
             # the window just ended are what the method compares with the measurement
@@ -437,10 +454,10 @@ def replay_method(
         reported_T[sl] = _reported(np.vstack([start_T, sim_T[sl.start + 1 : sl.stop + 1]]), corr)
         drift[sl] = 1e6 * expansion * ((steps - T0) @ model.probe_vectors.T)
         # the start field where the decks do not give it (or the readings need stating)
-        start_field = (None if last.T_start is previous_end and corr.readings_start_C is None
-                       else last.T_start.copy())
+        start_field_C = (None if last.T_start is previous_end and corr.readings_start_C is None
+                         and (k > 0 or initial.uniform) else last.T_start.copy())
         records.append(WindowRecord(k, start, speed, ambient, corr, nominal, deck,
-                                    start_C=start_field))
+                                    start_C=start_field_C))
         if field_step is not None and sl.start < field_step <= sl.stop:
             fields[STEP_S * field_step] = steps[field_step - sl.start - 1].copy()
         elif keep_fields and field_step is None:
@@ -458,9 +475,10 @@ def replay_method(
         drift_r_um=drift[:, 1],
         windows=records,
         fields=fields,
-        T_initial_C=T0,
+        T_initial_C=initial.mean_C,
         wall_s=time.perf_counter() - t_wall,
         band_sd=band,
+        start_C=None if initial.uniform else initial.field_C,
     )
 
 
@@ -581,6 +599,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
         "windows": [window(w) for w in r.windows],
         "fields": [[t, _array(T)] for t, T in r.fields.items()],
         "T_initial_C": r.T_initial_C, "wall_s": r.wall_s, "band_sd": _array(r.band_sd),
+        "start_C": _array(r.start_C),
     })
 
 
@@ -606,4 +625,5 @@ def method_replay_from_json(text: str) -> MethodReplay:
         windows=[window(w) for w in d["windows"]],
         fields={t: _from_array(T) for t, T in d["fields"]},
         T_initial_C=d["T_initial_C"], wall_s=d["wall_s"], band_sd=_from_array(d["band_sd"]),
+        start_C=_from_array(d["start_C"]),
     )

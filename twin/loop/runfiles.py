@@ -49,6 +49,7 @@ from twin.loop.replay import (
     replay_method,
 )
 from twin.loop.runnames import run_name
+from twin.loop.start_field import StartField, start_field
 from twin.version import code_identity
 
 if TYPE_CHECKING:
@@ -196,11 +197,13 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     ]
     solver = deck_window_solver(model)  # one session serves every method of the run
     primary = primary_method(methods)
+    start = start_field(model, run)  # every method's, found once
 
     results = _replay_methods(run, model, correctors, primary, solver, on_window,
                               partial(_write_fields, out_dir, model, fields), snapshots,
                               fork=plots.forked,
-                              keep_fields=fields != "none" or snapshots != "none")
+                              keep_fields=fields != "none" or snapshots != "none",
+                              start=start)
 
     first = next(iter(results.values()))
     meas_T, meas_T0, meas_drift = measured_reference(run, first.time_s)
@@ -221,7 +224,7 @@ def _replay_outputs(run_path: str | Path, out_dir: Path, methods: Sequence[str],
         _write_snapshots(out_dir, model, results[primary], snapshots, run)
     open_loop = results.get("open_loop")
     told = replay_findings(run, model, methods, None if open_loop is None else open_loop.T_twin_C,
-                           first.T_initial_C, meas_T, meas_T0)
+                           first.start_key_points_C(model), meas_T, meas_T0, start)
     write_quality(replace(run, quality=[*run.quality, *told]), out_dir / "quality.json")
     for name, r in results.items():
         deck_dir = out_dir / "decks" if name == primary else out_dir / "decks" / name
@@ -264,7 +267,7 @@ def _write_snapshots(out_dir: Path, model: SpindleModel, r: MethodReplay, snapsh
     for t in _window_ends(r.fields, snapshots):
         render_snapshot(model, r.fields[t], out_dir / _snapshot_name(r.method, t),
                         title=snapshot_title(run.name, r.method, t, run),
-                        T_initial_C=r.T_initial_C, clim=clim)
+                        T_initial_C=r.start_reference_C, clim=clim)
 
 
 def frames_range(model: SpindleModel, snapshots: str,
@@ -298,7 +301,6 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     end` or `none`) or damaged (the caller replays the run)."""
     from twin.contract import windows_in
     from twin.io.vtk import read_vtu
-    from twin.loop.replay import initial_temperature_C
     from twin.loop.snapshot import render_snapshot, snapshot_title
     from twin.runs import read_run
     from twin.spindle.model import SpindleModel
@@ -324,10 +326,11 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     # every frame's range is over all the window ends, drawn or kept: read them all then
     shown = {t: field_at(t) for t in (ends if snapshots == "every" else wanted)}
     clim = frames_range(model, snapshots, shown)
+    start = start_field(model, run)
     for t in wanted:
         render_snapshot(model, shown[t], out_dir / _snapshot_name(primary, t),
                         title=snapshot_title(run_name(run_path), primary, t, run),
-                        T_initial_C=initial_temperature_C(run), clim=clim)
+                        T_initial_C=start.field_C, clim=clim)
     return len(wanted)
 
 
@@ -335,10 +338,12 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
                     primary: str, solver: WindowSolver,
                     on_window: Callable[[str, int, int], None] | None,
                     write_primary_fields: Callable[[MethodReplay], None], snapshots: str,
-                    fork: bool, keep_fields: bool = True) -> dict[str, MethodReplay]:
+                    fork: bool, keep_fields: bool = True,
+                    start: StartField | None = None) -> dict[str, MethodReplay]:
     """Every method's replay, by name in the order given; the primary's field files are
     written by `write_primary_fields` as soon as it is replayed.  `keep_fields`: the
-    primary keeps its window-end fields (for the field files or the snapshots).
+    primary keeps its window-end fields (for the field files or the snapshots).  `start`:
+    the run's start field (found here if None).
 
     With `fork` a forked child on the second core replays the primary and writes its
     fields (their structural solves and stress recovery cost about as much as replaying one
@@ -354,11 +359,13 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
     child fail, the parent replays its methods itself: the error, if it is one, is then
     raised here with its own type.
     """
+    start = start or start_field(model, run)
+
     def replay(corrector: Corrector,
                told: Callable[[int, int], None] | None = None) -> MethodReplay:
         r = replay_method(run, model, corrector,
                           keep_fields=keep_fields and corrector.name == primary,
-                          on_window=told, solver=solver)
+                          on_window=told, solver=solver, start=start)
         if r.method == primary:
             write_primary_fields(r)
         return r
@@ -522,5 +529,5 @@ def _write_fields(out_dir: Path, model: SpindleModel, fields: str, r: MethodRepl
     if not times:
         return
     write_field_series(out_dir, ((t, _field_name(r.method, t),
-                                  field_mesh(model, r.fields[t], r.T_initial_C))
+                                  field_mesh(model, r.fields[t], r.start_reference_C))
                                  for t in times))

@@ -51,7 +51,7 @@ def render_snapshot(
     out_png: str | Path,
     field: str = "temperature",
     title: str = "",
-    T_initial_C: float | None = None,
+    T_initial_C: float | np.ndarray | None = None,
     section: bool = False,
     window_size: tuple[int, int] = (1200, 800),
     clim: tuple[float, float] | None = None,
@@ -74,7 +74,7 @@ def shown_values(arrays: dict[str, np.ndarray], field: str) -> np.ndarray:
 
 
 def colour_range(model: SpindleModel, fields: Iterable[np.ndarray], field: str = "temperature",
-                 T_initial_C: float | None = None) -> tuple[float, float]:
+                 T_initial_C: float | np.ndarray | None = None) -> tuple[float, float]:
     """The colour range of a run's frames: the lowest and highest value `field` takes over
     all the `fields` (temperature vectors, `render_snapshot`'s T).  The frames of a replay
     each spanned their own field's range (23.0–45.2 °C in one, 23.3–42.2 °C in the next),
@@ -115,7 +115,8 @@ def ctrl_c_after() -> Iterator[None]:
 
 
 def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str, title: str,
-            T_initial_C: float | None, section: bool, window_size: tuple[int, int],
+            T_initial_C: float | np.ndarray | None, section: bool,
+            window_size: tuple[int, int],
             clim: tuple[float, float] | None) -> Path:
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
     import pyvista as pv
@@ -193,9 +194,10 @@ def _render(model: SpindleModel, T: np.ndarray, out_png: str | Path, field: str,
     lines.append(f"hottest {t_max:.1f} °C at r = {hot_xyz[0]:.0f} mm, z = {hot_xyz[2]:.0f} mm")
     lines.append(f"nose drift (axial) {drift_z:+.2f} µm")
     if field == "displacement":  # the colours are the drift; the shape is not deformed
-        since = "" if T_initial_C is None else f" at {T_initial_C:.1f} °C"
-        lines.append(f"shape undeformed; colour: thermal displacement since the uniform "
-                     f"start{since}")
+        since = ("the uniform start" if T_initial_C is None
+                 else "the start (a warm start's fitted field)" if np.ndim(T_initial_C)
+                 else f"the uniform start at {float(T_initial_C):.1f} °C")
+        lines.append(f"shape undeformed; colour: thermal displacement since {since}")
     plotter.add_text("\n".join(lines), position="upper_left", font_size=11, color="black")
     if section:
         plotter.view_xz()

@@ -48,7 +48,7 @@ def simulate_for_training(run: RecordedRun, model: SpindleModel) -> list[Simulat
         # straight on twin.fem: training needs no decks
         result = replay_method(run, model, fit, solver=direct_window_solver(model),
                                keep_fields=False)
-        out.append(_simulated(run, result, np.array(fit.fitted), np.array(fit.anchors),
+        out.append(_simulated(run, model, result, np.array(fit.fitted), np.array(fit.anchors),
                               np.array(fit.anchored_inputs)))
     return out
 
@@ -57,7 +57,7 @@ def simulate_with_ratio(run: RecordedRun, model: SpindleModel) -> list[Simulated
     """The run replayed on `model` with the online ratio correction (the paper's training
     simulation)."""
     result = replay_method(run, model, make_corrector("ratio"), keep_fields=False)
-    return [_simulated(run, result, None)]
+    return [_simulated(run, model, result, None)]
 
 
 def training_simulator(rule: TargetRule | str = TargetRule.FIT,
@@ -78,14 +78,15 @@ def training_simulator(rule: TargetRule | str = TargetRule.FIT,
     return functools.update_wrapper(functools.partial(simulate, model=spindle), simulate)
 
 
-def _simulated(run: RecordedRun, result: MethodReplay, fitted: np.ndarray | None,
+def _simulated(run: RecordedRun, model: SpindleModel, result: MethodReplay,
+               fitted: np.ndarray | None,
                anchors: np.ndarray | None = None,
                anchored_inputs: np.ndarray | None = None) -> SimulatedRun:
-    # the series starts at t = 0 with the uniform initial field the loop starts from
+    # the series starts at t = 0 with the field the loop starts from
     t0 = float(run.time_s[0])
     return SimulatedRun(
         time_s=np.r_[0.0, result.time_s] + t0,
-        T_C=np.vstack([np.full((1, 5), result.T_initial_C), result.T_twin_C]),
+        T_C=np.vstack([result.start_key_points_C(model), result.T_twin_C]),
         nominal=np.array([list(w.nominal) for w in result.windows]),
         used=np.array([list(w.correction.values) for w in result.windows]),
         method=result.method,

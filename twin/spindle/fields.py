@@ -18,12 +18,12 @@ from twin.spindle.model import SpindleModel
 
 
 def field_arrays(model: SpindleModel, T: np.ndarray,
-                 T_initial_C: float | None = None) -> dict[str, np.ndarray]:
+                 T_initial_C: float | np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Point arrays on the thermal-mesh vertices (`twin.io.vtk` names and units).
 
-    The displacement is relative to a uniform `T_initial_C` (the start of the run: the
-    drift convention) when given, else to the stress-free T_ref; the stress is always the
-    thermal stress relative to T_ref.
+    The displacement is relative to `T_initial_C` (the start of the run, the drift
+    convention: a uniform temperature, or a warm start's field per thermal dof) when given,
+    else to the stress-free T_ref; the stress is always the thermal stress relative to T_ref.
     """
     mesh = model.mesh
     n_vertices = mesh.thermal.p.shape[1]
@@ -31,15 +31,16 @@ def field_arrays(model: SpindleModel, T: np.ndarray,
     elastic = model.elastic
     u_abs = elastic.solve(T)
     stress = elastic.stresses(u_abs, T)
-    # the structure is linear in T − T_ref: the drift from a uniform T_initial is the
-    # solution for the excess T − T_initial (one back-substitution instead of two)
+    # the structure is linear in T − T_ref: the drift from T_initial is the solution for
+    # the excess T − T_initial (one back-substitution instead of two)
     u = u_abs if T_initial_C is None else elastic.solve(T - T_initial_C + elastic.T_ref)
     nodes = mesh.node_map[:n_vertices]
     return field_point_data(T[:n_vertices], u[:, :n_glued][:, nodes],
                             stress["von_mises"][:n_glued][nodes])
 
 
-def field_mesh(model: SpindleModel, T: np.ndarray, T_initial_C: float | None = None) -> Any:
+def field_mesh(model: SpindleModel, T: np.ndarray,
+               T_initial_C: float | np.ndarray | None = None) -> Any:
     """meshio.Mesh of the section with the arrays of `field_arrays` and the region number."""
     mesh = model.mesh
     region = np.zeros(mesh.n_cells, dtype=np.int32)

@@ -1,0 +1,167 @@
+"""The field a replay starts from (`twin.loop.start_field`): uniform at rest, fitted to the
+first readings where the recording begins on a warm spindle.  The warm cases are the twin's
+own simulation cut part-way, so the true start field is known."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from twin.loop.start_field import WARM_START_SPREAD_K, start_field
+from twin.runs import read_run, write_run
+from twin.spindle.conditions import nominal_conditions
+from twin.spindle.simulate import simulate
+
+AMBIENT_C = 22.0
+
+
+@pytest.fixture(scope="module")
+def warm_up(spindle_model):
+    """30 min at 9000 rpm from a uniform 22 °C, the field every minute."""
+    return simulate(spindle_model, 9000.0, 30.0, AMBIENT_C, field_every_s=60.0)
+
+
+def cut_run(path, sim, cut_s, speed_rpm=9000.0):
+    """`sim` recorded from `cut_s` on (time and probe zeroed there), as a logger started
+    on a warm spindle would write it."""
+    keep = sim.time_s >= cut_s
+    t = sim.time_s[keep] - cut_s
+    columns = {"time_s": t, "speed_rpm": np.full(t.size, speed_rpm),
+               "ambient_C": np.full(t.size, AMBIENT_C)}
+    for i in range(5):
+        columns[f"T{i + 1}_C"] = sim.sensors_C[keep, i]
+    columns["disp_z_um"] = sim.disp_z_um[keep] - sim.disp_z_um[keep][0]
+    write_run(path, columns)
+    return read_run(path)
+
+
+def test_a_spindle_at_rest_starts_uniform_at_the_mean_of_its_first_readings(tmp_path,
+                                                                           spindle_model):
+    columns = {"time_s": np.arange(130.0), "speed_rpm": np.full(130, 9000.0),
+               "ambient_C": np.full(130, AMBIENT_C)}
+    first = [22.1, 22.4, 22.0, 22.3, 22.2 + 0.9 * WARM_START_SPREAD_K - 0.2]
+    for i, value in enumerate(first):
+        columns[f"T{i + 1}_C"] = np.full(130, value)
+    write_run(tmp_path / "rest.csv", columns)
+    start = start_field(spindle_model, read_run(tmp_path / "rest.csv"))
+    assert start.uniform and start.history == "at rest"
+    np.testing.assert_array_equal(start.field_C, np.full(spindle_model.n_dofs, np.mean(first)))
+
+
+def test_a_warm_start_is_fitted_close_to_the_true_field(tmp_path, spindle_model, warm_up):
+    """Cut 15 min into a warm-up, the fitted field reads T1..T5 within 0.05 K and lies
+    within a few tenths of a kelvin of the true field everywhere that matters, where the
+    uniform start at the readings' mean is kelvins off."""
+    true = dict(warm_up.fields)[900.0]
+    run = cut_run(tmp_path / "cut.csv", warm_up, 900.0)
+    start = start_field(spindle_model, run)
+    assert not start.uniform and start.history.startswith("warming")
+    S = spindle_model.sensor_matrix
+    assert np.abs(S @ start.field_C - S @ true).max() < 0.05
+    rms = float(np.sqrt(np.mean((start.field_C - true) ** 2)))
+    uniform = float(np.sqrt(np.mean((np.mean(S @ true) - true) ** 2)))
+    assert rms < 0.5 and uniform > 4.0 * rms, (rms, uniform)
+    # the nose drift the field holds (what the twin's drift grows from) is close too
+    drift = 1e6 * spindle_model.probe_vectors[0]
+    assert abs(drift @ (start.field_C - true)) < 0.1 * abs(drift @ (true - AMBIENT_C))
+
+
+def test_a_recording_that_begins_in_a_pause_is_fitted_as_a_cooling_spindle(tmp_path,
+                                                                           spindle_model):
+    ran = simulate(spindle_model, 9000.0, 60.0, AMBIENT_C)
+    stopped = nominal_conditions(spindle_model, 0.0, AMBIENT_C)
+    stepper = spindle_model.thermal.transient(stopped.to_thermal_loads(), dt=4.0)
+    *_, true = stepper.march(ran.final_T, 150)  # 10 min stopped
+    S = spindle_model.sensor_matrix
+    t = np.arange(130.0)
+    columns = {"time_s": t, "speed_rpm": np.zeros(t.size), "ambient_C": np.full(t.size, 22.0)}
+    for i, value in enumerate(S @ true):
+        columns[f"T{i + 1}_C"] = np.full(t.size, value)
+    write_run(tmp_path / "pause.csv", columns)
+    start = start_field(spindle_model, read_run(tmp_path / "pause.csv"))
+    assert start.history.startswith("stopped")
+    assert np.abs(S @ start.field_C - S @ true).max() < 0.1
+    rms = float(np.sqrt(np.mean((start.field_C - true) ** 2)))
+    uniform = float(np.sqrt(np.mean((np.mean(S @ true) - true) ** 2)))
+    assert uniform > 3.0 * rms, (rms, uniform)
+
+
+def test_a_warm_start_replays_the_twins_own_run_from_the_cut(tmp_path, spindle_model, warm_up):
+    """Open loop on the twin's own warm-up cut at 15 min is the twin itself: from the fitted
+    start it follows the rest of the warm-up within 0.05 K (measured 0.006 K) and its
+    drift within 10 % of its change (0.01 of 0.41 µm); from a uniform start at the
+    readings' mean (as every replay started before) T5 ran 6.8 K off, T3 4.8 K, and the
+    drift 2.6 µm."""
+    from twin.correction.methods import OpenLoop
+    from twin.loop.replay import replay_method
+    from twin.loop.start_field import StartField
+
+    run = cut_run(tmp_path / "cut.csv", warm_up, 900.0)
+    replay = replay_method(run, spindle_model, OpenLoop(), keep_fields=False)
+    later = warm_up.time_s >= 900.0
+    measured = warm_up.sensors_C[later][1:1 + len(replay.time_s)]
+    assert np.abs(replay.T_twin_C - measured).max() < 0.05
+    rise = warm_up.disp_z_um[later][1:1 + len(replay.time_s)] - warm_up.disp_z_um[later][0]
+    assert np.abs(replay.drift_z_um - rise).max() < 0.1 * np.abs(rise).max()
+
+    mean = float(np.mean(run.T_C[0]))
+    flat = StartField(np.full(spindle_model.n_dofs, mean), True, "at rest", mean, (), 0.0)
+    uniform = replay_method(run, spindle_model, OpenLoop(), keep_fields=False, start=flat)
+    assert np.abs(uniform.T_twin_C - measured).max() > 3.0
+    assert np.abs(uniform.drift_z_um - rise).max() > 1.0
+
+
+def test_a_warm_starts_replay_says_so_and_its_first_deck_runs_from_the_written_field(
+        tmp_path, spindle_model, warm_up):
+    """quality.json tells the fitted start; the first window's deck restarts from
+    decks/window_000_start.vtu and, run with apdl-like, gives the reported window."""
+    from apdl_like.cli import app as apdl_app
+    from twin.cli import app
+
+    cut_run(tmp_path / "cut.csv", warm_up, 900.0)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", str(tmp_path / "cut.csv"), "--out", str(out),
+                                      "--methods", "open_loop", "--snapshots", "none",
+                                      "--fields", "none", "--quiet"])
+    assert result.exit_code == 0, result.output
+    found = json.loads((out / "cut" / "quality.json").read_text())["findings"]
+    warm = [f for f in found if f["kind"] == "warm_start"]
+    assert len(warm) == 1 and "warming" in warm[0]["detail"], found
+    decks = out / "cut" / "decks"
+    deck = (decks / "window_000.inp").read_text()
+    antypes = [line for line in deck.splitlines() if line.startswith("ANTYPE")]
+    assert antypes[0] == "ANTYPE,TRANS,REST" and "TUNIF" not in deck
+    result = CliRunner().invoke(apdl_app, [
+        "run", str(decks / "window_000.inp"), "--spindle", "--quiet", "--out",
+        str(tmp_path / "w0"), "--start", str(decks / "window_000_start.vtu")])
+    assert result.exit_code == 0, result.output
+    last = meshio.read(sorted((tmp_path / "w0").glob("result_*.vtu"))[-1])
+    with open(out / "cut" / "keypoints.csv", newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if float(r["time_s"]) == 60.0]
+    reported = [float(rows[0][f"T{i}_twin_C"]) for i in range(1, 6)]
+    np.testing.assert_allclose(spindle_model.sensor_matrix @ last.point_data["TEMP"],
+                               reported, atol=1e-4)
+
+
+def test_a_cold_starts_replay_tells_nothing_and_starts_its_deck_from_tunif(tmp_path,
+                                                                         spindle_model):
+    from twin.cli import app
+
+    sim = simulate(spindle_model, 9000.0, 3.0, AMBIENT_C)
+    cut_run(tmp_path / "cold.csv", sim, 0.0)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["replay", str(tmp_path / "cold.csv"), "--out", str(out),
+                                      "--methods", "open_loop", "--snapshots", "none",
+                                      "--fields", "none", "--quiet"])
+    assert result.exit_code == 0, result.output
+    found = json.loads((out / "cold" / "quality.json").read_text())["findings"]
+    assert not [f for f in found if f["kind"] == "warm_start"]
+    deck = (out / "cold" / "decks" / "window_000.inp").read_text()
+    antypes = [line for line in deck.splitlines() if line.startswith("ANTYPE")]
+    assert antypes[0] == "ANTYPE,TRANS" and "TUNIF,22" in deck
+    assert not (out / "cold" / "decks" / "window_000_start.vtu").exists()
