@@ -155,8 +155,11 @@ class MethodReplay:
         return self.T_initial_C if self.start_C is None else self.start_C
 
     def start_key_points_C(self, model: SpindleModel) -> np.ndarray:
-        """T1..T5 of the start field (the metal at the sensor points), °C."""
-        return model.sensor_matrix @ np.broadcast_to(self.start_reference_C, (model.n_dofs,))
+        """T1..T5 of the start field (the metal at the sensor points), °C: a uniform
+        start's own temperature (not its interpolation, which may differ in the last bit)."""
+        if self.start_C is None:
+            return np.full(model.sensor_matrix.shape[0], self.T_initial_C)
+        return model.sensor_matrix @ self.start_C
 
 
 WindowSolver = Callable[..., tuple]
