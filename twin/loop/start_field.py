@@ -54,7 +54,7 @@ from twin.spindle.model import SpindleModel
 WARM_START_SPREAD_K = 1.0
 """First valid readings spreading more than this (K, largest − smallest) start the replay
 from a fitted field; within it the spindle is taken as at rest (uniform).  Emulated cold
-starts spread 0.05–0.2 K (noise and slow thermocouples)."""
+starts spread 0.49 K at most over 92 suite and sweep runs (noise, slow thermocouples)."""
 
 MIN_READINGS = 4
 """Valid first readings a fitted start needs (a level and three scales)."""
