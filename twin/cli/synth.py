@@ -82,6 +82,12 @@ def synth(
                                          "ambient, as the nominal model assumes; a "
                                          "scenario's [coolant] overrides it, with a "
                                          "warning)."),
+    record_from: float | None = typer.Option(
+        None, "--record-from", metavar="M", min=0.0,
+        help="The logger starts M minutes into the run (a recording begun on a warm "
+        "spindle): the spindle follows the profile and scenario from 0 s, the file holds "
+        "the samples from M on, time and probes zeroed there; at least 2 minutes before "
+        "--minutes.  Not with --suite."),
     overwrite: bool = typer.Option(False, "--overwrite", help="With --suite: remove the "
                                    "runs twin synth wrote already in the --out folder that "
                                    "this suite does not write (without it they are an "
@@ -104,7 +110,8 @@ def synth(
     if suite is not None:
         _synth_suite(suite, seed, 40.0 if minutes is None else minutes, rate, out,
                      given={"--speed": speed, "--profile": profile, "--scenario": scenario,
-                            "--ambient": ambient, "--coolant": coolant},
+                            "--ambient": ambient, "--coolant": coolant,
+                            "--record-from": record_from},
                      overwrite=overwrite, quiet=quiet, replace_bundled=replace_bundled)
         return
     if (speed is None) == (profile is None):
@@ -113,6 +120,9 @@ def synth(
     for name, value in (("--minutes", minutes), ("--ambient", ambient)):
         if value is None:
             raise InputError("missing: a single run needs it", column=name)
+    if record_from is not None and record_from > minutes - 2.0:
+        raise InputError(f"{record_from:g} min leaves less than two 60 s windows of the "
+                         f"{minutes:g}-min run (--minutes) to record", column="--record-from")
     # the range replay reads (twin.contract.OPERATING_TEMPERATURE_C; NaN too): synth must
     # not write what replay refuses
     check_operating_options(load_spec(None), speed or 0.0, ambient, coolant)
@@ -148,6 +158,7 @@ def synth(
         coolant_C=coolant,
         scenario_name=None if scenario is None else str(scenario),
         profile_name=None if profile is None else str(profile),
+        record_from_s=0.0 if record_from is None else 60.0 * record_from,
     )
     source = scenario or profile
     try:
@@ -159,8 +170,10 @@ def synth(
     run_path, truth_path = write_synth(run, out)
     if not quiet:
         # the run's length and the time the emulation took, each said as what it is
-        typer.echo(f"wrote {run_path} ({counted(run.n_samples, 'sample')} over {minutes:g} min, "
-                   f"emulated in {run.elapsed_s:.1f} s) and {truth_path}")
+        recorded = minutes if record_from is None else minutes - record_from
+        since = "" if not record_from else f" from {record_from:g} min into the run"
+        typer.echo(f"wrote {run_path} ({counted(run.n_samples, 'sample')} over {recorded:g} "
+                   f"min{since}, emulated in {run.elapsed_s:.1f} s) and {truth_path}")
 
 
 synth.__doc__ = SYNTH_HELP

@@ -220,7 +220,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
                profile: SpeedProfile | None = None, scenario: Scenario | None = None,
                rate_hz: float = 1.0, coolant_C: float | None = None,
                scenario_name: str | None = None, profile_name: str | None = None,
-               model: SpindleModel | None = None) -> SynthRun:
+               model: SpindleModel | None = None, record_from_s: float = 0.0) -> SynthRun:
     """An emulated recorded run (see the module doc).  Deterministic given the inputs.
 
     Exactly one of `speed_rpm` (constant) and `profile` is given.  `coolant_C` is the
@@ -228,10 +228,15 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
     is the truth's nominal SpindleModel, loaded once by a caller that synthesizes many
     runs (default: the reference spindle at the scenario's size factor, loaded here); the
     run's material factors and sensor offsets are applied on top (`truth_model`).
+    `record_from_s`: the logger starts this long into the run (a warm start): the spindle
+    follows the profile and scenario from 0 s, the files hold the samples from there on,
+    their time and the probes zeroed there (the readings then keep their noise).
     """
     start = time.perf_counter()
     if (speed_rpm is None) == (profile is None):
         raise ValueError("give exactly one of speed_rpm and profile")
+    if not 0.0 <= record_from_s <= 60.0 * float(minutes) - 120.0:
+        raise ValueError("the recording starts at 0 s or later and holds two 60 s windows")
     scenario = scenario or Scenario()
     duration = float(minutes) * 60.0
     if profile is not None:
@@ -331,6 +336,11 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         **{f"{n}_offset_mm": f"{dr + 0.0:.4f} {dz + 0.0:.4f}"  # + 0.0: no "-0.0000"
            for n, (dr, dz) in sorted(tables.form.sensor_offsets_mm.items())},
     }
+    if record_from_s > 0.0:
+        columns, truth_cols = _recorded_from(record_from_s, columns, truth_cols)
+        metadata["record_from_s"] = f"{record_from_s:g}"
+        metadata["displacement_reference"] = (f"probes zeroed at t = 0, {record_from_s:g} s "
+                                              "into the run (warm start)")
     metadata = {k: v for k, v in metadata.items() if v != ""}
     # relative to the run's peak heat input: a stop has no heat input to compare with
     rel = np.abs(truth.residual_W) / max(float(np.abs(truth.heat_in_W).max()), 1e-12)
@@ -339,6 +349,30 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
                     max_relative_residual=float(rel.max()),
                     extra={"truth_run": truth, "tables": tables,
                            "truth_metadata": truth_metadata})
+
+
+def _recorded_from(start_s: float, columns: dict[str, np.ndarray],
+                   truth: dict[str, np.ndarray]
+                   ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The run's and the truth's columns from `start_s` on, time zeroed there, each
+    displacement less its true value there (the probes zeroed as the logger starts)."""
+    keep = columns["time_s"] >= start_s - 1e-9
+    at = int(np.argmax(keep))
+    zero = {f"disp_{axis}_um": truth[f"disp_{axis}_true_um"][at] for axis in "xyz"}
+
+    def cut(table: dict[str, np.ndarray], true_suffix: bool) -> dict[str, np.ndarray]:
+        out = {}
+        for name, values in table.items():
+            values = values[keep]
+            if name == "time_s":
+                values = values - columns["time_s"][at]
+            key = name.replace("_true_um", "_um") if true_suffix else name
+            if key in zero:
+                values = values - zero[key]
+            out[name] = values
+        return out
+
+    return cut(columns, False), cut(truth, True)
 
 
 def truth_path_for(run_path: Path) -> Path:
