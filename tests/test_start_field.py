@@ -40,6 +40,20 @@ def cut_run(path, sim, cut_s, speed_rpm=9000.0):
     return read_run(path)
 
 
+def replay_open_loop(run_csv, out):
+    """`twin replay RUN --methods open_loop` into `out`: (its quality.json findings, the
+    text of its first window's deck)."""
+    from twin.cli import app
+
+    result = CliRunner().invoke(app, ["replay", str(run_csv), "--out", str(out), "--methods",
+                                      "open_loop", "--snapshots", "none", "--fields", "none",
+                                      "--quiet"])
+    assert result.exit_code == 0, result.output
+    name = run_csv.stem
+    found = json.loads((out / name / "quality.json").read_text())["findings"]
+    return found, (out / name / "decks" / "window_000.inp").read_text()
+
+
 def test_a_spindle_at_rest_starts_uniform_at_the_mean_of_its_first_readings(tmp_path,
                                                                            spindle_model):
     columns = {"time_s": np.arange(130.0), "speed_rpm": np.full(130, 9000.0),
@@ -121,19 +135,13 @@ def test_a_warm_starts_replay_says_so_and_its_first_deck_runs_from_the_written_f
     """quality.json tells the fitted start; the first window's deck restarts from
     decks/window_000_start.vtu and, run with apdl-like, gives the reported window."""
     from apdl_like.cli import app as apdl_app
-    from twin.cli import app
 
     cut_run(tmp_path / "cut.csv", warm_up, 900.0)
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["replay", str(tmp_path / "cut.csv"), "--out", str(out),
-                                      "--methods", "open_loop", "--snapshots", "none",
-                                      "--fields", "none", "--quiet"])
-    assert result.exit_code == 0, result.output
-    found = json.loads((out / "cut" / "quality.json").read_text())["findings"]
+    found, deck = replay_open_loop(tmp_path / "cut.csv", out)
     warm = [f for f in found if f["kind"] == "warm_start"]
     assert len(warm) == 1 and "warming" in warm[0]["detail"], found
     decks = out / "cut" / "decks"
-    deck = (decks / "window_000.inp").read_text()
     antypes = [line for line in deck.splitlines() if line.startswith("ANTYPE")]
     assert antypes[0] == "ANTYPE,TRANS,REST" and "TUNIF" not in deck
     result = CliRunner().invoke(apdl_app, [
@@ -150,18 +158,11 @@ def test_a_warm_starts_replay_says_so_and_its_first_deck_runs_from_the_written_f
 
 def test_a_cold_starts_replay_tells_nothing_and_starts_its_deck_from_tunif(tmp_path,
                                                                          spindle_model):
-    from twin.cli import app
-
     sim = simulate(spindle_model, 9000.0, 3.0, AMBIENT_C)
     cut_run(tmp_path / "cold.csv", sim, 0.0)
     out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["replay", str(tmp_path / "cold.csv"), "--out", str(out),
-                                      "--methods", "open_loop", "--snapshots", "none",
-                                      "--fields", "none", "--quiet"])
-    assert result.exit_code == 0, result.output
-    found = json.loads((out / "cold" / "quality.json").read_text())["findings"]
+    found, deck = replay_open_loop(tmp_path / "cold.csv", out)
     assert not [f for f in found if f["kind"] == "warm_start"]
-    deck = (out / "cold" / "decks" / "window_000.inp").read_text()
     antypes = [line for line in deck.splitlines() if line.startswith("ANTYPE")]
     assert antypes[0] == "ANTYPE,TRANS" and "TUNIF,22" in deck
     assert not (out / "cold" / "decks" / "window_000_start.vtu").exists()
