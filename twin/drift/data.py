@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -55,6 +56,20 @@ def displacement_columns(table: RawTable) -> list[str]:
     return [n for n in table.columns if n.endswith(DISPLACEMENT_SUFFIX)]
 
 
+def sensor_order(names: Sequence[str]) -> list[str]:
+    """`names` in the one order a model takes its sensors in: by name, numbers by value
+    (t2_C before t10_C), so the bundled data's t1_C … t16_C keep theirs.
+
+    The features (and so a network's start, the validation, every prediction) followed
+    the file's column order: the same data with the columns permuted gave another model.
+    """
+    def key(name: str) -> tuple:
+        parts = re.split(r"(\d+)", name)
+        return (tuple((0, int(p), p) if p.isdigit() else (1, 0, p) for p in parts), name)
+
+    return sorted(names, key=key)
+
+
 def array_digest(arrays: dict[str, np.ndarray]) -> str:
     """SHA-256 of named arrays: names sorted, each name, shape and little-endian float64
     bytes (the drift model file's tensor checksum, and what identifies fitting data)."""
@@ -70,7 +85,8 @@ def array_digest(arrays: dict[str, np.ndarray]) -> str:
 class DriftData:
     """Checked, gap-bridged drift data of one or more files, rows concatenated.
 
-    `T_C` (n, m) holds the temperature columns `sensors`; `targets_um` (n, p) the
+    `T_C` (n, m) holds the temperature columns `sensors` (in `sensor_order`, whatever
+    order the files hold them in); `targets_um` (n, p) the
     displacement columns `targets` (NaN where not measured, or None when the files hold
     none of them).  `segment_starts` are the first row of every file; `rows` the row of
     every sample in its file (1-based line of a CSV file).  `left_out` maps a temperature
@@ -245,8 +261,8 @@ def drift_data(
 ) -> DriftData:
     """Check the tables and assemble a `DriftData`.
 
-    `sensors` None takes the temperature columns every file holds and that change (in the
-    first file's order; the others are `left_out`, whichever file comes first); `targets`
+    `sensors` None takes the temperature columns every file holds and that change (the
+    others are `left_out`, whichever file comes first); either way in `sensor_order`; `targets`
     must be present in every file when `require_targets`.
     """
     if not tables:
@@ -256,7 +272,7 @@ def drift_data(
     left_out: dict[str, str] = {}
     if sensors is None:
         sensors, left_out = usable_temperatures(tables)
-    sensors, targets = list(sensors), list(targets)
+    sensors, targets = sensor_order(sensors), list(targets)
     # speed is optional: a column without any value (a logger that exports every channel
     # it has) is no speed, as a file without one
     use_speed = require_speed or all(_has_values(t, SPEED) for t in tables)

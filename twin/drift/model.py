@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from twin.drift.data import TEMPERATURE_SUFFIX, DriftData
+from twin.drift.data import TEMPERATURE_SUFFIX, DriftData, sensor_order
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
 from twin.drift.folds import block_labels, blocked_folds
 from twin.drift.intervals import apply_interval
@@ -79,10 +79,14 @@ def listed_sensors(option: str) -> list[str] | None:
 
 
 def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str]) -> list[str]:
-    """`auto` (cluster representatives), `all`, a count K (best K representatives) or a list."""
+    """`auto` (cluster representatives), `all`, a count K (best K representatives) or a list.
+
+    Representatives come best first (the ranking is made on the data's columns in
+    `sensor_order`, ties kept in it); `all` and a list in `sensor_order`: either way the
+    order of the columns in a file or a list changes nothing."""
     text = option.strip()
     if text == "all":
-        return list(available)
+        return sensor_order(available)
     if text == "auto":
         return ranking.pick()
     if text.isdigit():
@@ -103,7 +107,8 @@ def parse_sensors(option: str, ranking: SensorRanking, available: Sequence[str])
     if unknown or not names:
         raise InputError(f"unknown temperature columns {unknown}; the data hold "
                          f"{', '.join(available)}", column="--sensors")
-    return names
+    # a set: listed in another order, the features (and a network's start) were another
+    return sensor_order(names)
 
 
 def sensor_ranking(data: DriftData) -> SensorRanking:
