@@ -80,6 +80,18 @@ def _report_findings(data: DriftData, quiet: bool) -> None:
                    "data: time_s, speed_rpm, *_C temperatures, *_um displacements)", err=True)
 
 
+def _tell_outside_range(outside: dict | None) -> None:
+    """A note on the rows beyond the operating range the model was fitted on: a model
+    extrapolates there, and its band is widened for it (`twin.drift.intervals`)."""
+    if outside is None:
+        return
+    typer.echo(f"note: {outside['rows']} row{'s' * (outside['rows'] != 1)} "
+               f"({outside['rows_pct']:.1f} %) outside the operating range the model was "
+               f"fitted on (furthest: {outside['max_excess_spans']:.2f} of its span beyond, "
+               f"in {outside['feature']}): the model extrapolates there; the 90 % interval "
+               f"is widened for it, up to ×{outside['max_band_factor']:.2f}", err=True)
+
+
 @drift_app.command("fit", cls=PlainHelpCommand)
 @report_errors
 def fit(
@@ -145,6 +157,12 @@ def fit(
             mark = "  <- chosen" if name == model.method else ""
             typer.echo(f"  {name:14s} {per}   mean {v['mean_rmse_um']:6.2f}   {cover:5.1f} %"
                        f"  worst {worst:5.1f} %{mark}")
+        chosen = validation[model.method]
+        outside = chosen.get("outside_range_pct_per_block", [])
+        if any(outside):
+            typer.echo("rows outside the operating range of the other blocks, per block: "
+                       + " / ".join(f"{v:.0f} %" for v in outside) + " (their band is "
+                       "widened with the distance; `predict` notes such rows)")
         typer.echo(f"sensors: {', '.join(model.spec.sensors)}")
         typer.echo(f"wrote {out}")
 
@@ -171,9 +189,10 @@ def predict(
     drift_data = read_drift_data([data], sensors=model.spec.sensors, targets=model.targets,
                                  require_targets=False, require_speed=model.spec.uses_speed)
     _report_findings(drift_data, quiet)
-    mean, lo, hi = model.predict(drift_data)
+    mean, lo, hi, excess, furthest = model.predict_data(drift_data)
     write_predictions(out, model, drift_data, mean, lo, hi)
     if not quiet:
+        _tell_outside_range(model.outside_range(excess, furthest))
         rows = drift_data.n_samples
         typer.echo(f"wrote {out} ({rows} row{'s' * (rows != 1)})")
 
@@ -205,6 +224,7 @@ def report(
         for t, m in metrics["targets"].items():
             typer.echo(f"{t:12s} RMSE {m['rmse_um']:.2f} µm, 90 % interval coverage "
                        f"{m['coverage_90_pct']:.1f} %")
+        _tell_outside_range(metrics["outside_range"])
         fitted = metrics["fitted_rows_pct"]
         if fitted:
             validation = model.metadata.get("validation", {})

@@ -3,7 +3,8 @@
 `fit_drift_model` ranks the sensors, picks them (`--sensors auto|K|all|LIST`), runs the
 time-blocked validation of the candidate methods (all of them, or the one forced; each
 fold picks its sensors on its own training rows), fits the chosen method on every row
-with a measured drift, and keeps the interval rule from the out-of-fold residuals.
+with a measured drift, and keeps the interval rule from the out-of-fold residuals and the
+operating range of its training rows (a row beyond it gets a wider band and a note).
 `DriftModel.predict` is causal: the features of a row use that row and earlier rows of
 its file only.
 """
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from twin.drift.data import TEMPERATURE_SUFFIX, DriftData, sensor_order
+from twin.drift.extrapolation import OperatingRange, fold_excess
 from twin.drift.features import FeatureSpec, dynamic_features, reference_temperatures
 from twin.drift.folds import block_labels, blocked_folds
 from twin.drift.intervals import apply_interval
@@ -49,16 +51,53 @@ class DriftModel:
                        segment_starts: np.ndarray | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(mean, lo, hi), each (n, p) in µm, for temperatures T_C of `spec.sensors`."""
+        return self.predict_with_range(time_s, T_C, speed_rpm, segment_starts)[:3]
+
+    def predict_with_range(self, time_s: np.ndarray, T_C: np.ndarray,
+                           speed_rpm: np.ndarray | None,
+                           segment_starts: np.ndarray | None = None) -> tuple[
+                               np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(mean, lo, hi, excess, furthest): besides the prediction, how far each row lies
+        outside the training rows' operating range (0 inside) and the index into
+        `operating_range.features` of the feature furthest out."""
         with one_blas_thread():
             X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
             mean, std = METHODS[self.method].predict(self.params, X)
-            lo, hi = apply_interval(self.interval, mean, std)
-        return mean, lo, hi
+            excess = furthest = np.zeros(len(X), dtype=np.int64)
+            if self.operating_range is not None:
+                excess, furthest = self.operating_range.excess(self.spec, X)
+            lo, hi = apply_interval(self.interval, mean, std, excess)
+        return mean, lo, hi, excess, furthest
+
+    @property
+    def operating_range(self) -> OperatingRange | None:
+        """The training rows' operating range (None in a file written before it)."""
+        doc = self.interval.get("operating_range")
+        return None if doc is None else OperatingRange.from_json(doc)
 
     def predict(self, data: DriftData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.predict_data(data)[:3]
+
+    def predict_data(self, data: DriftData) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray, np.ndarray]:
+        """`predict_with_range` of the data's rows."""
         columns = [data.sensors.index(s) for s in self.spec.sensors]
-        return self.predict_arrays(data.time_s, data.T_C[:, columns], data.speed_rpm,
-                                   data.segment_starts)
+        return self.predict_with_range(data.time_s, data.T_C[:, columns], data.speed_rpm,
+                                       data.segment_starts)
+
+    def outside_range(self, excess: np.ndarray, furthest: np.ndarray) -> dict | None:
+        """What to tell of the rows beyond the training rows' operating range (JSON-ready):
+        their count and share, the largest excess (spans of the range), the feature it is
+        in and the widening of the band there; None when every row lies inside."""
+        rng = self.operating_range
+        out = excess > 0
+        if rng is None or not out.any():
+            return None
+        k = int(np.argmax(excess))
+        gain = float(self.interval.get("extrapolation_gain", 0.0))
+        return {"rows": int(out.sum()), "rows_pct": 100.0 * float(np.mean(out)),
+                "max_excess_spans": float(excess[k]), "feature": rng.features[furthest[k]],
+                "max_band_factor": 1.0 + gain * float(excess[k])}
 
 
 def listed_sensors(option: str) -> list[str] | None:
@@ -218,42 +257,44 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
         method_named(method)
     ranking = sensor_ranking(data)
     chosen_sensors = parse_sensors(sensors, ranking, data.sensors)
-    columns = [data.sensors.index(s) for s in chosen_sensors]
-    T = data.T_C[:, columns]
-    reference = tuple(float(v) for v in reference_temperatures(T))
     rows = measured_rows(data, every_file=True)
     Y = data.targets_um[rows]
     blocks = block_labels(data.n_samples, data.segment_ids())[rows]
     names = [method] if method else list(candidates or METHODS)
     if data.speed_rpm is None:
         names = _methods_without_speed(names, method, data, progress)
-    features: dict[tuple[tuple[str, ...], tuple[str, ...]], np.ndarray] = {}
+    features: dict[tuple[tuple[str, ...], tuple[str, ...]], tuple[FeatureSpec, np.ndarray]] = {}
 
-    def features_of(sensor_names: Sequence[str], groups: tuple[str, ...]) -> np.ndarray:
+    def features_of(sensor_names: Sequence[str], groups: tuple[str, ...]
+                    ) -> tuple[FeatureSpec, np.ndarray]:
         key = (tuple(sensor_names), groups)
         if key not in features:
             cols = [data.sensors.index(s) for s in sensor_names]
             spec = FeatureSpec(key[0], tuple(float(v) for v in reference_temperatures(
                 data.T_C[:, cols])), groups=groups)
-            features[key] = dynamic_features(spec, data.time_s, data.T_C[:, cols],
-                                             data.speed_rpm, data.segment_starts)[rows]
+            features[key] = spec, dynamic_features(spec, data.time_s, data.T_C[:, cols],
+                                                   data.speed_rpm, data.segment_starts)[rows]
         return features[key]
 
     fold_sensors = sensors_per_fold(sensors, data, rows, blocks)
+    folds = blocked_folds(rows.size, blocks)
     results: list[MethodValidation] = []
     for name in names:
         groups = METHODS[name].groups
-        fold_X = None if fold_sensors is None else [features_of(s, groups)
-                                                    for s in fold_sensors]
-        results.append(validate_method(name, features_of(chosen_sensors, groups), Y,
-                                       data.time_s[rows], blocks, seed, progress, fold_X))
+        per_fold = [features_of(s, groups) for s in (fold_sensors or [chosen_sensors]
+                                                     * len(folds))]
+        fold_X = None if fold_sensors is None else [X for _, X in per_fold]
+        excess = fold_excess([spec for spec, _ in per_fold], [X for _, X in per_fold], folds,
+                             rows.size)
+        results.append(validate_method(name, features_of(chosen_sensors, groups)[1], Y,
+                                       data.time_s[rows], blocks, seed, progress, fold_X,
+                                       excess))
     best = method or choose_default(results)
     result = next(r for r in results if r.name == best)
-    spec = FeatureSpec(tuple(chosen_sensors), reference, groups=METHODS[best].groups)
+    spec, X = features_of(chosen_sensors, METHODS[best].groups)
     if progress:
         progress(f"fitting {best} on all rows")
-    params = METHODS[best].fit(FitRows(features_of(chosen_sensors, spec.groups), Y,
-                                       data.time_s[rows], blocks, seed, progress))
+    params = METHODS[best].fit(FitRows(X, Y, data.time_s[rows], blocks, seed, progress))
     metadata = {
         "training_files": list(data.files), "n_rows": int(rows.size), "seed": seed,
         # what `report` tells in-sample data by, whatever the file is called now
@@ -268,6 +309,7 @@ def _fit_drift_model(data: DriftData, method: str | None, sensors: str, seed: in
         metadata["sensors_left_out"] = data.left_out
     validation = {"time_s": data.time_s[rows], "block": blocks.astype(float), "measured_um": Y,
                   "predicted_um": result.predicted, "lo_um": result.lo, "hi_um": result.hi}
+    interval = {**result.interval, "operating_range": OperatingRange.of(spec, X).to_json()}
     return DriftModel(best, list(data.targets), spec,
                       {k: np.asarray(v, dtype=float) for k, v in params.items()},
-                      result.interval, metadata, validation)
+                      interval, metadata, validation)

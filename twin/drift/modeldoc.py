@@ -76,14 +76,51 @@ WIDTHS = {"conformal": "half_width_um", "scaled_posterior": "factor"}
 """The interval kinds (`twin.drift.intervals.interval_rule`) and the list each one holds."""
 
 
+class OperatingRange(_Fixed):
+    """`twin.drift.extrapolation.OperatingRange.to_json`: a range per feature named."""
+
+    features: list[str] = Field(min_length=1)
+    lo: list[FiniteFloat]
+    hi: list[FiniteFloat]
+    stopped_lo: list[FiniteFloat] | None = None
+    stopped_hi: list[FiniteFloat] | None = None
+
+    @field_validator("features")
+    @classmethod
+    def _features(cls, names: list[str]) -> list[str]:
+        return _each_once(names)
+
+    @model_validator(mode="after")
+    def _one_range_per_feature(self) -> OperatingRange:
+        if not len(self.lo) == len(self.hi) == len(self.features):
+            raise ValueError(f"{len(self.lo)} lower (lo) and {len(self.hi)} upper (hi) ends "
+                             f"for {len(self.features)} features")
+        if any(h < lo for lo, h in zip(self.lo, self.hi, strict=True)):
+            raise ValueError("an upper end (hi) below its lower end (lo)")
+        if (self.stopped_lo is None) != (self.stopped_hi is None):
+            raise ValueError("the stopped rows' range needs both ends (stopped_lo, stopped_hi)")
+        if self.stopped_lo is not None and self.stopped_hi is not None:
+            if not len(self.stopped_lo) == len(self.stopped_hi) == len(self.features):
+                raise ValueError(f"{len(self.stopped_lo)} lower (stopped_lo) and "
+                                 f"{len(self.stopped_hi)} upper (stopped_hi) ends for "
+                                 f"{len(self.features)} features")
+            if any(h < lo for lo, h in zip(self.stopped_lo, self.stopped_hi, strict=True)):
+                raise ValueError("an upper end (stopped_hi) below its lower end (stopped_lo)")
+        return self
+
+
 class Interval(_Fixed):
-    """`interval_rule`: conformal half-widths (µm) or the posterior σ's factor, per target.
+    """`interval_rule`: conformal half-widths (µm) or the posterior σ's factor, per target,
+    and (files written since the band widens beyond the training range) the gain and the
+    training rows' operating range.
     One model, not a union tagged by `kind`: pydantic would put the tag in the field's path
     (`interval.conformal.half_width_um`), which names no key of the file."""
 
     kind: Literal[tuple(WIDTHS)]  # type: ignore[valid-type]
     half_width_um: list[Annotated[float, Field(ge=0, allow_inf_nan=False)]] | None = None
     factor: list[Annotated[float, Field(ge=1, allow_inf_nan=False)]] | None = None
+    extrapolation_gain: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    operating_range: OperatingRange | None = None
 
     @model_validator(mode="after")
     def _widths_of_its_kind(self) -> Interval:

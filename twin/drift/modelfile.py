@@ -107,6 +107,11 @@ def _check_weights_fit(doc: ModelDocument, spec: FeatureSpec, params: dict[str, 
                 f"{len(spec.sensors)} sensors and {len(spec.taus_min)} lags make {columns} "
                 f"feature columns; the weights take {array.shape[0] if array.ndim else 0}",
                 file=file, field="features")
+    rng = doc.interval.operating_range
+    unknown = [] if rng is None else [f for f in rng.features if f not in spec.names]
+    if unknown:
+        raise MetadataError(f"{unknown[0]!r} is none of the model's features",
+                            file=file, field="interval.operating_range.features")
     try:
         mean, std = method.predict(params, np.zeros((2, columns)))
     except (KeyError, ValueError, IndexError):

@@ -66,8 +66,9 @@ def fitted_share_pct(model: DriftModel, data: DriftData) -> float | None:
 
 
 def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.ndarray,
-                  hi: np.ndarray) -> dict:
-    """metrics.json: per target rmse_um, mae_um, max_abs_um, r2, coverage_90_pct."""
+                  hi: np.ndarray, outside_range: dict | None = None) -> dict:
+    """metrics.json: per target rmse_um, mae_um, max_abs_um, r2, coverage_90_pct; the rows
+    beyond the model's operating range (`DriftModel.outside_range`, null for none)."""
     if data.targets_um is None:
         raise ValueError("the data hold no targets")
     per_target = {t: target_metrics(data.targets_um[:, j], mean[:, j], lo[:, j], hi[:, j])
@@ -79,7 +80,8 @@ def drift_metrics(model: DriftModel, data: DriftData, mean: np.ndarray, lo: np.n
         "method": model.method, "files": list(data.files), "n_rows": data.n_samples,
         "sensors": list(model.spec.sensors), "targets": per_target, "mean": mean_of,
         "fitted_rows_pct": fitted_share_pct(model, data),
-        "interval": model.interval, "data_findings": data.findings,
+        "interval": model.interval, "outside_range": outside_range,
+        "data_findings": data.findings,
         "validation": validation})
 
 

@@ -118,8 +118,8 @@ def _validation_figures(model: DriftModel) -> list[dict]:
 def write_drift_report(out_dir: str | os.PathLike[str], model: DriftModel, data: DriftData,
                        model_name: str) -> tuple[dict, Path, Path]:
     """Write metrics.json and report.html into `out_dir`: (metrics, their paths)."""
-    mean, lo, hi = model.predict(data)
-    metrics = drift_metrics(model, data, mean, lo, hi)
+    mean, lo, hi, excess, furthest = model.predict_data(data)
+    metrics = drift_metrics(model, data, mean, lo, hi, model.outside_range(excess, furthest))
     out = Path(out_dir)
     validation = model.metadata.get("validation", {}).get("methods", {})
     html = render_page(

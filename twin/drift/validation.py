@@ -2,8 +2,9 @@
 
 Each method is fitted on all blocks but one and predicts the left-out block (never
 shuffled); the out-of-fold predictions give RMSE per target and block, and their
-residuals give the conformal interval widths of the deterministic methods.  The default
-method is the one with the lowest out-of-fold RMSE, averaged over the targets.
+residuals calibrate the 90 % interval (`twin.drift.intervals`), each block's with the
+other blocks only.  The default method is the one with the lowest out-of-fold RMSE,
+averaged over the targets.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ class MethodValidation:
     posterior_coverage_pct: list[float] | None  # per target, uncalibrated posterior
     coverage_per_block_pct: np.ndarray  # (n_blocks, p): the pooled share hides a block
     # whose band misses most of it behind blocks covered whole
+    outside_range_pct_per_block: list[float]  # rows beyond the others' operating range
 
     pooled_rmse_um: np.ndarray     # (p,) over every out-of-fold row
     lo: np.ndarray                 # (n, p) the interval calibrated without the row's block
@@ -49,6 +51,7 @@ class MethodValidation:
                 "coverage_90_pct": dict(zip(targets, self.coverage_pct, strict=True)),
                 "coverage_90_pct_per_block": {t: self.coverage_per_block_pct[:, j].tolist()
                                               for j, t in enumerate(targets)},
+                "outside_range_pct_per_block": self.outside_range_pct_per_block,
                 "posterior_coverage_90_pct": None if self.posterior_coverage_pct is None
                 else dict(zip(targets, self.posterior_coverage_pct, strict=True))}
 
@@ -58,12 +61,15 @@ def validate_method(
     blocks: np.ndarray, seed: int,
     progress: Callable[[str], None] | None = None,
     fold_X: Sequence[np.ndarray] | None = None,
+    excess: np.ndarray | None = None,
 ) -> MethodValidation:
     """Leave-one-block-out predictions of one method (`blocks` from `block_labels`).
 
     `fold_X`, one feature matrix of every row per fold (in `blocked_folds` order), when
     the features depend on the fold: sensors chosen by their grade on that fold's
     training rows, so the left-out block's drift has no say in which sensors predict it.
+    `excess`, per row, how far its operating point lies outside its fold's training rows'
+    (`twin.drift.extrapolation.fold_excess`): its band widens with it.
     """
     method = METHODS[name]
     folds = blocked_folds(len(X), blocks)
@@ -89,11 +95,14 @@ def validate_method(
         labels[test] = k
     # coverage of every block with the interval calibrated on the other blocks only
     lo, hi = np.empty_like(predicted), np.empty_like(predicted)
+    excess = np.zeros(len(X)) if excess is None else np.asarray(excess, dtype=float)
     for k in range(len(folds)):
-        rule = interval_rule(predicted[labels != k], std if std is None else std[labels != k],
-                             Y[labels != k])
-        sd = None if std is None else std[labels == k]
-        lo[labels == k], hi[labels == k] = apply_interval(rule, predicted[labels == k], sd)
+        calibration, scored = labels != k, labels == k
+        rule = interval_rule(predicted[calibration],
+                             None if std is None else std[calibration], Y[calibration],
+                             labels[calibration])
+        sd = None if std is None else std[scored]
+        lo[scored], hi[scored] = apply_interval(rule, predicted[scored], sd, excess[scored])
     coverage = [coverage_pct(Y[:, j], lo[:, j], hi[:, j]) for j in range(Y.shape[1])]
     per_block = np.array([[coverage_pct(Y[test, j], lo[test, j], hi[test, j])
                            for j in range(Y.shape[1])] for _, test in folds])
@@ -102,8 +111,10 @@ def validate_method(
         posterior = [coverage_pct(Y[:, j], predicted[:, j] - Z90 * std[:, j],
                                   predicted[:, j] + Z90 * std[:, j]) for j in range(Y.shape[1])]
     pooled = np.sqrt(np.mean((predicted - Y) ** 2, axis=0))
-    return MethodValidation(name, predicted, std, rmse, interval_rule(predicted, std, Y),
-                            coverage, posterior, per_block, pooled, lo, hi)
+    outside = [100.0 * float(np.mean(excess[test] > 0)) for _, test in folds]
+    return MethodValidation(name, predicted, std, rmse,
+                            interval_rule(predicted, std, Y, labels),
+                            coverage, posterior, per_block, outside, pooled, lo, hi)
 
 
 def choose_default(results: Sequence[MethodValidation]) -> str:

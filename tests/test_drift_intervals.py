@@ -1,0 +1,142 @@
+"""The 90 % band: calibrated across left-out blocks, widened beyond the training range."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from tests.drift_synthetic import synthetic_columns, write_csv
+from twin.drift.data import read_drift_data
+from twin.drift.extrapolation import OperatingRange, range_excess
+from twin.drift.features import FeatureSpec
+from twin.drift.intervals import GAIN, apply_interval, conformal_half_width, interval_rule
+from twin.drift.model import fit_drift_model
+from twin.drift.modelfile import load_drift_model, save_drift_model
+
+
+def test_the_band_is_as_wide_as_the_worst_left_out_block_needs():
+    """Rows of a block are autocorrelated: pooled, two well-predicted blocks outvoted a
+    third whose band then missed most of it."""
+    rng = np.random.default_rng(0)
+    blocks = np.repeat([0, 1, 2], 400)
+    residual = rng.normal(0.0, np.where(blocks == 2, 5.0, 1.0))[:, None]
+    rule = interval_rule(residual, None, np.zeros_like(residual), blocks)
+    worst = conformal_half_width(residual[blocks == 2])
+    np.testing.assert_array_equal(rule["half_width_um"], worst)
+    assert worst[0] > 1.2 * conformal_half_width(residual)[0]     # what pooling gave
+    lo, hi = apply_interval(rule, np.zeros((3, 1)), None, np.array([0.0, 0.5, 2.0]))
+    np.testing.assert_allclose(hi[:, 0], worst[0] * (1.0 + GAIN * np.array([0.0, 0.5, 2.0])))
+    np.testing.assert_allclose(lo, -hi)
+
+
+def test_the_bayesian_band_keeps_its_floor_and_widens_the_same_way():
+    blocks = np.repeat([0, 1], 50)
+    std = np.full((100, 1), 2.0)
+    rule = interval_rule(np.full((100, 1), 0.1), std, np.zeros((100, 1)), blocks)
+    assert rule["kind"] == "scaled_posterior" and rule["factor"] == [1.0]
+    lo, hi = apply_interval(rule, np.zeros((2, 1)), std[:2], np.array([0.0, 1.0]))
+    np.testing.assert_allclose(hi[:, 0], 1.6448536269514722 * 2.0 * np.array([1.0, 1 + GAIN]))
+
+
+def test_range_excess_counts_spans_beyond_the_range():
+    lo, hi = np.array([0.0, 10.0]), np.array([2.0, 10.0])
+    x = np.array([[1.0, 10.0], [3.0, 10.0], [-1.0, 10.0], [1.0, 10.5], [2.5, 12.0]])
+    excess, worst = range_excess(x, lo, hi)
+    # a column that held one value counts in its own units
+    np.testing.assert_allclose(excess, [0.0, 0.5, 0.5, 0.5, 2.0])
+    assert worst.tolist()[1:] == [0, 0, 1, 1]
+
+
+def test_a_speed_between_a_stop_and_the_slowest_run_is_outside_the_range():
+    """Fitted on stops and 2500–5000 rpm, 1250 rpm lies inside [0, 5000] but no running
+    row of the training was that slow; a stopped row is held against the stopped ones."""
+    spec = FeatureSpec(("A_C",), (20.0,), taus_min=(10.0,), groups=("rise", "speed"))
+    assert spec.names == ["A_C:rise", "speed_krpm", "speed_krpm2", "speed_krpm:lag10min",
+                          "speed_krpm2:lag10min"]
+
+    def row(rise: float, krpm: float, lag: float) -> list[float]:
+        return [rise, krpm, krpm**2, lag, lag**2]
+
+    train = np.array([row(0, 0, 0), row(5, 2.5, 0), row(8, 2.5, 2.5), row(9, 0, 2.5),
+                      row(4, 0, 0.5), row(9, 5.0, 0), row(20, 5, 5), row(18, 0, 5)])
+    rng = OperatingRange.of(spec, train)
+    assert rng.features == ("speed_krpm", "speed_krpm2", "speed_krpm:lag10min",
+                            "speed_krpm2:lag10min")          # the temperatures are not
+    query = np.array([row(50, 2.5, 1.0), row(3, 1.25, 1.25), row(3, 0, 1.25), row(3, 6, 5.0)])
+    excess, worst = rng.excess(spec, query)
+    # 1250 rpm: (2.5 − 1.25)/2.5 of n; 6000 rpm: (36 − 25)/18.75 of n², more than n's 0.4
+    np.testing.assert_allclose(excess, [0.0, 0.5, 0.0, 11.0 / 18.75])
+    assert [rng.features[k] for k in worst[[1, 3]]] == ["speed_krpm", "speed_krpm2"]
+    doc = json.loads(json.dumps(rng.to_json()))
+    assert OperatingRange.from_json(doc) == rng
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("drift_band")
+    data = folder / "machine.csv"
+    write_csv(data, synthetic_columns(hours=3.0))                  # 3000 and 6000 rpm
+    model = fit_drift_model(read_drift_data([data], targets=["drift_um"]),
+                            method="ridge_dynamic", sensors="all", seed=0)
+    path = save_drift_model(model, folder / "model.safetensors")
+    faster = synthetic_columns(hours=3.0)
+    faster["speed_rpm"] = 1.5 * faster["speed_rpm"]                # 4500 and 9000 rpm
+    write_csv(folder / "faster.csv", faster)
+    return folder, data, path
+
+
+def test_rows_beyond_the_fitted_speeds_get_a_wider_band_and_a_note(fitted):
+    from twin.cli import app
+
+    folder, data, path = fitted
+    model = load_drift_model(path)
+    w = model.interval["half_width_um"][0]
+    same = read_drift_data([data], targets=["drift_um"])
+    mean, lo, hi, excess, _ = model.predict_data(same)
+    assert not excess.any() and model.outside_range(excess, _) is None
+    np.testing.assert_allclose(hi - mean, w)                      # the fitted range: w
+    faster = read_drift_data([folder / "faster.csv"], targets=["drift_um"])
+    mean, lo, hi, excess, furthest = model.predict_data(faster)
+    at_9000 = faster.speed_rpm == 9000
+    # n² 81 beyond its running range 9–36 by 45/27 of the span (its lags later further)
+    assert np.all(excess[at_9000] >= 45.0 / 27.0 - 1e-12)
+    np.testing.assert_allclose((hi - mean)[:, 0], w * (1.0 + GAIN * excess))
+    outside = model.outside_range(excess, furthest)
+    assert outside["rows"] == int(np.sum(excess > 0)) >= int(at_9000.sum())
+    assert outside["max_band_factor"] == pytest.approx(1.0 + GAIN * excess.max())
+    result = CliRunner().invoke(app, ["drift", "predict", str(path), str(folder / "faster.csv"),
+                                      "--out", str(folder / "pred.csv")])
+    assert result.exit_code == 0, result.output
+    assert (f"note: {outside['rows']} rows ({outside['rows_pct']:.1f} %) outside the operating "
+            f"range the model was fitted on (furthest: {outside['max_excess_spans']:.2f} of its "
+            f"span beyond, in {outside['feature']}): the model extrapolates there; the 90 % "
+            f"interval is widened for it, up to ×{outside['max_band_factor']:.2f}"
+            in result.output), result.output
+    result = CliRunner().invoke(app, ["drift", "predict", str(path), str(data),
+                                      "--out", str(folder / "same.csv")])
+    assert result.exit_code == 0 and "outside the operating range" not in result.output
+    result = CliRunner().invoke(app, ["drift", "report", str(path), str(folder / "faster.csv"),
+                                      "--out", str(folder / "report")])
+    assert result.exit_code == 0, result.output
+    metrics = json.loads((folder / "report" / "metrics.json").read_text())
+    assert metrics["outside_range"]["rows"] == outside["rows"]
+    assert "Outside the fitted range:" in (folder / "report" / "report.html").read_text()
+
+
+def test_a_model_file_without_the_range_keeps_its_band(fitted):
+    """A file written before the band widened has no operating range: it loads, and its
+    band is the width it was fitted with everywhere."""
+    folder, _, path = fitted
+    model = load_drift_model(path)
+    older = type(model)(model.method, model.targets, model.spec, model.params,
+                        {k: v for k, v in model.interval.items()
+                         if k not in ("operating_range", "extrapolation_gain")},
+                        model.metadata, model.validation)
+    older_path = save_drift_model(older, folder / "older.safetensors")
+    faster = read_drift_data([folder / "faster.csv"], targets=["drift_um"])
+    mean, lo, hi, excess, furthest = load_drift_model(older_path).predict_data(faster)
+    assert not excess.any()
+    np.testing.assert_allclose(hi - mean, model.interval["half_width_um"][0])

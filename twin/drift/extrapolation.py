@@ -1,0 +1,128 @@
+"""How far a row's operating point lies outside the rows a model was fitted on.
+
+A drift model fitted on the 2500–5000 rpm step tests and asked about 1250 rpm (or fitted
+up to 3750 and asked about 5000) extrapolates, and its error there is not that of the
+blocks it was calibrated on: one band for every row covered 8 % of a probe's samples in
+the 5000-rpm test while it covered every sample of the 2500-rpm one.
+
+The operating point is what the user sets: the speed history (n, n² and their lags) for
+a model that takes the speed; for one that does not, the temperature features, its only
+inputs.  The temperatures are the machine's answer to it, and a left-out block's are
+always a little outside the others' (a colder start, another ambient) without its error
+growing.  A running spindle and a stopped one are two regimes (DESIGN: speed 0 is a stop,
+no bearing or motor heat), so a running row is compared with the running training rows
+and a stopped one (its lags still falling from the speed before) with the stopped ones:
+1250 rpm lies between a stop and 2500 rpm, but no model fitted on stops and 2500–5000 rpm
+has seen the spindle run that slowly.  The excess of a row is the largest, over those
+features, of how far it lies beyond its regime's training range in units of that range's
+span (0 inside): the band grows as a linear error would (see `twin.drift.intervals`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from twin.drift.features import FeatureSpec
+
+SPEED_PREFIX = "speed_"
+SPEED_NOW = "speed_krpm"
+"""The feature that tells a running row (non-zero) from a stopped one."""
+
+
+def operating_features(spec: FeatureSpec) -> list[str]:
+    """The feature names that set the operating point (see the module note)."""
+    names = spec.names
+    speed = [n for n in names if n.startswith(SPEED_PREFIX)]
+    return speed or names
+
+
+def _running(spec: FeatureSpec, X: np.ndarray) -> np.ndarray | None:
+    """Rows of X where the spindle runs; None for a model without the speed."""
+    if SPEED_NOW not in spec.names:
+        return None
+    return X[:, spec.names.index(SPEED_NOW)] != 0
+
+
+def _ends(x: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+    if x.shape[0] == 0:
+        return None
+    return tuple(float(v) for v in x.min(axis=0)), tuple(float(v) for v in x.max(axis=0))
+
+
+@dataclass(frozen=True)
+class OperatingRange:
+    """The training rows' range of the operating features (`features`, names of
+    `FeatureSpec.names`): `lo`, `hi` per feature over the running rows (every row for a
+    model without the speed), `stopped_lo`, `stopped_hi` over the stopped ones (None
+    without any: a stopped row is then held against the running rows' range, as a running
+    row is without any running training row)."""
+
+    features: tuple[str, ...]
+    lo: tuple[float, ...]
+    hi: tuple[float, ...]
+    stopped_lo: tuple[float, ...] | None = None
+    stopped_hi: tuple[float, ...] | None = None
+
+    @classmethod
+    def of(cls, spec: FeatureSpec, X: np.ndarray) -> OperatingRange:
+        """The ranges of the operating features over the rows of X (n, len(spec.names))."""
+        features = operating_features(spec)
+        x = X[:, [spec.names.index(f) for f in features]]
+        running = _running(spec, X)
+        if running is None:
+            return cls(tuple(features), *_ends(x))
+        run, stop = _ends(x[running]), _ends(x[~running])
+        lo, hi = run or stop
+        return cls(tuple(features), lo, hi, *(stop if run and stop else (None, None)))
+
+    def to_json(self) -> dict:
+        doc = {"features": list(self.features), "lo": list(self.lo), "hi": list(self.hi)}
+        if self.stopped_lo is not None and self.stopped_hi is not None:
+            doc.update(stopped_lo=list(self.stopped_lo), stopped_hi=list(self.stopped_hi))
+        return doc
+
+    @classmethod
+    def from_json(cls, doc: dict) -> OperatingRange:
+        def floats(key: str) -> tuple[float, ...] | None:
+            return None if doc.get(key) is None else tuple(float(v) for v in doc[key])
+
+        return cls(tuple(doc["features"]), floats("lo"), floats("hi"),
+                   floats("stopped_lo"), floats("stopped_hi"))
+
+    def excess(self, spec: FeatureSpec, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(excess (n,), index into `features` of the feature furthest out (n,)) of the
+        rows of X (n, len(spec.names)).  A feature that held one value in training counts
+        its distance in its own units (a speed in krpm)."""
+        x = X[:, [spec.names.index(f) for f in self.features]]
+        excess, worst = range_excess(x, np.asarray(self.lo), np.asarray(self.hi))
+        running = _running(spec, X)
+        if running is not None and self.stopped_lo is not None and self.stopped_hi is not None:
+            stopped = ~running
+            excess[stopped], worst[stopped] = range_excess(
+                x[stopped], np.asarray(self.stopped_lo), np.asarray(self.stopped_hi))
+        return excess, worst
+
+
+def range_excess(x: np.ndarray, lo: np.ndarray, hi: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of x (n, k), the largest of (x − hi)/span and (lo − x)/span over the
+    columns (0 inside [lo, hi]; span = hi − lo, 1 where it is 0), and its column."""
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    if x.shape[1] == 0:
+        return np.zeros(x.shape[0]), np.zeros(x.shape[0], dtype=np.int64)
+    span = np.where(hi > lo, hi - lo, 1.0)
+    out = np.maximum(np.maximum(x - hi, lo - x) / span, 0.0)
+    worst = np.argmax(out, axis=1)
+    return out[np.arange(x.shape[0]), worst], worst
+
+
+def fold_excess(spec_of_fold: Sequence[FeatureSpec], X_of_fold: Sequence[np.ndarray],
+                folds: Sequence[tuple[np.ndarray, np.ndarray]], n_rows: int) -> np.ndarray:
+    """Excess of every left-out row over its fold's training rows (validation order)."""
+    out = np.zeros(n_rows)
+    for spec, X, (train, test) in zip(spec_of_fold, X_of_fold, folds, strict=True):
+        out[test] = OperatingRange.of(spec, X[train]).excess(spec, X[test])[0]
+    return out
