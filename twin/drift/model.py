@@ -63,7 +63,7 @@ class DriftModel:
         with one_blas_thread():
             X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
             mean, std = METHODS[self.method].predict(self.params, X)
-            excess = furthest = np.zeros(len(X), dtype=np.int64)
+            excess, furthest = np.zeros(len(X)), np.zeros(len(X), dtype=np.int64)
             if self.operating_range is not None:
                 excess, furthest = self.operating_range.excess(self.spec, X)
             lo, hi = apply_interval(self.interval, mean, std, excess)
