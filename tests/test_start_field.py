@@ -166,3 +166,89 @@ def test_a_cold_starts_replay_tells_nothing_and_starts_its_deck_from_tunif(tmp_p
     antypes = [line for line in deck.splitlines() if line.startswith("ANTYPE")]
     assert antypes[0] == "ANTYPE,TRANS" and "TUNIF,22" in deck
     assert not (out / "cold" / "decks" / "window_000_start.vtu").exists()
+
+
+def test_a_recording_begun_just_after_a_stop_is_not_fitted_as_a_far_hotter_spindle(
+        tmp_path, spindle_model):
+    """A logger started seconds after the spindle stopped (20 min at 14700 rpm) finds the
+    rings at their running temperatures.  The cooling family began one minute into the
+    pause, so the fit took that minute's cooling up with source scales of 5.5 and 3.9: a
+    field up to 108 °C where the spindle held 48, 26 K RMS off (the uniform start 8.9) and
+    the open-loop drift 17 µm off over the run (from the uniform start 2.6).  Its first
+    seconds of cooling are in the family now: 2.3 K RMS off, the drift 0.4 µm."""
+    from twin.correction.methods import OpenLoop
+    from twin.loop.replay import replay_method
+
+    ran = simulate(spindle_model, 14700.0, 20.0, AMBIENT_C)
+    stopped = nominal_conditions(spindle_model, 0.0, AMBIENT_C)
+    stepper = spindle_model.thermal.transient(stopped.to_thermal_loads(), dt=4.0)
+    fields = np.array(list(stepper.march(ran.final_T, 45)))  # 3 min stopped, every 4 s
+    true = fields[0]  # the recording begins 4 s after the stop
+    S = spindle_model.sensor_matrix
+    drift = 1e6 * spindle_model.probe_vectors[0]
+    columns = {"time_s": 4.0 * np.arange(len(fields)), "speed_rpm": np.zeros(len(fields)),
+               "ambient_C": np.full(len(fields), AMBIENT_C),
+               "disp_z_um": np.asarray((fields - true) @ drift).ravel()}
+    for i, values in enumerate(S @ fields.T):
+        columns[f"T{i + 1}_C"] = values
+    write_run(tmp_path / "stop.csv", columns)
+    run = read_run(tmp_path / "stop.csv")
+    start = start_field(spindle_model, run)
+    assert start.history.startswith("stopped")
+    # the family's history (60 min at 9000 rpm) is not this one: the rotor is fitted 5.6 K
+    # hotter than it was (was 60 K)
+    assert start.field_C.max() < true.max() + 8.0, (start.history, start.field_C.max())
+    rms = float(np.sqrt(np.mean((start.field_C - true) ** 2)))
+    uniform = float(np.sqrt(np.mean((np.mean(S @ true) - true) ** 2)))
+    assert rms < 0.5 * uniform, (rms, uniform)
+    replay = replay_method(run, spindle_model, OpenLoop(), keep_fields=False, start=start)
+    measured = columns["disp_z_um"][1:1 + len(replay.time_s)]
+    assert np.abs(replay.drift_z_um - measured).max() < 1.0
+
+
+@pytest.fixture(scope="module")
+def hour_at_9000(spindle_model):
+    """An hour at 9000 rpm (the history the cooling family assumes), then 12 min stopped:
+    the field every 4 s of the pause."""
+    ran = simulate(spindle_model, 9000.0, 60.0, AMBIENT_C)
+    stopped = nominal_conditions(spindle_model, 0.0, AMBIENT_C)
+    stepper = spindle_model.thermal.transient(stopped.to_thermal_loads(), dt=4.0)
+    return np.array(list(stepper.march(ran.final_T, 180)))
+
+
+def pause_run(path, model, fields):
+    S = model.sensor_matrix
+    drift = 1e6 * model.probe_vectors[0]
+    columns = {"time_s": 4.0 * np.arange(len(fields)), "speed_rpm": np.zeros(len(fields)),
+               "ambient_C": np.full(len(fields), AMBIENT_C),
+               "disp_z_um": np.asarray((fields - fields[0]) @ drift).ravel()}
+    for i, values in enumerate(S @ fields.T):
+        columns[f"T{i + 1}_C"] = values
+    write_run(path, columns)
+    return read_run(path), columns["disp_z_um"]
+
+
+@pytest.mark.parametrize("after_s", [4.0, 600.0])
+def test_a_pause_is_fitted_with_plausible_scales_not_whichever_meets_the_readings_best(
+        tmp_path, spindle_model, hour_at_9000, after_s):
+    """The twin's own pause after the very history the family assumes.  Chosen by the
+    readings' misfit alone (0.14 to 0.24 K RMS over the first minutes), 4 s into it the fit
+    took 2 min of cooling from three times the bearing heat (scales 3.0, 0.8, 2.4): a field
+    12.8 K RMS off (uniform 8.1), the open-loop drift 9.8 µm off (uniform 1.1); 10 min into
+    it, 90 min of cooling from 36 times the heat.  Chosen by the fit's whole cost, with the
+    common scale drawn towards the nominal heat: 4.8 K and 1.8 µm, and 12 min from scales
+    near 1."""
+    from twin.correction.methods import OpenLoop
+    from twin.loop.replay import replay_method
+
+    fields = hour_at_9000[int(after_s / 4.0) - 1:]
+    run, measured = pause_run(tmp_path / "pause.csv", spindle_model, fields)
+    start = start_field(spindle_model, run)
+    assert start.history.startswith("stopped")
+    assert max(start.scales) < 2.0, (start.history, start.scales)
+    S = spindle_model.sensor_matrix
+    rms = float(np.sqrt(np.mean((start.field_C - fields[0]) ** 2)))
+    uniform = float(np.sqrt(np.mean((np.mean(S @ fields[0]) - fields[0]) ** 2)))
+    assert rms < 0.7 * uniform, (rms, uniform)
+    replay = replay_method(run, spindle_model, OpenLoop(), keep_fields=False, start=start)
+    assert np.abs(replay.drift_z_um - measured[1:1 + len(replay.time_s)]).max() < 2.5
