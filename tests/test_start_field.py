@@ -252,3 +252,31 @@ def test_a_pause_is_fitted_with_plausible_scales_not_whichever_meets_the_reading
     assert rms < 0.7 * uniform, (rms, uniform)
     replay = replay_method(run, spindle_model, OpenLoop(), keep_fields=False, start=start)
     assert np.abs(replay.drift_z_um - measured[1:1 + len(replay.time_s)]).max() < 2.5
+
+
+def test_a_cold_start_loads_no_fitting_library(tmp_path):
+    """A cold start is replayed as before, at its cost before: the bounded least squares'
+    module (scipy.optimize) loaded with the replay for every run added 9 MB to a cold
+    replay's peak memory (bench `replay_peak_rss_MB` 132 -> 141) and its import time."""
+    import subprocess
+    import sys
+
+    t = np.arange(130.0)
+    columns = {"time_s": t, "speed_rpm": np.full(t.size, 9000.0),
+               "ambient_C": np.full(t.size, AMBIENT_C)}
+    for i in range(5):
+        columns[f"T{i + 1}_C"] = np.full(t.size, AMBIENT_C + 0.1 * i)
+    write_run(tmp_path / "rest.csv", columns)
+    probe = (
+        "import json, sys\n"
+        "from twin.loop.runfiles import replay_run_to_dir\n"
+        "from twin.loop.start_field import start_field\n"
+        "from twin.runs import read_run\n"
+        "from twin.spindle.model import SpindleModel\n"
+        f"start = start_field(SpindleModel.load(), read_run({str(tmp_path / 'rest.csv')!r}))\n"
+        "assert start.uniform\n"
+        "print(json.dumps(sorted(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", probe], check=True, capture_output=True,
+                         text=True).stdout
+    loaded = set(json.loads(out.splitlines()[-1]))
+    assert "twin.loop.start_field" in loaded and "scipy.optimize" not in loaded

@@ -45,7 +45,6 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from twin.fem.loads import ThermalLoads
 from twin.fem.stepper import ThermalStepper
@@ -162,6 +161,10 @@ def _fit(columns: np.ndarray, readings: np.ndarray) -> tuple[np.ndarray, float]:
     value, but five readings do not pin three scales and a level freely) and that towards
     the nominal (`COMMON_SCALE_SD`), and the least squares' cost (half the weighted sum of
     squares: readings and scales)."""
+    # here, not with the module: a cold start (every replay imports this) loaded it for
+    # nothing, 9 MB of a replay's peak memory
+    from scipy.optimize import lsq_linear
+
     n, m = columns.shape
     # unknowns [b, a_1..a_m, a_common]: readings within READING_SD_K, a_j − a_common ≈ 0,
     # a_common ≈ 1
