@@ -280,3 +280,26 @@ def test_a_cold_start_loads_no_fitting_library(tmp_path):
                          text=True).stdout
     loaded = set(json.loads(out.splitlines()[-1]))
     assert "twin.loop.start_field" in loaded and "scipy.optimize" not in loaded
+
+
+def test_a_warm_start_is_not_told_its_speed_may_be_in_rev_per_s(tmp_path):
+    """`warms_unlike_twin` compares the thermocouples' rise with the open-loop twin's at the
+    recorded speeds, calibrated on runs begun at rest.  From a fitted warm start the twin's
+    rise is that of the guessed history's continuation: a spindle whose bearings run 40 %
+    and motor 30 % above nominal (as suite runs draw), recorded from 10 min into 12000 rpm,
+    was told its speed might be in rev/s (rise 3.3 K, 3347 times the twin's), as 5 of 42
+    warm recordings cut from suite runs were; from the uniform start before, none."""
+    from twin.cli import app
+
+    (tmp_path / "hot.toml").write_text(
+        "[bearing_heat.front]\ntime_s = [0]\nfactor = [1.4]\n"
+        "[bearing_heat.rear]\ntime_s = [0]\nfactor = [1.4]\n"
+        "[motor_heat]\ntime_s = [0]\nfactor = [1.3]\n")
+    run = tmp_path / "hot.csv"
+    result = CliRunner().invoke(app, [
+        "synth", "--speed", "12000", "--minutes", "40", "--ambient", "22", "--seed", "7000123",
+        "--scenario", str(tmp_path / "hot.toml"), "--record-from", "10", "--out", str(run)])
+    assert result.exit_code == 0, result.output
+    found, _ = replay_open_loop(run, tmp_path / "out")
+    kinds = [f["kind"] for f in found]
+    assert "warm_start" in kinds and "warms_unlike_twin" not in kinds, found
