@@ -56,6 +56,8 @@ def replay_open_loop(run_csv, out):
 
 def test_a_spindle_at_rest_starts_uniform_at_the_mean_of_its_first_readings(tmp_path,
                                                                            spindle_model):
+    """T5 1.6 K above the others, as a thermocouple's calibration offset may put it, is
+    still a spindle at rest (fitted, it made a motor-heated rotor 8-20 K warm)."""
     columns = {"time_s": np.arange(130.0), "speed_rpm": np.full(130, 9000.0),
                "ambient_C": np.full(130, AMBIENT_C)}
     first = [22.1, 22.4, 22.0, 22.3, 22.2 + 0.9 * WARM_START_SPREAD_K - 0.2]

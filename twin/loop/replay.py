@@ -50,7 +50,7 @@ the field window k's deck starts from, so the decks reproduce both the reported 
 and the carried state.
 
 The run starts from a uniform field at the mean of the first measured T1..T5 (a spindle
-at rest has equalised) or, where those spread more than a kelvin (a recording that begins
+at rest has equalised) or, where those spread more than 2 K (a recording that begins
 on a warm spindle), from a field fitted to them (`twin.loop.start_field`).  The start field
 is the zero of the drift: the recorded drift is taken as measured from the start.
 """
