@@ -83,8 +83,9 @@ def _num(x: float) -> str:
 
 HOW_TO_RUN = (
     "! loads only: runs on the spindle model (apdl-like run DECK --spindle --out DIR); a",
-    "! later window restarts from the field the run carried in: --start with the previous",
-    "! deck's last result_NNN.vtu, or window_kkk_start.vtu where written (README, Usage)",
+    "! restart (a later window, a warm start's first) runs from the field the run carried",
+    "! in: --start with the previous deck's last result_NNN.vtu, or window_kkk_start.vtu",
+    "! where written (README, Usage)",
 )
 
 
