@@ -6,9 +6,9 @@ stress) plus SEQV; NaN marks nodes outside the elements; the field data TIME hol
 step's end time (s).  Every file is written atomically.
 
 A *state file* is the same format with TEMP and TIME only (`write_state_vtu`; a replay's
-`decks/window_kkk_start.vtu`, with the estimator's READINGS_START_C and SENSOR_LAG_S as
-further field data): `read_state_vtu` reads it, or any result_NNN.vtu, as the temperature
-state a restart (ANTYPE,,REST) continues from (`apdl-like run --start`).
+`decks/window_kkk_start.vtu`, with the estimator's READINGS_START_C, SENSOR_LAG_S and
+SENSOR_OFFSET_C as further field data): `read_state_vtu` reads it, or any result_NNN.vtu,
+as the temperature state a restart (ANTYPE,,REST) continues from (`apdl-like run --start`).
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ import numpy as np
 from bench.loop import _cli
 
 ROOT = Path(__file__).resolve().parent.parent
-MEMBERS = (12, 16, 24, 32, 48)  # at least parameters + 2 (eight estimated)
+MEMBERS = (16, 24, 32, 48)  # at least parameters + 2 (fourteen estimated by default)
 
 
 def bundled_runs() -> list[Path]:

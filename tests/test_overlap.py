@@ -172,7 +172,8 @@ def test_method_replay_survives_its_json_exactly():
     band = rng.random((30, 6)) / 3.0
     correction = Correction(1.1e6 / 3, 2.2e6, 1.2e-4, 1e-4 / 7, C_H=(1.01, 0.99),
                             C_C=(1.0, 1.0 / 3), factors={"motor": 1.07, "film_coolant": 0.93},
-                            state_C=rng.normal(25.0, 1.0, 40), band_sd=band[:15])
+                            state_C=rng.normal(25.0, 1.0, 40), band_sd=band[:15],
+                            sensor_offset_C=rng.normal(0.0, 0.5, 5))
     r = MethodReplay(
         method="estimator", time_s=4.0 * np.arange(1, 31), T_twin_C=T,
         drift_z_um=rng.normal(size=30), drift_r_um=rng.normal(size=30),
@@ -191,6 +192,7 @@ def test_method_replay_survives_its_json_exactly():
     assert w.nominal == r.windows[0].nominal and c == correction  # values, C_H, C_C, factors
     np.testing.assert_array_equal(c.state_C, correction.state_C)
     np.testing.assert_array_equal(c.band_sd, correction.band_sd)
+    np.testing.assert_array_equal(c.sensor_offset_C, correction.sensor_offset_C)
 
 
 _SAME_WITH_AND_WITHOUT_FORK = """

@@ -258,7 +258,8 @@ def test_every_window_runs_with_apdl_like_from_the_replays_outputs(tmp_path, spi
         return model.sensor_matrix @ vtu.point_data["TEMP"]
 
     # the estimator's window 2: its deck from its analysed field, 15 load steps of 4 s; the
-    # metal at T1..T5 through the stated lag from the stated readings is what it reported
+    # metal at T1..T5 through the stated lag from the stated readings, plus the stated
+    # thermocouple offsets, is what it reported
     decks = run_dir / "decks" / "estimator"
     start = meshio.read(decks / "window_002_start.vtu")
     assert start.field_data["TIME"][0] == 120.0
@@ -267,6 +268,7 @@ def test_every_window_runs_with_apdl_like_from_the_replays_outputs(tmp_path, spi
     metal = np.vstack([sensors(start), [sensors(s) for s in steps]])
     readings = first_order_lag(metal, 4.0 * np.arange(16), start.field_data["SENSOR_LAG_S"][0],
                                start.field_data["READINGS_START_C"])[1:]
+    readings = readings + start.field_data["SENSOR_OFFSET_C"]
     np.testing.assert_allclose(readings, reported("estimator", 2), atol=1e-4)
     # the analysed field is not the forecast's end: chaining the decks would miss it
     window1 = apdl(decks / "window_001.inp", decks / "window_001_start.vtu", "est1")

@@ -48,6 +48,10 @@ class Correction:
     first-order lag `sensor_lag_s` (`twin.lag`).  None: the metal."""
     sensor_lag_s: float = 0.0
     """The thermocouples' time constant, s (a method that estimates it; 0: not estimated)."""
+    sensor_offset_C: np.ndarray | None = field(default=None, repr=False, compare=False)
+    """(5,) what each thermocouple reads above its metal once its lag has settled, K
+    (calibration, placement; a method that estimates it): added to T1..T5 as reported
+    (with `readings_start_C`: to the readings).  None: no offset."""
     loads_follow_rings: bool = False
     """The window's bearing heat and contact resistance follow the twin's own ring and
     sleeve temperatures every solver step (`twin.correction.rerun.LOAD_UPDATE_STEPS`), as the
@@ -74,7 +78,8 @@ class Correction:
         cls, values: BoundaryValues | np.ndarray, previous: BoundaryValues, **extra: object
     ) -> Correction:
         """These values with C_H, C_C on `previous` (1 where that was 0: a stop);
-        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s, coolant_C.
+        `extra`: factors, state_C, band_sd, readings_start_C, sensor_lag_s,
+        sensor_offset_C, coolant_C.
         The methods give the previous window's values carried to this window's nominal
         level (`WindowFeatures.carried_previous`), the H' and R' of Eq. 3 and Eq. 6: a
         speed change moves the nominal heat, not the correction (on the previous values

@@ -17,7 +17,9 @@ One parameter is no factor: `coolant_offset`, the coolant inlet's offset from th
 the conditions assume (K, additive: an inlet 2 K below is as likely as 2 K above, and 0 K
 is no boundary value to take a logarithm of).  It is estimated only on a run that records
 no inlet temperature, where the conditions assume the inlet at the ambient
-(`twin.estimation.method`, "Coolant inlet").
+(`twin.estimation.method`, "Coolant inlet").  Nor are the thermocouples' offsets
+(`SENSOR_BIASES`, K, additive and observation-only: what each reads above its metal; the
+filter adds them where it compares the field with T1..T5; "Thermocouple offsets" there).
 """
 
 from __future__ import annotations
@@ -45,7 +47,8 @@ class Parameter:
                resistance), motor (motor loss), film_<group> (FILM_GROUPS film coefficients),
                expansion (every thermal expansion coefficient: the drift's scale),
                sensor_lag (the thermocouples' time constant: what T1..T5 read of the metal),
-               coolant_offset (the coolant inlet's offset, K; `OFFSETS`)
+               coolant_offset (the coolant inlet's offset, K; `OFFSETS`), bias_T1..bias_T5
+               (each thermocouple's offset from its metal, K; `SENSOR_BIASES`)
     prior_sd   spread of the prior in log space (0.2 ≈ ±20 %); an offset's in K
     walk_sd    random-walk spread added per 60 s window, log space; an offset's in K
     bounds     (lowest, highest) factor on the nominal value; an offset's in K
@@ -64,9 +67,14 @@ class Parameter:
         return math.log(self.bounds[0]), math.log(self.bounds[1])
 
 
-OFFSETS: frozenset[str] = frozenset({"coolant_offset"})
+SENSOR_BIASES: tuple[str, ...] = ("bias_T1", "bias_T2", "bias_T3", "bias_T4", "bias_T5")
+"""Each thermocouple's additive offset, K: what it reads above the metal at its nominal point
+once the lag has settled (calibration, placement).  Observation-only, in T1..T5's order."""
+
+OFFSETS: frozenset[str] = frozenset({"coolant_offset", *SENSOR_BIASES})
 """Additive parameters (K), not log-factors: the coolant inlet's offset from the inlet the
-conditions assume.  `factors_of` leaves them out; `apply_factors` takes the offset apart."""
+conditions assume and the thermocouples' offsets.  `factors_of` leaves them out;
+`apply_factors` takes the coolant offset apart."""
 
 
 ALL_PARAMETERS: dict[str, Parameter] = {
@@ -84,12 +92,17 @@ ALL_PARAMETERS: dict[str, Parameter] = {
         Parameter("expansion", 0.05, 0.002, (0.7, 1.4)),
         Parameter("sensor_lag", 0.45, 0.01, (0.2, 4.0)),
         Parameter("coolant_offset", 2.5, 0.10, (-8.0, 8.0)),
+        *(Parameter(name, 0.15, 0.0, (-3.0, 3.0)) for name in SENSOR_BIASES),
     )
 }
 """Every candidate.  Prior spreads follow REFERENCE.md §7 (motor ±20–30 %, films ±20–40 %)
 and the paper's corrections (bearing heat and contact resistance moving by tens of %);
 sensor_lag's spread spans the 4–20 s of sheathed thermocouples around the assumed 10 s;
-coolant_offset's 2.5 K a chiller holding the jacket 1–3 K off the room air, either way."""
+coolant_offset's 2.5 K a chiller holding the jacket 1–3 K off the room air, either way;
+a thermocouple offset's 0.15 K is narrower than real offsets (±0.5–1 K): the data carry a
+0.7 K offset well beyond it where speed changes and stops tell it from the factors, and a
+wider prior let the offsets stand in for factors where they do not (`twin.estimation.
+method`, "Thermocouple offsets"); no walk (an offset does not move within a run)."""
 
 DEFAULT_PARAMETERS: tuple[str, ...] = (
     "H_front", "H_rear", "R_front", "R_rear", "motor", "film_rotor", "film_coolant", "expansion",
@@ -102,7 +115,7 @@ DRIFT_ONLY: frozenset[str] = frozenset({"expansion"})
 coefficient, which scales the nose drift and nothing else.  Only the drift measurement
 updates it; without one it keeps its prior (and widens the drift band by it)."""
 
-OBSERVATION_ONLY: frozenset[str] = frozenset({"sensor_lag"})
+OBSERVATION_ONLY: frozenset[str] = frozenset({"sensor_lag", *SENSOR_BIASES})
 """Parameters of the sensors, not of the spindle: a factor on the thermocouples' assumed
 time constant.  It moves no temperature (no boundary value, no tangent column); the filter
 applies it where it compares the field with T1..T5 (`twin.estimation.method`)."""

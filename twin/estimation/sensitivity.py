@@ -12,6 +12,9 @@ The coolant inlet's offset (`coolant_offset`, additive) is differenced by δ K i
 sensitivities are per K.  For it the report also gives the cosine of its column with every
 other and the RMS of its column left after a least-squares fit by all the others: what no
 combination of them can stand in for (`twin.estimation.method`, "Coolant inlet").
+A thermocouple's offset (`bias_T1`..`bias_T5`) moves no temperature: its column is 1 K
+per K on its own sensor at every sample, 0 elsewhere and on the drift; it is studied only
+where named (the default: every other candidate).
 
     python -m twin.estimation.sensitivity [--speed 9000] [--minutes 30] [--sigma 0.1]
                                           [--names H_front,…,coolant_offset]
@@ -27,7 +30,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from twin.contract import STEP_S
-from twin.estimation.parameters import ALL_PARAMETERS, OFFSETS, apply_factors
+from twin.estimation.parameters import ALL_PARAMETERS, OFFSETS, SENSOR_BIASES, apply_factors
+
+CANDIDATES: tuple[str, ...] = tuple(n for n in ALL_PARAMETERS if n not in SENSOR_BIASES)
+"""The study's default: every candidate but the thermocouples' offsets."""
 
 if TYPE_CHECKING:
     from twin.spindle.conditions import BoundaryConditions
@@ -74,7 +80,7 @@ def trajectory_sensitivity(
     speed_rpm: float = 9000.0,
     ambient_C: float = 25.0,
     minutes: float = 30.0,
-    names: Sequence[str] = tuple(ALL_PARAMETERS),
+    names: Sequence[str] = CANDIDATES,
     delta: float = 0.05,
     dt_s: float = STEP_S,
 ) -> Sensitivity:
@@ -88,6 +94,11 @@ def trajectory_sensitivity(
     J = np.empty(base_T.shape + (len(names),))
     Jd = np.empty(base_d.shape + (len(names),))
     for i, name in enumerate(names):
+        if name in SENSOR_BIASES:  # read on its own sensor only: 1 K per K
+            J[..., i] = 0.0
+            J[:, SENSOR_BIASES.index(name), i] = 1.0
+            Jd[..., i] = 0.0
+            continue
         # an offset (K) moves by `delta` K: its sensitivity is per K
         moved = (apply_factors(bc, {}, coolant_offset_K=delta) if name in OFFSETS
                  else apply_factors(bc, {name: np.exp(delta)}))
@@ -137,8 +148,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--speed", type=float, default=9000.0)
     parser.add_argument("--minutes", type=float, default=30.0)
     parser.add_argument("--sigma", type=float, default=0.1)
-    parser.add_argument("--names", default=",".join(ALL_PARAMETERS),
-                        help="comma-separated parameters (default: every candidate)")
+    parser.add_argument("--names", default=",".join(CANDIDATES),
+                        help="comma-separated parameters (default: every candidate but the "
+                             "thermocouples' offsets)")
     args = parser.parse_args(argv)
     sens = trajectory_sensitivity(SpindleModel.load(), args.speed, minutes=args.minutes,
                                   names=tuple(args.names.split(",")))

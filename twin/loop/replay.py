@@ -488,11 +488,14 @@ def replay_method(
 def _reported(metal_C: np.ndarray, corr: Correction) -> np.ndarray:
     """T1..T5 over a window as reported (metal_C: the window start and its steps): the
     metal at the sensor points, or, for a method that gives the thermocouples' readings at
-    the window start, their readings through the method's lag."""
+    the window start, their readings through the method's lag; plus each thermocouple's
+    offset where the method states one (`Correction.sensor_offset_C`)."""
+    offset = 0.0 if corr.sensor_offset_C is None else np.asarray(corr.sensor_offset_C, float)
     if corr.readings_start_C is None or corr.sensor_lag_s <= 0:
-        return metal_C[1:]
+        return metal_C[1:] + offset
     time_s = STEP_S * np.arange(len(metal_C))
-    return first_order_lag(metal_C, time_s, corr.sensor_lag_s, corr.readings_start_C)[1:]
+    return first_order_lag(metal_C, time_s, corr.sensor_lag_s,
+                           corr.readings_start_C)[1:] + offset
 
 
 @dataclass(frozen=True)
@@ -592,6 +595,7 @@ def method_replay_to_json(r: MethodReplay) -> str:
                 "factors": dict(c.factors), "state_C": _array(c.state_C),
                 "band_sd": _array(c.band_sd), "sensor_lag_s": c.sensor_lag_s,
                 "readings_start_C": _array(c.readings_start_C),
+                "sensor_offset_C": _array(c.sensor_offset_C),
                 "loads_follow_rings": c.loads_follow_rings, "coolant_C": c.coolant_C,
             },
         }
@@ -616,7 +620,8 @@ def method_replay_from_json(text: str) -> MethodReplay:
             *c["values"], C_H=tuple(c["C_H"]), C_C=tuple(c["C_C"]), factors=c["factors"],
             state_C=_from_array(c["state_C"]), band_sd=_from_array(c["band_sd"]),
             readings_start_C=_from_array(c["readings_start_C"]),
-            sensor_lag_s=c["sensor_lag_s"], loads_follow_rings=c["loads_follow_rings"],
+            sensor_lag_s=c["sensor_lag_s"], sensor_offset_C=_from_array(c.get("sensor_offset_C")),
+            loads_follow_rings=c["loads_follow_rings"],
             coolant_C=c.get("coolant_C"))
         return WindowRecord(w["window"], w["start_s"], w["speed_rpm"], w["ambient_C"],
                             correction, BoundaryValues(*w["nominal"]), w["deck"],

@@ -6,7 +6,8 @@ Layout under DIR/<run-name>/ (shared DESIGN.md):
     corrections.csv    window, method, H_front, H_rear, R_front, R_rear, C_H, C_C (on the
                        previous values carried to this window's nominal level), and
                        <name>_factor for further estimated values (motor, film groups),
-                       sensor_lag_s and coolant_C where a method estimates them
+                       sensor_lag_s, coolant_C and T1..T5_offset_K (each thermocouple's
+                       offset) where a method estimates them
     accuracy.json      per-method metrics (twin.loop.metrics)
     quality.json       data-quality findings of the recorded run
     decks/window_kkk.inp        the primary method's window decks (others: decks/<method>/),
@@ -248,6 +249,8 @@ def _write_start_state(path: Path, model: SpindleModel, w: WindowRecord) -> None
     c = w.correction
     extra = {} if c.readings_start_C is None else {
         "READINGS_START_C": c.readings_start_C, "SENSOR_LAG_S": c.sensor_lag_s}
+    if c.sensor_offset_C is not None:
+        extra["SENSOR_OFFSET_C"] = c.sensor_offset_C
     write_state_vtu(path, thermal.p.T, thermal.t.T, w.start_C[:thermal.p.shape[1]],
                     w.start_s, extra)
 
@@ -496,6 +499,10 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
     # the coolant inlet, where a method estimates it (the estimator, on a run without one)
     cooled = any(w.correction.coolant_C is not None for r in results.values() for w in r.windows)
     header += ["coolant_C"] if cooled else []
+    # each thermocouple's offset, where a method estimates it (the estimator)
+    offset = any(w.correction.sensor_offset_C is not None
+                 for r in results.values() for w in r.windows)
+    header += [f"T{i + 1}_offset_K" for i in range(5)] if offset else []
     rows = []
     for name, r in results.items():
         for w in r.windows:
@@ -515,6 +522,8 @@ def _write_corrections(path: Path, results: dict[str, MethodReplay]) -> None:
                     *(c.factors.get(k, float("nan")) for k in extra),
                     *([c.sensor_lag_s if c.sensor_lag_s > 0 else float("nan")] if lagged else []),
                     *([float("nan") if c.coolant_C is None else c.coolant_C] if cooled else []),
+                    *((np.full(5, np.nan) if c.sensor_offset_C is None else c.sensor_offset_C)
+                      if offset else []),
                 ]
             )
     write_csv(path, header, rows)
