@@ -601,16 +601,18 @@ def _step_speed(t: float) -> float:
     return 6000.0 if t < 76.0 else 12000.0 if t < 100.0 else 3000.0
 
 
-def write_speed_step_run(path, model, speed_at=_step_speed, windows=6):  # noqa: ANN001, ANN201
+def write_speed_step_run(path, model, speed_at=_step_speed, windows=6,  # noqa: ANN001, ANN201
+                         drift=False):
     """A 6-window run of the nominal model whose speed steps from 6000 to 12000 rpm at 76 s
     and down to 3000 rpm at 100 s, both inside window 1 (loads fixed at 60 s); each step
     at the speed recorded at its start, its loads at the rings' temperatures at its start
     (as the spindle's, and the twin's, follow them), ideal thermocouples.  Returns `path`.
-    `speed_at(t)` (rpm at t s) and `windows` give another profile and length."""
+    `speed_at(t)` (rpm at t s) and `windows` give another profile and length; `drift`
+    records the twin's own axial nose drift too (a probe the estimator reads)."""
     from twin.runs import write_run
 
     T = np.full(model.n_dofs, 24.0)
-    times, temps = [0.0], [model.sensor_matrix @ T]
+    times, temps, drifts = [0.0], [model.sensor_matrix @ T], [0.0]
 
     for i in range(windows * 15):
         t_end = 4.0 * (i + 1)
@@ -620,10 +622,12 @@ def write_speed_step_run(path, model, speed_at=_step_speed, windows=6):  # noqa:
         T = model.thermal.transient(bc.to_thermal_loads(), 4.0).step(T)
         times.append(t_end)
         temps.append(model.sensor_matrix @ T)
+        drifts.append(1e6 * float(model.probe_vectors[0] @ (T - 24.0)))
     t, temps = np.array(times), np.array(temps)
     write_run(path, {"time_s": t, "speed_rpm": [speed_at(x) for x in t],
                      "ambient_C": np.full(t.size, 24.0),
-                     **{f"T{i + 1}_C": temps[:, i] for i in range(5)}})
+                     **{f"T{i + 1}_C": temps[:, i] for i in range(5)},
+                     **({"disp_z_um": np.array(drifts)} if drift else {})})
     return path
 
 

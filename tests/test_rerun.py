@@ -234,7 +234,7 @@ def test_every_window_runs_with_apdl_like_from_the_replays_outputs(tmp_path, spi
     from twin.lag import first_order_lag
 
     model = spindle_model
-    run = write_speed_step_run(tmp_path / "step.csv", model)
+    run = write_speed_step_run(tmp_path / "step.csv", model, drift=True)  # offsets too
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["replay", str(run), "--out", str(out), "--methods",
                                       "bpnn,estimator", "--snapshots", "none", "--quiet"])

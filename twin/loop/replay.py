@@ -342,7 +342,11 @@ def replay_method(
 
     measured_T = run.T_valid_C
     measured_drift = None
-    if run.disp_um is not None and AXIAL_PROBE in run.valid and not probe_left_out(run, model):
+    if (run.disp_um is not None and AXIAL_PROBE in run.valid
+            and bool(np.any(run.valid[AXIAL_PROBE] & np.isfinite(run.disp_um[:, 2])))
+            and not probe_left_out(run, model)):
+        # (decided once, from the whole file, as the probe's other rules: a probe with no
+        # valid sample is none, for the estimator's choice of what it estimates too)
         # its change since the run start where the probe was not zeroed there
         measured_drift = np.where(run.valid[AXIAL_PROBE],
                                   run.disp_um[:, 2] - probe_start_offset_um(run), np.nan)

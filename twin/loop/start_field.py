@@ -32,8 +32,9 @@ deformation 90.7 / −17 → 93.7 / 78.6 %, ratio's deformation median −10 →
 that knew the whole history (the uncut run, scored from the cut) gives the estimator
 deformation 91.6 % median.  On 18 recordings cut from a suite not used to design it
 (README, "A recording that begins on a warm spindle"): 99.46 / 98.92 → 99.85 / 99.34 %
-and 84.5 / 15.2 → 92.0 / 18.7 % (the history known: 89.9 % deformation median).  Only the readings at the start are read (causal), and the fit
-is the same for every method: it is the twin's initial condition, not a correction.
+and 84.5 / 15.2 → 92.0 / 18.7 % (the history known: 89.9 % deformation median).
+Only the readings at the start are read (causal), and the fit is the same for every
+method: it is the twin's initial condition, not a correction.
 
 The nose drift is the change from the start field (the probe is taken as zeroed at the
 start, `probe_start_offset_um`), so a non-uniform start moves no drift by itself.  The
