@@ -33,7 +33,7 @@ from twin.correction.features import (
     rows_between,
     window_observed,
 )
-from twin.loop.start_field import WARM_START_SPREAD_K, StartField
+from twin.loop.start_field import SOURCES, WARM_START_SPREAD_K, StartField
 from twin.runs import TEMPERATURES, RecordedRun
 from twin.runs.quality import (
     AXIAL_PROBE,
@@ -328,8 +328,8 @@ def start_findings(run: RecordedRun, start: StartField) -> list[dict]:
     starts from a field fitted to the first readings, not from a uniform one."""
     if start.uniform:
         return []
-    scales = ", ".join(f"{name} {a:.2f}" for name, a in zip(
-        ("front bearing", "rear bearing", "motor"), start.scales, strict=True))
+    scales = ", ".join(f"{name} {a:.2f}" for name, a in zip(SOURCES, start.scales,
+                                                             strict=True))
     return [finding(TEMPERATURES[0], WARM_START,
                     "the replay starts from a field fitted to the first readings (every "
                     "method); the drift is taken from there",
@@ -342,7 +342,7 @@ def start_findings(run: RecordedRun, start: StartField) -> list[dict]:
 def replay_findings(run: RecordedRun, model: SpindleModel, methods: Sequence[str],
                     open_loop_C: np.ndarray | None, open_loop_start_C: np.ndarray,
                     measured_C: np.ndarray, measured_start_C: np.ndarray,
-                    start: StartField | None = None) -> list[dict]:
+                    start: StartField) -> list[dict]:
     """Every finding of this module for a replay of `run` with `methods` (the open-loop
     twin's key points as `warming_findings` reads them; `start` the replay's start
     field), in the order quality.json lists them after the quality check's.
@@ -352,10 +352,9 @@ def replay_findings(run: RecordedRun, model: SpindleModel, methods: Sequence[str
     recorded speeds (5 of 42 warm recordings cut from suite runs, speeds in rpm, were
     told theirs might be in rev/s, one at 3442 times the twin's rise); the uniform start
     before told none of them either."""
-    warm = start is not None and not start.uniform
-    return [*(start_findings(run, start) if start is not None else []),
+    return [*start_findings(run, start),
             *held_correction_findings(run, methods), *tail_findings(run),
             *probe_offset_findings(run), *probe_scale_findings(run),
             *probe_direction_findings(run, model),
-            *([] if warm else warming_findings(open_loop_C, open_loop_start_C, measured_C,
-                                               measured_start_C))]
+            *(warming_findings(open_loop_C, open_loop_start_C, measured_C, measured_start_C)
+              if start.uniform else [])]

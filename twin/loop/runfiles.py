@@ -341,12 +341,12 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
                     primary: str, solver: WindowSolver,
                     on_window: Callable[[str, int, int], None] | None,
                     write_primary_fields: Callable[[MethodReplay], None], snapshots: str,
-                    fork: bool, keep_fields: bool = True,
-                    start: StartField | None = None) -> dict[str, MethodReplay]:
+                    fork: bool, start: StartField,
+                    keep_fields: bool = True) -> dict[str, MethodReplay]:
     """Every method's replay, by name in the order given; the primary's field files are
     written by `write_primary_fields` as soon as it is replayed.  `keep_fields`: the
     primary keeps its window-end fields (for the field files or the snapshots).  `start`:
-    the run's start field (found here if None).
+    the run's start field, every method's.
 
     With `fork` a forked child on the second core replays the primary and writes its
     fields (their structural solves and stress recovery cost about as much as replaying one
@@ -362,8 +362,6 @@ def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corr
     child fail, the parent replays its methods itself: the error, if it is one, is then
     raised here with its own type.
     """
-    start = start or start_field(model, run)
-
     def replay(corrector: Corrector,
                told: Callable[[int, int], None] | None = None) -> MethodReplay:
         r = replay_method(run, model, corrector,

@@ -66,6 +66,9 @@ offsets of ±0.5 K (1 σ) spread more than 1 K in about half of all cold starts,
 a motor-heated rotor 8–20 K above it, its open-loop drift 0.35–0.82 µm off instead of
 0.26."""
 
+SOURCES = ("front bearing", "rear bearing", "motor")
+"""The heat sources whose responses a start is fitted with, in `StartField.scales`' order."""
+
 MIN_READINGS = 4
 """Valid first readings a fitted start needs (a level and three scales)."""
 READING_SD_K = 0.3
@@ -96,7 +99,7 @@ class StartField:
     uniform    at rest: the mean of the first readings everywhere
     history    the history fitted ("at rest", "warming 23 min at 9000 rpm", ...)
     level_C    b of the fit: the offset from the ambient (at rest: the uniform temperature)
-    scales     a_j of the front bearing, rear bearing and motor (none at rest)
+    scales     a_j of the `SOURCES` (none at rest)
     misfit_K   RMS of the field's T1..T5 against the valid readings
     """
 
@@ -113,26 +116,14 @@ class StartField:
         return float(self.field_C[0]) if self.uniform else float(np.mean(self.field_C))
 
 
-def first_readings_C(run: RecordedRun) -> np.ndarray:
-    """T1..T5 as measured at the run's first sample (NaN where invalid)."""
-    return run.before(np.array([run.time_s[0]])).T_valid_C[0]
-
-
-def uniform_start_C(run: RecordedRun) -> float:
-    """The uniform start temperature: the mean of the first valid T1..T5 (the ambient
-    where none is valid)."""
-    first = run.before(np.array([run.time_s[0]]))
-    T0 = first.T_valid_C[0]
-    if not np.any(np.isfinite(T0)):
-        return float(first.ambient_C[0])
-    return float(np.nanmean(T0))
-
-
 def start_field(model: SpindleModel, run: RecordedRun) -> StartField:
     """The field `run`'s replay starts from (see the module doc)."""
-    readings = first_readings_C(run)
+    first = run.before(np.array([run.time_s[0]]))  # what was measured at the start
+    readings = first.T_valid_C[0]  # T1..T5, NaN where invalid
     valid = np.isfinite(readings)
-    T_uniform = uniform_start_C(run)
+    ambient = float(first.ambient_C[0])
+    # at rest: the mean of the valid readings (the ambient where none is valid)
+    T_uniform = float(np.nanmean(readings)) if valid.any() else ambient
     spread = float(np.ptp(readings[valid])) if valid.sum() >= 2 else 0.0
     if valid.sum() < MIN_READINGS or spread <= WARM_START_SPREAD_K:
         field = np.full(model.n_dofs, T_uniform)
@@ -140,8 +131,6 @@ def start_field(model: SpindleModel, run: RecordedRun) -> StartField:
             else 0.0
         return StartField(field, True, "at rest", T_uniform, (), misfit)
 
-    first = run.before(np.array([run.time_s[0]]))
-    ambient = float(first.ambient_C[0])
     coolant = ambient if first.coolant_C is None else float(first.coolant_C[0])
     speed = float(first.speed_rpm[0])
     S = model.sensor_matrix[valid]
@@ -156,9 +145,8 @@ def start_field(model: SpindleModel, run: RecordedRun) -> StartField:
         if best is None or cost < best[0]:
             best = (cost, history, x, [*responses, sink])
     _, history, x, parts = best
-    misfit = float(np.sqrt(np.mean((x[0] + sum(
-        a * (S @ r) for a, r in zip(x[1:], parts[:-1], strict=True)) + S @ parts[-1] - y) ** 2)))
     field = x[0] + sum(a * r for a, r in zip(x[1:], parts[:-1], strict=True)) + parts[-1]
+    misfit = float(np.sqrt(np.mean((S @ field - y) ** 2)))
     return StartField(field, False, history, float(x[0]), tuple(float(a) for a in x[1:]),
                       misfit)
 
@@ -217,24 +205,21 @@ def _family(model: SpindleModel, speed_rpm: float, ambient_C: float, coolant_C: 
             contact_resistance=loads.contact_resistance)
         return model.thermal.transient(rise, dt=PRE_RUN_STEP_S)
 
-    full = bc.to_thermal_loads().sources
     front = {r: bc.H_front for r in bc.bearing_regions["front"]}
     rear = {r: bc.H_rear for r in bc.bearing_regions["rear"]}
-    motor = {r: q for r, q in full.items() if r in bc.motor_heat}
-    running_steppers = [stepper(bc, src, 0.0) for src in (front, rear, motor)]
+    # in the order of SOURCES
+    running_steppers = [stepper(bc, src, 0.0) for src in (front, rear, dict(bc.motor_heat))]
     inlet_K = coolant_C - ambient_C
     running_sink = stepper(bc, {}, inlet_K)
-    fields = [zero] * 3
+    fields = [zero] * len(SOURCES)
     sink_rise = zero
-    warming = []
     for minute in range(1, (WARMING_MINUTES if running else COOLING_AFTER_MINUTES) + 1):
         fields = [_advance(st, T, per_minute) for st, T in zip(running_steppers, fields,
                                                                strict=True)]
         sink_rise = _advance(running_sink, sink_rise, per_minute)
-        warming.append((minute, fields, sink_rise))
+        if running:
+            yield f"warming {minute} min at {speed_rpm:.0f} rpm", fields, ambient_C + sink_rise
     if running:
-        for minute, responses, rise in warming:
-            yield (f"warming {minute} min at {speed_rpm:.0f} rpm", responses, ambient_C + rise)
         return
     stopped = nominal_conditions(model, 0.0, ambient_C, coolant_C)
     resting = stepper(stopped, {}, 0.0)
