@@ -99,6 +99,14 @@ def test_design_example_scenario_parses(tmp_path):
     ("[motor_heat]\ntime_s = [0]\nfactor = [true]\n", 3, "motor_heat.factor[0]",
      "valid number"),
     ("[sensors]\nlag_s = \"8\"\n", 2, "sensors.lag_s", "valid number"),
+    # calibration offsets: temperature channels only, each once, within a thermocouple's
+    # plausible error
+    ("[sensors]\noffset_C = {T2 = 0.3, disp_z = 1.0}\n", 2, "sensors.offset_C",
+     "'disp_z' is no temperature channel"),
+    ("[sensors.offset_C]\nT2 = 0.2\nT9 = 0.1\n", 1, "sensors.offset_C", "'T9'"),
+    ("[sensors.offset_C]\nT2 = 0.2\nT2_C = 0.1\n", 1, "sensors.offset_C", "second time"),
+    ("[sensors.offset_C]\nT1 = 0.1\ncoolant = -7.5\n", 3, "sensors.offset_C.coolant",
+     "greater than or equal to -5"),
 ])
 def test_bad_scenarios(text, row, column, words):
     with pytest.raises(InputError) as info:

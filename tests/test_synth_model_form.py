@@ -182,3 +182,23 @@ def test_a_stop_has_no_heat_and_cools_down(truth_of):
     assert np.all(np.diff(T1[late]) < 0)
     assert T1[-1] < T1[truth.time_s == 360.0][0]
     assert run.max_relative_residual < 1e-8
+
+
+def test_calibration_offsets_shift_the_readings_not_the_metal(truth_of):
+    """An offset is added to its channel's every reading, noise and all, and to nothing
+    else: the truth file keeps the metal's temperature and records the offset."""
+    noisy = Sensors(noise_C=0.05, noise_um=0.1, lag_s=8.0, placement_mm=0.0)
+    plain = truth_of(pinned(sensors=noisy))
+    offsets = {"T2": 0.25, "T5": -0.4, "coolant": -0.2}
+    shifted = truth_of(pinned(sensors=noisy.model_copy(update={"offset_C": Sensors(
+        offset_C=offsets).offset_C})))
+    for column, values in plain.columns.items():
+        offset = offsets.get(column.removesuffix("_C"), 0.0) if column != "time_s" else 0.0
+        np.testing.assert_allclose(shifted.columns[column] - values, offset, atol=1e-12,
+                                   err_msg=column)
+    for column, values in plain.truth.items():
+        np.testing.assert_array_equal(shifted.truth[column], values)
+    recorded = shifted.extra["truth_metadata"]
+    assert (recorded["T2_calibration_offset_C"], recorded["T5_calibration_offset_C"],
+            recorded["coolant_calibration_offset_C"]) == ("0.25", "-0.4", "-0.2")
+    assert not any("calibration" in key for key in plain.extra["truth_metadata"])

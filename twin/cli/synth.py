@@ -38,7 +38,8 @@ Model-form error (the truth only; the twin keeps its nominal model):
   [motor_heat]                     factor on the motor loss
   [film.coolant|housing|air_gap|rotor]  factor on that group's films
   [material] conductivity, expansion  constant multipliers
-  [sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple offset)
+  [sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple's point
+            off by up to this), offset_C = {T2 = 0.3} (calibration, K)
   [faults] stuck, dropouts, spikes;  [model] size_factor
 
 Unknown keys are errors naming the file and line.  Without a scenario the

@@ -17,7 +17,7 @@ temperatures (oil viscosity, Eq. 5 fit) every 2 s step, as a real spindle's do
 continuously: held over 20 s from the cold start (oil at ambient, too much heat), they
 dropped T1 by up to 0.23 K per second after 20 s at 15 000 rpm.  The drifting ambient and
 coolant and the motor and film factors are held over `UPDATE_S`.  The sensors then add
-thermocouple lag, noise and faults.
+thermocouple lag, calibration offsets, noise and faults.
 
 Displacement probes are zeroed at the start of the run (as on a test stand), so
 `disp_z_um` is the thermal drift of the nose from the cold start.
@@ -37,7 +37,7 @@ from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
 from twin.lag import first_order_lag
 from twin.plant.profile import SpeedProfile
 from twin.plant.scenario import Scenario
-from twin.plant.sensors import add_noise, apply_faults
+from twin.plant.sensors import add_noise, apply_faults, calibrated_reading
 from twin.plant.timetable import StepTable
 from twin.plant.truth import (
     FILM_GROUPS,
@@ -284,15 +284,16 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         x_true, y_true = tables.x_um(t_out), tables.y_um(t_out)
     # the air and inlet readings stay in the range every reader accepts: at --ambient 45
     # (a bound) their noise crossed it, and the run emulated was refused by replay
+    read = calibrated_reading(sensors.offset_C)
     columns = {
         "time_s": t_out,
         "speed_rpm": speed(t_out).astype(float),
-        "ambient_C": np.clip(add_noise(rng, tables.ambient_C(t_out), sensors.noise_C),
-                             *OPERATING_TEMPERATURE_C),
-        **{f"{s}_C": add_noise(rng, T_meas[:, j], sensors.noise_C)
+        "ambient_C": np.clip(add_noise(rng, read("ambient_C", tables.ambient_C(t_out)),
+                                       sensors.noise_C), *OPERATING_TEMPERATURE_C),
+        **{f"{s}_C": add_noise(rng, read(f"{s}_C", T_meas[:, j]), sensors.noise_C)
            for j, s in enumerate(SENSOR_NAMES)},
-        "coolant_C": np.clip(add_noise(rng, tables.coolant_C(t_out), sensors.noise_C),
-                             *OPERATING_TEMPERATURE_C),
+        "coolant_C": np.clip(add_noise(rng, read("coolant_C", tables.coolant_C(t_out)),
+                                       sensors.noise_C), *OPERATING_TEMPERATURE_C),
         "disp_x_um": add_noise(rng, x_true, sensors.noise_um),
         "disp_y_um": add_noise(rng, y_true, sensors.noise_um),
         "disp_z_um": add_noise(rng, disp_z, sensors.noise_um),
@@ -335,6 +336,8 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         "expansion_factor": f"{tables.form.expansion:.6g}",
         **{f"{n}_offset_mm": f"{dr + 0.0:.4f} {dz + 0.0:.4f}"  # + 0.0: no "-0.0000"
            for n, (dr, dz) in sorted(tables.form.sensor_offsets_mm.items())},
+        **{f"{column.removesuffix('_C')}_calibration_offset_C": f"{value:g}"
+           for column, value in sensors.offset_C.items()},
     }
     if record_from_s > 0.0:
         columns, truth_cols = _recorded_from(record_from_s, columns, truth_cols)

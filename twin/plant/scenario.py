@@ -33,6 +33,9 @@ Sensors and faults:
     [sensors]      noise_C, lag_s, noise_um,
                    placement_mm   each thermocouple sits up to this far from its nominal
                                   point (a seeded offset that stays inside the solid)
+                   offset_C = {T2 = 0.3, coolant = -0.1}
+                                  calibration offsets, K: added to a temperature channel's
+                                  every reading (the truth keeps the metal's temperature)
     [faults]       stuck = ["T2"], dropouts = [{sensor, start_s, end_s}],
                    spikes = [{sensor, time_s, size}]   (size in °C or µm)
     [model]        size_factor     (mesh refinement of the truth model; < 1 is finer)
@@ -67,6 +70,7 @@ SENSOR_COLUMNS = {
     "disp_x": "disp_x_um", "disp_y": "disp_y_um", "disp_z": "disp_z_um",
 }
 _BY_COLUMN = {c: c for c in SENSOR_COLUMNS.values()}
+TEMPERATURE_CHANNELS = tuple(n for n, c in SENSOR_COLUMNS.items() if c.endswith("_C"))
 
 
 def sensor_column(name: str) -> str:
@@ -162,11 +166,33 @@ class MaterialFactors(_Strict):
     expansion: Multiplier | None = None
 
 
+MAX_SENSOR_OFFSET_C = 5.0
+"""Largest calibration offset, K: a class-2 thermocouple's tolerance is ±2.5 K."""
+
+
 class Sensors(_Strict):
     noise_C: Annotated[float, Field(ge=0.0, le=5.0)] = 0.05
     lag_s: Annotated[float, Field(ge=0.0, le=600.0)] = 8.0
     noise_um: Annotated[float, Field(ge=0.0, le=10.0)] = 0.1
     placement_mm: Annotated[float, Field(ge=0.0, le=10.0)] = 1.0
+    offset_C: dict[str, Annotated[float, Field(ge=-MAX_SENSOR_OFFSET_C,
+                                               le=MAX_SENSOR_OFFSET_C)]] = {}
+    """Calibration offset per temperature channel (T1..T5, ambient, coolant), K; keyed by
+    the run column (`T2_C`) once parsed."""
+
+    @field_validator("offset_C")
+    @classmethod
+    def _temperature_channels(cls, offsets: dict[str, float]) -> dict[str, float]:
+        columns: dict[str, float] = {}
+        for name, value in offsets.items():
+            column = SENSOR_COLUMNS.get(name) or _BY_COLUMN.get(name)
+            if column is None or not column.endswith("_C"):
+                raise ValueError(f"{name!r} is no temperature channel; calibration offsets "
+                                 f"are for {', '.join(TEMPERATURE_CHANNELS)}")
+            if column in columns:
+                raise ValueError(f"{name!r} names {column} a second time")
+            columns[column] = value
+        return dict(sorted(columns.items()))
 
 
 class _SensorRef(_Strict):

@@ -30,7 +30,9 @@ start, middle and end of the run, each within ±8 % of the run's draw and inside
       air_gap|rotor            U(0.6, 1.5) each, constant
     material                   conductivity U(0.9, 1.1), expansion U(0.95, 1.05)
     sensors                    lag_s U(4, 20), noise_C U(0.02, 0.1), noise_um U(0.05, 0.3),
-                               placement_mm U(0, 2)
+                               placement_mm U(0, 2); T1..T5 calibration offsets
+                               U(−0.3, 0.3) K each (drawn last: the other draws are those
+                               of the suites before offsets existed)
     faults                     stuck T sensor with p = 0.2; 1–2 dropouts (30–300 s) with
                                p = 0.3; 1–3 spikes (±3–8 °C) with p = 0.3
     =========================  ===========================================================
@@ -39,6 +41,12 @@ Sensor noise against a real machine (`tools/sensor_noise.py`): the real data in
 `examples/real` (15 s sampling) have 0.005–0.016 °C thermocouple noise and 0.02–0.04 µm
 on the probes of a running spindle; even as 15 s averages (√15 more per 1 s sample) that
 is at most 0.06 °C and 0.15 µm, below the upper ends drawn here.
+
+Calibration offsets: a Pt100 of tolerance class A reads within ±0.21 K at 30 °C, class B
+within ±0.45 K; thermocouples of one stand calibrated together agree to a few tenths.
+Drawn uniform over ±0.3 K, an offset is never known to the twin (the truth file records
+it).  The ambient and coolant readings get none here: their offsets move every method's
+boundary alike (a scenario's `[sensors] offset_C` can give them one).
 """
 
 from __future__ import annotations
@@ -81,6 +89,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "noise_C": (0.02, 0.1),
     "noise_um": (0.05, 0.3),
     "placement_mm": (0.0, 2.0),
+    "calibration_offset_C": (-0.3, 0.3),
 }
 """The ranges of the module doc's table (the single source of the numbers)."""
 TABLE_WOBBLE = 0.08
@@ -208,6 +217,8 @@ def draw_case(suite_seed: int, index: int, minutes: float = DEFAULT_MINUTES,
                     for k in ("lag_s", "noise_C", "noise_um", "placement_mm")},
         "faults": _faults(rng, duration),
     }
+    data["sensors"]["offset_C"] = {s: _r(u(*RANGES["calibration_offset_C"]), 3)
+                                   for s in TEMPERATURE_SENSORS}
     scenario = Scenario.model_validate(data)
     seed = int(sequence.generate_state(1)[0])
     return SuiteCase(name=case_name(suite_seed, index), suite_seed=int(suite_seed),
