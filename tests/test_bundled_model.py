@@ -15,7 +15,7 @@ from twin.correction.modelfile import load_model
 
 ROOT = Path(__file__).resolve().parent.parent
 BUNDLED_MODEL = ROOT / "examples" / "correction_model.safetensors"
-BUNDLED_MODEL_SHA256 = "c9e141ce54c972a95b9fcdf018674d1b9b1d9433cc0931b0caeb917d27368c8c"
+BUNDLED_MODEL_SHA256 = "4fba336e0640eabe6c4c2890b35c75abb734bff19d6a9aac1f35d6496fc7c8e3"
 
 
 def _make_model():
