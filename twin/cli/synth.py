@@ -39,7 +39,7 @@ Model-form error (the truth only; the twin keeps its nominal model):
   [film.coolant|housing|air_gap|rotor]  factor on that group's films
   [material] conductivity, expansion  constant multipliers
   [sensors] noise_C, lag_s, noise_um, placement_mm (thermocouple's point
-            off by up to this), offset_C = {T2 = 0.3} (calibration, K)
+            off by up to this); [sensors.offset_C] T2 = 0.3 (calibration, K)
   [faults] stuck, dropouts, spikes;  [model] size_factor
 
 Unknown keys are errors naming the file and line.  Without a scenario the

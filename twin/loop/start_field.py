@@ -58,13 +58,14 @@ from twin.spindle.model import SpindleModel
 WARM_START_SPREAD_K = 2.0
 """First valid readings spreading more than this (K, largest − smallest) start the replay
 from a fitted field; within it the spindle is taken as at rest (uniform).  Emulated cold
-starts spread 0.49 K at most over 92 suite and sweep runs (noise, slow thermocouples), the
-warm starts measured 4 K and more (recorded from 10 min into a run or from a pause).  Not
-1 K: real thermocouples carry calibration offsets the emulator has none of, and five
-offsets of ±0.5 K (1 σ) spread more than 1 K in about half of all cold starts, more than
-2 K in about one in twenty; one thermocouple 1.5 K off on a spindle at rest was fitted as
-a motor-heated rotor 8–20 K above it, its open-loop drift 0.35–0.82 µm off instead of
-0.26."""
+starts spread 0.49 K at most over 92 suite and sweep runs without calibration offsets
+(noise, slow thermocouples), and 0.66 K at most (median 0.44) over 96 suite runs with the
+suites' offsets of ±0.3 K; the warm starts measured 4 K and more (recorded from 10 min
+into a run or from a pause).  Not 1 K: a stand's thermocouples may be further off than the
+suites', and five offsets of ±0.5 K (1 σ) spread more than 1 K in about half of all
+cold starts, more than 2 K in about one in twenty; one thermocouple 1.5 K off on a spindle
+at rest was fitted as a motor-heated rotor 8–20 K above it, its open-loop drift
+0.35–0.82 µm off instead of 0.26."""
 
 SOURCES = ("front bearing", "rear bearing", "motor")
 """The heat sources whose responses a start is fitted with, in `StartField.scales`' order."""
