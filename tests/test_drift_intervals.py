@@ -74,6 +74,36 @@ def test_a_speed_between_a_stop_and_the_slowest_run_is_outside_the_range():
     assert OperatingRange.from_json(doc) == rng
 
 
+def test_a_stop_hotter_than_every_fitted_stop_is_outside_the_range():
+    """A stop holds no input but its heat, and the speed lags fall back inside their range
+    long before it is gone: a stopped row hotter than every stopped training row counts,
+    in spans of their range; a colder one does not (the room was colder), nor a running
+    row's temperatures (the speed's answer, held against the speed)."""
+    spec = FeatureSpec(("A_C",), (20.0,), taus_min=(10.0,), groups=("rise", "speed"))
+
+    def row(rise: float, krpm: float, lag: float) -> list[float]:
+        return [rise, krpm, krpm**2, lag, lag**2]
+
+    train = np.array([row(0, 0, 0), row(5, 2.5, 0), row(9, 0, 2.5), row(20, 5, 5),
+                      row(18, 0, 5)])
+    rng = OperatingRange.of(spec, train)
+    assert rng.state_features == ("A_C:rise",)
+    assert (rng.stopped_state_lo, rng.stopped_state_hi) == ((0.0,), (18.0,))
+    query = np.array([row(27, 0, 1.0), row(-9, 0, 1.0), row(40, 5, 5), row(27, 0, 6.0),
+                      row(18, 0, 6.0)])
+    excess, worst = rng.excess(spec, query)
+    # 9 K above the hottest stop: 9/18 of the stops' span; 6 of a lag in 0–5: n² (36 − 25)/25
+    np.testing.assert_allclose(excess, [0.5, 0.0, 0.0, 0.5, 11.0 / 25.0])
+    assert [rng.named[k] for k in worst[[0, 3, 4]]] == ["A_C:rise", "A_C:rise",
+                                                        "speed_krpm2:lag10min"]
+    doc = json.loads(json.dumps(rng.to_json()))
+    assert OperatingRange.from_json(doc) == rng
+    # a file written before the state was kept: its stops held against the speed alone
+    older = OperatingRange.from_json({k: v for k, v in doc.items() if "state" not in k})
+    np.testing.assert_allclose(older.excess(spec, query)[0], [0.0, 0.0, 0.0, 11.0 / 25.0,
+                                                              11.0 / 25.0])
+
+
 @pytest.fixture(scope="module")
 def fitted(tmp_path_factory):
     folder = tmp_path_factory.mktemp("drift_band")
@@ -140,3 +170,36 @@ def test_a_model_file_without_the_range_keeps_its_band(fitted):
     mean, lo, hi, excess, furthest = load_drift_model(older_path).predict_data(faster)
     assert not excess.any()
     np.testing.assert_allclose(hi - mean, model.interval["half_width_um"][0])
+
+
+def test_a_model_file_without_the_stopped_state_keeps_its_band(fitted):
+    """A spindle heating half as much again at the same speeds: its stops are hotter than
+    every fitted stop, and a model holds them outside its range, with a wider band (its
+    running rows, at speeds it was fitted on, keep theirs).  A file written before stopped
+    rows were held against their thermal state loads, and holds them inside, as it did."""
+    folder, data, path = fitted
+    model = load_drift_model(path)
+    assert set(model.operating_range.state_features) == {
+        f"{s}:{kind}" for s in ("A_C", "B_C", "C_C")
+        for kind in ["rise"] + [f"lag{tau:g}min" for tau in model.spec.taus_min]}
+    columns = synthetic_columns(hours=3.0)
+    for sensor in ("A_C", "B_C"):
+        columns[sensor] = 20.0 + 1.5 * (columns[sensor] - 20.0)
+    write_csv(folder / "hotter.csv", columns)
+    hotter = read_drift_data([folder / "hotter.csv"], targets=["drift_um"])
+    mean, lo, hi, excess, furthest = model.predict_data(hotter)
+    stopped = hotter.speed_rpm == 0
+    assert not excess[~stopped].any()
+    assert np.mean(excess[stopped] > 0) > 0.5
+    named = model.operating_range.named
+    assert {named[k] for k in furthest[excess > 0]} <= set(model.operating_range.state_features)
+    w = model.interval["half_width_um"][0]
+    np.testing.assert_allclose((hi - mean)[:, 0], w * (1.0 + GAIN * excess))
+    doc = {k: v for k, v in model.interval["operating_range"].items() if "state" not in k}
+    older = type(model)(model.method, model.targets, model.spec, model.params,
+                        {**model.interval, "operating_range": doc},
+                        model.metadata, model.validation)
+    older_path = save_drift_model(older, folder / "older_state.safetensors")
+    mean, lo, hi, excess, _ = load_drift_model(older_path).predict_data(hotter)
+    assert not excess.any()
+    np.testing.assert_allclose(hi - mean, w)

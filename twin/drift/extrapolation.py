@@ -16,6 +16,21 @@ and a stopped one (its lags still falling from the speed before) with the stoppe
 has seen the spindle run that slowly.  The excess of a row is the largest, over those
 features, of how far it lies beyond its regime's training range in units of that range's
 span (0 inside): the band grows as a linear error would (see `twin.drift.intervals`).
+
+A stopped row is also held against the *thermal state* the stopped training rows held:
+its temperature features (rises and their lags, the model's other inputs), on the hot
+side only.  A stop has no input but what the spindle still holds, and the speed lags fall
+back inside their range within an hour or two while the heat stays: the stops after the
+5000-rpm test cooled from hotter than any stop of the other three (the 90-min lag of one
+sensor up to 0.65 spans above), unflagged, and a network's band covered 20 % of two
+probes there (now 56 %; at two other network seeds 67–72 % → 100 %).  Hotter only, and
+stopped rows only: the rises are against the file's first rows, so a left-out test's
+temperatures lie a little outside the others' wherever the room was colder (and, running,
+wherever the speed already says so) without its error growing.  Over six methods, three
+seeds and the four tests, colder stops too widened the bands of the 2500 and 3750 rpm
+tests, whose speeds lie inside, by 8–11 % on average, and running rows' temperatures too
+1.2 and 1.8 times, for no better worst block; hotter stops alone widen them by 0 and
+0.5 %.
 """
 
 from __future__ import annotations
@@ -39,6 +54,13 @@ def operating_features(spec: FeatureSpec) -> list[str]:
     return speed or names
 
 
+def state_features(spec: FeatureSpec) -> list[str]:
+    """The temperature features a stopped row's thermal state is held against (see the
+    module note): none for a model without the speed, whose operating features they are."""
+    operating = operating_features(spec)
+    return [n for n in spec.names if n not in operating]
+
+
 def _running(spec: FeatureSpec, X: np.ndarray) -> np.ndarray | None:
     """Rows of X where the spindle runs; None for a model without the speed."""
     if SPEED_NOW not in spec.names:
@@ -58,13 +80,18 @@ class OperatingRange:
     `FeatureSpec.names`): `lo`, `hi` per feature over the running rows (every row for a
     model without the speed), `stopped_lo`, `stopped_hi` over the stopped ones (None
     without any: a stopped row is then held against the running rows' range, as a running
-    row is without any running training row)."""
+    row is without any running training row); `stopped_state_lo`, `stopped_state_hi` the
+    stopped rows' range of the `state_features` (None in a file written before them, or
+    without stopped training rows: no stopped row is then held against its state)."""
 
     features: tuple[str, ...]
     lo: tuple[float, ...]
     hi: tuple[float, ...]
     stopped_lo: tuple[float, ...] | None = None
     stopped_hi: tuple[float, ...] | None = None
+    state_features: tuple[str, ...] = ()
+    stopped_state_lo: tuple[float, ...] | None = None
+    stopped_state_hi: tuple[float, ...] | None = None
 
     @classmethod
     def of(cls, spec: FeatureSpec, X: np.ndarray) -> OperatingRange:
@@ -76,12 +103,26 @@ class OperatingRange:
             return cls(tuple(features), *_ends(x))
         run, stop = _ends(x[running]), _ends(x[~running])
         lo, hi = run or stop
-        return cls(tuple(features), lo, hi, *(stop if run and stop else (None, None)))
+        if not (run and stop):
+            return cls(tuple(features), lo, hi)
+        state = state_features(spec)
+        state_ends = _ends(X[~running][:, [spec.names.index(f) for f in state]])
+        return cls(tuple(features), lo, hi, *stop, tuple(state),
+                   *(state_ends if state else (None, None)))
+
+    @property
+    def named(self) -> tuple[str, ...]:
+        """The features `excess` indexes: the operating ones, then the state ones."""
+        return self.features + self.state_features
 
     def to_json(self) -> dict:
         doc = {"features": list(self.features), "lo": list(self.lo), "hi": list(self.hi)}
         if self.stopped_lo is not None and self.stopped_hi is not None:
             doc.update(stopped_lo=list(self.stopped_lo), stopped_hi=list(self.stopped_hi))
+        if self.stopped_state_lo is not None and self.stopped_state_hi is not None:
+            doc.update(state_features=list(self.state_features),
+                       stopped_state_lo=list(self.stopped_state_lo),
+                       stopped_state_hi=list(self.stopped_state_hi))
         return doc
 
     @classmethod
@@ -90,12 +131,14 @@ class OperatingRange:
             return None if doc.get(key) is None else tuple(float(v) for v in doc[key])
 
         return cls(tuple(doc["features"]), floats("lo"), floats("hi"),
-                   floats("stopped_lo"), floats("stopped_hi"))
+                   floats("stopped_lo"), floats("stopped_hi"),
+                   tuple(doc.get("state_features") or ()), floats("stopped_state_lo"),
+                   floats("stopped_state_hi"))
 
     def excess(self, spec: FeatureSpec, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(excess (n,), index into `features` of the feature furthest out (n,)) of the
-        rows of X (n, len(spec.names)).  A feature that held one value in training counts
-        its distance in its own units (a speed in krpm)."""
+        """(excess (n,), index into `named` of the feature furthest out (n,)) of the rows
+        of X (n, len(spec.names)).  A feature that held one value in training counts its
+        distance in its own units (a speed in krpm, a rise in K)."""
         x = X[:, [spec.names.index(f) for f in self.features]]
         excess, worst = range_excess(x, np.asarray(self.lo), np.asarray(self.hi))
         running = _running(spec, X)
@@ -103,18 +146,27 @@ class OperatingRange:
             stopped = ~running
             excess[stopped], worst[stopped] = range_excess(
                 x[stopped], np.asarray(self.stopped_lo), np.asarray(self.stopped_hi))
+            if self.stopped_state_lo is not None and self.stopped_state_hi is not None:
+                state = X[stopped][:, [spec.names.index(f) for f in self.state_features]]
+                hotter, which = range_excess(state, np.asarray(self.stopped_state_lo),
+                                             np.asarray(self.stopped_state_hi), above_only=True)
+                further = hotter > excess[stopped]
+                excess[stopped] = np.where(further, hotter, excess[stopped])
+                worst[stopped] = np.where(further, len(self.features) + which, worst[stopped])
         return excess, worst
 
 
-def range_excess(x: np.ndarray, lo: np.ndarray, hi: np.ndarray
+def range_excess(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, above_only: bool = False
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Per row of x (n, k), the largest of (x − hi)/span and (lo − x)/span over the
-    columns (0 inside [lo, hi]; span = hi − lo, 1 where it is 0), and its column."""
+    columns (0 inside [lo, hi]; span = hi − lo, 1 where it is 0), and its column; with
+    `above_only`, of (x − hi)/span alone."""
     x = np.atleast_2d(np.asarray(x, dtype=float))
     if x.shape[1] == 0:
         return np.zeros(x.shape[0]), np.zeros(x.shape[0], dtype=np.int64)
     span = np.where(hi > lo, hi - lo, 1.0)
-    out = np.maximum(np.maximum(x - hi, lo - x) / span, 0.0)
+    beyond = x - hi if above_only else np.maximum(x - hi, lo - x)
+    out = np.maximum(beyond / span, 0.0)
     worst = np.argmax(out, axis=1)
     return out[np.arange(x.shape[0]), worst], worst
 

@@ -14,7 +14,8 @@ reflects errors on blocks the model had not seen, not its training fit:
   band covered every sample of two tests and 8 % of a probe in a third).  With K blocks,
   a new block like them is covered to 90 % with probability K/(K+1) at least, no more.
 - e(x) is how far the row's operating point lies outside the range the model was fitted
-  on, in spans of that range (`twin.drift.extrapolation`; 0 inside).  An error linear in
+  on (a stopped row's thermal state too: hotter than every fitted stop), in spans of that
+  range (`twin.drift.extrapolation`; 0 inside).  An error linear in
   the inputs and within ±w over the range is within ±w·(1 + 2e) at e spans beyond it:
   GAIN = 2 is that bound, not a figure fitted to the data.  w is not divided by the
   left-out blocks' own widening first: it would shrink by the blocks that extrapolated,

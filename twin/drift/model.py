@@ -59,7 +59,7 @@ class DriftModel:
                                np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(mean, lo, hi, excess, furthest): besides the prediction, how far each row lies
         outside the training rows' operating range (0 inside) and the index into
-        `operating_range.features` of the feature furthest out."""
+        `operating_range.named` of the feature furthest out."""
         with one_blas_thread():
             X = dynamic_features(self.spec, time_s, T_C, speed_rpm, segment_starts)
             mean, std = METHODS[self.method].predict(self.params, X)
@@ -96,7 +96,7 @@ class DriftModel:
         k = int(np.argmax(excess))
         gain = float(self.interval.get("extrapolation_gain", 0.0))
         return {"rows": int(out.sum()), "rows_pct": 100.0 * float(np.mean(out)),
-                "max_excess_spans": float(excess[k]), "feature": rng.features[furthest[k]],
+                "max_excess_spans": float(excess[k]), "feature": rng.named[furthest[k]],
                 "max_band_factor": 1.0 + gain * float(excess[k])}
 
 

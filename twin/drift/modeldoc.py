@@ -84,11 +84,19 @@ class OperatingRange(_Fixed):
     hi: list[FiniteFloat]
     stopped_lo: list[FiniteFloat] | None = None
     stopped_hi: list[FiniteFloat] | None = None
+    state_features: list[str] | None = None
+    stopped_state_lo: list[FiniteFloat] | None = None
+    stopped_state_hi: list[FiniteFloat] | None = None
 
     @field_validator("features")
     @classmethod
     def _features(cls, names: list[str]) -> list[str]:
         return _each_once(names)
+
+    @field_validator("state_features")
+    @classmethod
+    def _state_features(cls, names: list[str] | None) -> list[str] | None:
+        return None if names is None else _each_once(names)
 
     @model_validator(mode="after")
     def _one_range_per_feature(self) -> OperatingRange:
@@ -106,13 +114,36 @@ class OperatingRange(_Fixed):
                                  f"{len(self.features)} features")
             if any(h < lo for lo, h in zip(self.stopped_lo, self.stopped_hi, strict=True)):
                 raise ValueError("an upper end (stopped_hi) below its lower end (stopped_lo)")
+        state = (self.state_features, self.stopped_state_lo, self.stopped_state_hi)
+        if any(v is None for v in state) and not all(v is None for v in state):
+            raise ValueError("the stopped rows' thermal state needs its features and both "
+                             "ends (state_features, stopped_state_lo, stopped_state_hi)")
+        if self.state_features is not None and self.stopped_lo is None:
+            raise ValueError("a thermal state of the stopped rows (state_features) without "
+                             "their range (stopped_lo, stopped_hi)")
+        if (self.state_features is not None and self.stopped_state_lo is not None
+                and self.stopped_state_hi is not None):
+            if not (len(self.stopped_state_lo) == len(self.stopped_state_hi)
+                    == len(self.state_features)):
+                raise ValueError(f"{len(self.stopped_state_lo)} lower (stopped_state_lo) and "
+                                 f"{len(self.stopped_state_hi)} upper (stopped_state_hi) ends "
+                                 f"for {len(self.state_features)} state_features")
+            if any(h < lo for lo, h in zip(self.stopped_state_lo, self.stopped_state_hi,
+                                           strict=True)):
+                raise ValueError("an upper end (stopped_state_hi) below its lower end "
+                                 "(stopped_state_lo)")
+            twice = set(self.features) & set(self.state_features)
+            if twice:
+                raise ValueError(f"{sorted(twice)[0]!r} is both an operating and a state "
+                                 "feature")
         return self
 
 
 class Interval(_Fixed):
     """`interval_rule`: conformal half-widths (µm) or the posterior σ's factor, per target,
     and (files written since the band widens beyond the training range) the gain and the
-    training rows' operating range.
+    training rows' operating range (since stopped rows are held against their thermal
+    state too, with the stopped rows' range of the temperature features).
     One model, not a union tagged by `kind`: pydantic would put the tag in the field's path
     (`interval.conformal.half_width_um`), which names no key of the file."""
 

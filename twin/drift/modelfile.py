@@ -108,10 +108,12 @@ def _check_weights_fit(doc: ModelDocument, spec: FeatureSpec, params: dict[str, 
                 f"feature columns; the weights take {array.shape[0] if array.ndim else 0}",
                 file=file, field="features")
     rng = doc.interval.operating_range
-    unknown = [] if rng is None else [f for f in rng.features if f not in spec.names]
-    if unknown:
-        raise MetadataError(f"{unknown[0]!r} is none of the model's features",
-                            file=file, field="interval.operating_range.features")
+    for key in ("features", "state_features"):
+        named = [] if rng is None else getattr(rng, key) or []
+        unknown = [f for f in named if f not in spec.names]
+        if unknown:
+            raise MetadataError(f"{unknown[0]!r} is none of the model's features",
+                                file=file, field=f"interval.operating_range.{key}")
     try:
         mean, std = method.predict(params, np.zeros((2, columns)))
     except (KeyError, ValueError, IndexError):
