@@ -15,8 +15,10 @@ Per run (by default only the runs that miss an issue-13 target; `--all`: every r
   start, DESIGN.md causality), `after` the window right after one of those, `first`
   windows 1–2 (window 0 is not scored), `rest`;
 - the noise ceiling: the accuracy of the noise-free truth (`*.truth.csv`: metal
-  temperatures put through the run's thermocouple lag, and the nose drift) against the
-  measurement — what a perfect twin scores, set by sensor noise alone;
+  temperatures put through the run's thermocouple lag and read with its thermocouples'
+  calibration offsets, and the nose drift) against the measurement — what a perfect twin
+  scores, set by sensor noise alone (every ceiling here reads the metal with the
+  offsets the truth file records: a twin that knew everything would know them too);
 - the metal ceiling: the same with the truth's metal temperatures, no lag: what a perfect
   twin scores in temperature if it reports the metal at T1..T5 (as the twin does) while
   the thermocouples lag by 4–20 s;
@@ -160,11 +162,13 @@ def analyse_run(run_csv: Path, replay_dir: Path, method: str) -> dict:
     acc = json.loads((replay_dir / name / "accuracy.json").read_text())["methods"]
     _, kp = read_table(replay_dir / name / "keypoints.csv")
     meta, _ = read_table(run_csv)
-    _, truth = read_table(Path(f"{run_csv.with_suffix('')}.truth.csv"))
+    truth_meta, truth = read_table(Path(f"{run_csv.with_suffix('')}.truth.csv"))
     lag_s = float(meta.get("thermocouple_lag_s", 0.0))
+    offsets_C = np.array([float(truth_meta.get(f"{s}_calibration_offset_C", 0.0))
+                          for s in SENSOR_NAMES])
     tt = truth["time_s"]
     truth_T = first_order_lag(np.column_stack([truth[f"{s}_true_C"] for s in SENSOR_NAMES]),
-                              tt, lag_s)
+                              tt, lag_s) + offsets_C
     rows = {m: kp["method"] == m for m in ("open_loop", method)}
     t = kp["time_s"][rows[method]]
     meas = np.column_stack([kp[f"{s}_meas_C"][rows[method]] for s in SENSOR_NAMES])
@@ -184,9 +188,10 @@ def analyse_run(run_csv: Path, replay_dir: Path, method: str) -> dict:
                         ).squeeze()
 
     noise_T, noise_d = at(truth_T), at(truth["disp_z_true_um"])
-    metal_T = at(np.column_stack([truth[f"{s}_true_C"] for s in SENSOR_NAMES]))
+    metal_T = at(np.column_stack([truth[f"{s}_true_C"] for s in SENSOR_NAMES]) + offsets_C)
     oracle_T, oracle_d = noise_T.copy(), noise_d.copy()
     for k, (ot, oT, od) in oracle_windows(run_csv, steps, lag_s).items():
+        oT = oT + offsets_C
         sel = win == k
         before = ot < k * WINDOW_S + 1e-9  # 1 Hz from 0 s in both files
         if not np.allclose(oT[before], truth_T[:before.sum()], atol=2e-4):
