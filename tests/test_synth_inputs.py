@@ -101,10 +101,14 @@ def test_design_example_scenario_parses(tmp_path):
     ("[sensors]\nlag_s = \"8\"\n", 2, "sensors.lag_s", "valid number"),
     # calibration offsets: temperature channels only, each once, within a thermocouple's
     # plausible error
-    ("[sensors]\noffset_C = {T2 = 0.3, disp_z = 1.0}\n", 2, "sensors.offset_C",
+    ("[sensors]\noffset_C = {T2 = 0.3, disp_z = 1.0}\n", 2, "sensors.offset_C.disp_z",
      "'disp_z' is no temperature channel"),
-    ("[sensors.offset_C]\nT2 = 0.2\nT9 = 0.1\n", 1, "sensors.offset_C", "'T9'"),
-    ("[sensors.offset_C]\nT2 = 0.2\nT2_C = 0.1\n", 1, "sensors.offset_C", "second time"),
+    # a bad channel is told on its own line, not on the table's header
+    ("[sensors.offset_C]\nT2 = 0.2\nT9 = 0.1\n", 3, "sensors.offset_C.T9", "'T9'"),
+    ("[sensors.offset_C]\nT1 = 0.1\ndisp_z = 0.2\nT3 = 0.1\n", 3,
+     "sensors.offset_C.disp_z", "'disp_z' is no temperature channel"),
+    ("[sensors.offset_C]\nT2 = 0.2\nT3 = 0.1\nT2_C = 0.1\n", 4, "sensors.offset_C.T2_C",
+     "'T2_C' names T2_C a second time (as 'T2' does)"),
     ("[sensors.offset_C]\nT1 = 0.1\ncoolant = -7.5\n", 3, "sensors.offset_C.coolant",
      "greater than or equal to -5"),
 ])

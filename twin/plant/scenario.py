@@ -183,16 +183,30 @@ class Sensors(_Strict):
     @field_validator("offset_C")
     @classmethod
     def _temperature_channels(cls, offsets: dict[str, float]) -> dict[str, float]:
+        # a bad name is told at its own key (its line), not at the table's header: in a
+        # [sensors.offset_C] table of seven channels the header said nothing of which one
         columns: dict[str, float] = {}
+        named_by: dict[str, str] = {}
         for name, value in offsets.items():
             column = SENSOR_COLUMNS.get(name) or _BY_COLUMN.get(name)
             if column is None or not column.endswith("_C"):
-                raise ValueError(f"{name!r} is no temperature channel; calibration offsets "
-                                 f"are for {', '.join(TEMPERATURE_CHANNELS)}")
+                raise _key_error(name, f"{name!r} is no temperature channel; calibration "
+                                 f"offsets are for {', '.join(TEMPERATURE_CHANNELS)}")
             if column in columns:
-                raise ValueError(f"{name!r} names {column} a second time")
-            columns[column] = value
+                raise _key_error(name, f"{name!r} names {column} a second time (as "
+                                 f"{named_by[column]!r} does)")
+            columns[column], named_by[column] = value, name
         return dict(sorted(columns.items()))
+
+
+def _key_error(key: str, message: str) -> ValidationError:
+    """A validation error of a table located at its key `key` (pydantic locates a field
+    validator's ValueError at the table)."""
+    from pydantic_core import InitErrorDetails, PydanticCustomError
+
+    return ValidationError.from_exception_data("offset_C", [InitErrorDetails(
+        type=PydanticCustomError("value_error", "{message}", {"message": message}),
+        loc=(key,), input=key)])
 
 
 class _SensorRef(_Strict):
