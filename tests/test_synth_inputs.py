@@ -578,3 +578,36 @@ def test_an_ambient_or_coolant_a_table_overrides_is_told(tmp_path):
     assert synth("--speed", "6000", "--scenario", str(scenario), "--ambient", "24",
                  "--coolant", "22") == ("", "24")
     assert synth("--profile", str(profile), "--ambient", "20") == ("", "20")
+
+
+@pytest.mark.parametrize("ambient, table, line, key", [
+    ("44.8", "[sensors.offset_C]\nT2 = 0.1\nambient = 0.5\n", 3, "sensors.offset_C.ambient"),
+    ("-39.5", "[sensors]\noffset_C = {coolant_C = -3.0}\n", 2, "sensors.offset_C.coolant_C"),
+])
+def test_an_offset_that_takes_the_air_or_inlet_out_of_range_is_refused_naming_it(
+        tmp_path, ambient, table, line, key):
+    """The air and inlet readings' noise is kept inside the range replay reads, but an
+    offset taking the reading itself out was clipped away as the noise is: +0.5 K at
+    44.8 °C read a flat 45 °C while the truth file told 0.5 K.  Now the offset's key is
+    named; within the range the offset is read whole."""
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+    from twin.runs import read_table
+
+    path = tmp_path / "s.toml"
+    path.write_text(table)
+    out = tmp_path / "run.csv"
+    args = ["synth", "--speed", "9000", "--minutes", "3", "--seed", "1", "--scenario",
+            str(path), "--out", str(out), "--quiet"]
+    refused = CliRunner().invoke(app, [*args, "--ambient", ambient])
+    assert refused.exit_code == 2, refused.output
+    assert refused.output.startswith(f"error: {path}, line {line}, key '{key}': with this "
+                                     "calibration offset"), refused.output
+    assert "Traceback" not in refused.output and not out.exists()
+    done = CliRunner().invoke(app, [*args, "--ambient", "30"])
+    assert done.exit_code == 0, done.output
+    column = key.rsplit(".", 1)[1].removesuffix("_C") + "_C"
+    offset = float(table.split("= ")[-1].rstrip("}\n"))
+    reading, truth = read_table(out).columns, read_table(tmp_path / "run.truth.csv").columns
+    np.testing.assert_allclose(reading[column] - truth[column], offset, atol=0.2)

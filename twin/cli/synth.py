@@ -104,7 +104,7 @@ def synth(
     from twin.io.destinations import check_out_file
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
-    from twin.plant.scenario import load_scenario
+    from twin.plant.scenario import load_scenario, offset_error
     from twin.runs import check_replayable
     from twin.spindle.spec import load_spec
 
@@ -165,6 +165,11 @@ def synth(
     try:
         check_replayable(run.columns, str(out), load_spec(None).spindle.max_speed_rpm)
     except InputError as exc:
+        if scenario is not None and exc.column in truth.sensors.offset_C:
+            # the offset took the reading out: the air and inlet themselves stay in range
+            raise offset_error(scenario, exc.column, "with this calibration offset the "
+                               f"emulated run's {exc.column} would be refused by replay "
+                               f"({exc.reason})") from None
         raise InputError(f"the emulated run would be refused by replay: {exc.reason}",
                          file=None if source is None else str(source),
                          column=exc.column) from None

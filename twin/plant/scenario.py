@@ -61,6 +61,7 @@ from pydantic import (
 )
 
 from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
+from twin.errors import TomlError
 from twin.paths import parse_toml, read_toml, toml_error, toml_validation_error
 from twin.plant.timetable import TimeTable
 
@@ -304,6 +305,16 @@ def load_scenario(path: str | os.PathLike[str] | None,
     if duration_s is not None:
         _check_fault_times(scenario.faults, duration_s, text, str(path))
     return scenario
+
+
+def offset_error(path: str | os.PathLike[str], column: str, message: str) -> TomlError:
+    """TomlError at the calibration offset of the run column `column` in the scenario file
+    `path`, at its key as the file spells it (`ambient` or `ambient_C`)."""
+    text, data = read_toml(path, column="--scenario")
+    named = (data.get("sensors") or {}).get("offset_C") or {}
+    key = next((k for k in named if k in (column, column.removesuffix("_C"))),
+               column.removesuffix("_C"))
+    return toml_error(text, str(path), ("sensors", "offset_C", key), message)
 
 
 def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) -> None:
