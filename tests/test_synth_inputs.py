@@ -611,3 +611,20 @@ def test_an_offset_that_takes_the_air_or_inlet_out_of_range_is_refused_naming_it
     offset = float(table.split("= ")[-1].rstrip("}\n"))
     reading, truth = read_table(out).columns, read_table(tmp_path / "run.truth.csv").columns
     np.testing.assert_allclose(reading[column] - truth[column], offset, atol=0.2)
+
+
+def test_a_fault_on_a_channel_with_an_offset_is_not_blamed_on_the_offset(tmp_path):
+    """An ambient logged as NaN throughout is refused for that, offset or not."""
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    path = tmp_path / "s.toml"
+    path.write_text('[sensors.offset_C]\nambient = 0.1\n'
+                    '[faults]\ndropouts = [{sensor = "ambient", start_s = 0, end_s = 200}]\n')
+    refused = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "3", "--seed",
+                                       "1", "--ambient", "22", "--scenario", str(path),
+                                       "--out", str(tmp_path / "run.csv"), "--quiet"])
+    assert refused.exit_code == 2, refused.output
+    assert refused.output.startswith(f"error: {path}, column 'ambient_C': the emulated run "
+                                     "would be refused by replay"), refused.output
