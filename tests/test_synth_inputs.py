@@ -101,10 +101,14 @@ def test_design_example_scenario_parses(tmp_path):
     ("[sensors]\nlag_s = \"8\"\n", 2, "sensors.lag_s", "valid number"),
     # calibration offsets: temperature channels only, each once, within a thermocouple's
     # plausible error
-    ("[sensors]\noffset_C = {T2 = 0.3, disp_z = 1.0}\n", 2, "sensors.offset_C",
+    ("[sensors]\noffset_C = {T2 = 0.3, disp_z = 1.0}\n", 2, "sensors.offset_C.disp_z",
      "'disp_z' is no temperature channel"),
-    ("[sensors.offset_C]\nT2 = 0.2\nT9 = 0.1\n", 1, "sensors.offset_C", "'T9'"),
-    ("[sensors.offset_C]\nT2 = 0.2\nT2_C = 0.1\n", 1, "sensors.offset_C", "second time"),
+    # a bad channel is told on its own line, not on the table's header
+    ("[sensors.offset_C]\nT2 = 0.2\nT9 = 0.1\n", 3, "sensors.offset_C.T9", "'T9'"),
+    ("[sensors.offset_C]\nT1 = 0.1\ndisp_z = 0.2\nT3 = 0.1\n", 3,
+     "sensors.offset_C.disp_z", "'disp_z' is no temperature channel"),
+    ("[sensors.offset_C]\nT2 = 0.2\nT3 = 0.1\nT2_C = 0.1\n", 4, "sensors.offset_C.T2_C",
+     "'T2_C' names T2_C a second time (as 'T2' does)"),
     ("[sensors.offset_C]\nT1 = 0.1\ncoolant = -7.5\n", 3, "sensors.offset_C.coolant",
      "greater than or equal to -5"),
 ])
@@ -574,3 +578,53 @@ def test_an_ambient_or_coolant_a_table_overrides_is_told(tmp_path):
     assert synth("--speed", "6000", "--scenario", str(scenario), "--ambient", "24",
                  "--coolant", "22") == ("", "24")
     assert synth("--profile", str(profile), "--ambient", "20") == ("", "20")
+
+
+@pytest.mark.parametrize("ambient, table, line, key", [
+    ("44.8", "[sensors.offset_C]\nT2 = 0.1\nambient = 0.5\n", 3, "sensors.offset_C.ambient"),
+    ("-39.5", "[sensors]\noffset_C = {coolant_C = -3.0}\n", 2, "sensors.offset_C.coolant_C"),
+])
+def test_an_offset_that_takes_the_air_or_inlet_out_of_range_is_refused_naming_it(
+        tmp_path, ambient, table, line, key):
+    """The air and inlet readings' noise is kept inside the range replay reads, but an
+    offset taking the reading itself out was clipped away as the noise is: +0.5 K at
+    44.8 °C read a flat 45 °C while the truth file told 0.5 K.  Now the offset's key is
+    named; within the range the offset is read whole."""
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+    from twin.runs import read_table
+
+    path = tmp_path / "s.toml"
+    path.write_text(table)
+    out = tmp_path / "run.csv"
+    args = ["synth", "--speed", "9000", "--minutes", "3", "--seed", "1", "--scenario",
+            str(path), "--out", str(out), "--quiet"]
+    refused = CliRunner().invoke(app, [*args, "--ambient", ambient])
+    assert refused.exit_code == 2, refused.output
+    assert refused.output.startswith(f"error: {path}, line {line}, key '{key}': with this "
+                                     "calibration offset"), refused.output
+    assert "Traceback" not in refused.output and not out.exists()
+    done = CliRunner().invoke(app, [*args, "--ambient", "30"])
+    assert done.exit_code == 0, done.output
+    column = key.rsplit(".", 1)[1].removesuffix("_C") + "_C"
+    offset = float(table.split("= ")[-1].rstrip("}\n"))
+    reading, truth = read_table(out).columns, read_table(tmp_path / "run.truth.csv").columns
+    np.testing.assert_allclose(reading[column] - truth[column], offset, atol=0.2)
+
+
+def test_a_fault_on_a_channel_with_an_offset_is_not_blamed_on_the_offset(tmp_path):
+    """An ambient logged as NaN throughout is refused for that, offset or not."""
+    from typer.testing import CliRunner
+
+    from twin.cli import app
+
+    path = tmp_path / "s.toml"
+    path.write_text('[sensors.offset_C]\nambient = 0.1\n'
+                    '[faults]\ndropouts = [{sensor = "ambient", start_s = 0, end_s = 200}]\n')
+    refused = CliRunner().invoke(app, ["synth", "--speed", "9000", "--minutes", "3", "--seed",
+                                       "1", "--ambient", "22", "--scenario", str(path),
+                                       "--out", str(tmp_path / "run.csv"), "--quiet"])
+    assert refused.exit_code == 2, refused.output
+    assert refused.output.startswith(f"error: {path}, column 'ambient_C': the emulated run "
+                                     "would be refused by replay"), refused.output

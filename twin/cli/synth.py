@@ -14,6 +14,8 @@ from twin.io.destinations import REPLACE_BUNDLED_RUNS
 from twin.wording import counted
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from twin.plant.profile import SpeedProfile
     from twin.plant.scenario import Scenario
 
@@ -104,7 +106,7 @@ def synth(
     from twin.io.destinations import check_out_file
     from twin.plant.emulator import synthesize, truth_path_for, write_synth
     from twin.plant.profile import read_speed_profile
-    from twin.plant.scenario import load_scenario
+    from twin.plant.scenario import load_scenario, offset_error
     from twin.runs import check_replayable
     from twin.spindle.spec import load_spec
 
@@ -162,9 +164,18 @@ def synth(
         record_from_s=0.0 if record_from is None else 60.0 * record_from,
     )
     source = scenario or profile
+    max_speed = load_spec(None).spindle.max_speed_rpm
     try:
-        check_replayable(run.columns, str(out), load_spec(None).spindle.max_speed_rpm)
+        check_replayable(run.columns, str(out), max_speed)
     except InputError as exc:
+        offsets = truth.sensors.offset_C
+        if (scenario is not None and exc.column in offsets and _replayable(
+                {**run.columns, **{c: run.columns[c] - v for c, v in offsets.items()}},
+                max_speed)):
+            # the offsets alone took the readings out (not a fault on the same channel)
+            raise offset_error(scenario, exc.column, "with this calibration offset the "
+                               f"emulated run's {exc.column} would be refused by replay "
+                               f"({exc.reason})") from None
         raise InputError(f"the emulated run would be refused by replay: {exc.reason}",
                          file=None if source is None else str(source),
                          column=exc.column) from None
@@ -178,6 +189,16 @@ def synth(
 
 
 synth.__doc__ = SYNTH_HELP
+
+
+def _replayable(columns: dict[str, np.ndarray], max_speed_rpm: float) -> bool:
+    from twin.runs import check_replayable
+
+    try:
+        check_replayable(columns, "", max_speed_rpm)
+    except InputError:
+        return False
+    return True
 
 
 def _tell_steps_after_the_end(speed_profile: SpeedProfile, profile: Path | None,

@@ -61,6 +61,7 @@ from pydantic import (
 )
 
 from twin.contract import OPERATING_TEMPERATURE_C, SENSOR_NAMES
+from twin.errors import TomlError
 from twin.paths import parse_toml, read_toml, toml_error, toml_validation_error
 from twin.plant.timetable import TimeTable
 
@@ -183,16 +184,30 @@ class Sensors(_Strict):
     @field_validator("offset_C")
     @classmethod
     def _temperature_channels(cls, offsets: dict[str, float]) -> dict[str, float]:
+        # a bad name is told at its own key (its line), not at the table's header: in a
+        # [sensors.offset_C] table of seven channels the header said nothing of which one
         columns: dict[str, float] = {}
+        named_by: dict[str, str] = {}
         for name, value in offsets.items():
             column = SENSOR_COLUMNS.get(name) or _BY_COLUMN.get(name)
             if column is None or not column.endswith("_C"):
-                raise ValueError(f"{name!r} is no temperature channel; calibration offsets "
-                                 f"are for {', '.join(TEMPERATURE_CHANNELS)}")
+                raise _key_error(name, f"{name!r} is no temperature channel; calibration "
+                                 f"offsets are for {', '.join(TEMPERATURE_CHANNELS)}")
             if column in columns:
-                raise ValueError(f"{name!r} names {column} a second time")
-            columns[column] = value
+                raise _key_error(name, f"{name!r} names {column} a second time (as "
+                                 f"{named_by[column]!r} does)")
+            columns[column], named_by[column] = value, name
         return dict(sorted(columns.items()))
+
+
+def _key_error(key: str, message: str) -> ValidationError:
+    """A validation error of a table located at its key `key` (pydantic locates a field
+    validator's ValueError at the table)."""
+    from pydantic_core import InitErrorDetails, PydanticCustomError
+
+    return ValidationError.from_exception_data("offset_C", [InitErrorDetails(
+        type=PydanticCustomError("value_error", "{message}", {"message": message}),
+        loc=(key,), input=key)])
 
 
 class _SensorRef(_Strict):
@@ -290,6 +305,16 @@ def load_scenario(path: str | os.PathLike[str] | None,
     if duration_s is not None:
         _check_fault_times(scenario.faults, duration_s, text, str(path))
     return scenario
+
+
+def offset_error(path: str | os.PathLike[str], column: str, message: str) -> TomlError:
+    """TomlError at the calibration offset of the run column `column` in the scenario file
+    `path`, at its key as the file spells it (`ambient` or `ambient_C`)."""
+    text, data = read_toml(path, column="--scenario")
+    named = (data.get("sensors") or {}).get("offset_C") or {}
+    key = next((k for k in named if k in (column, column.removesuffix("_C"))),
+               column.removesuffix("_C"))
+    return toml_error(text, str(path), ("sensors", "offset_C", key), message)
 
 
 def _check_fault_times(faults: Faults, duration_s: float, text: str, file: str) -> None:
