@@ -344,7 +344,7 @@ def synthesize(*, minutes: float, ambient_C: float, seed: int, speed_rpm: float 
         "expansion_factor": f"{tables.form.expansion:.6g}",
         **{f"{n}_offset_mm": f"{dr + 0.0:.4f} {dz + 0.0:.4f}"  # + 0.0: no "-0.0000"
            for n, (dr, dz) in sorted(tables.form.sensor_offsets_mm.items())},
-        **{f"{column.removesuffix('_C')}_calibration_offset_C": f"{value:g}"
+        **{f"{column.removesuffix('_C')}_calibration_offset_C": f"{value + 0.0:.12g}"
            for column, value in sensors.offset_C.items()},
     }
     if record_from_s > 0.0:

@@ -217,7 +217,7 @@ def draw_case(suite_seed: int, index: int, minutes: float = DEFAULT_MINUTES,
                     for k in ("lag_s", "noise_C", "noise_um", "placement_mm")},
         "faults": _faults(rng, duration),
     }
-    data["sensors"]["offset_C"] = {s: _r(u(*RANGES["calibration_offset_C"]), 3)
+    data["sensors"]["offset_C"] = {s: _r(u(*RANGES["calibration_offset_C"]), 3) + 0.0
                                    for s in TEMPERATURE_SENSORS}
     scenario = Scenario.model_validate(data)
     seed = int(sequence.generate_state(1)[0])
