@@ -329,12 +329,29 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     # every frame's range is over all the window ends, drawn or kept: read them all then
     shown = {t: field_at(t) for t in (ends if snapshots == "every" else wanted)}
     clim = frames_range(model, snapshots, shown)
-    start = start_field(model, run)
+    start_C = _replayed_start(out_dir, model, run)
     for t in wanted:
         render_snapshot(model, shown[t], out_dir / _snapshot_name(primary, t),
                         title=snapshot_title(run_name(run_path), primary, t, run),
-                        T_initial_C=start.field_C, clim=clim)
+                        T_initial_C=start_C, clim=clim)
     return len(wanted)
+
+
+def _replayed_start(out_dir: Path, model: SpindleModel, run: RecordedRun) -> np.ndarray:
+    """The field the finished run folder `out_dir`'s replay started from (the zero of its
+    drift): its first deck's start state, `decks/window_000_start.vtu`, where the replay
+    wrote one (always for a warm start: its fitted field), else the run's start field,
+    which is then uniform and found without a fit.  Fitting a warm start again cost
+    --resume 0.17 s a run for a picture's drift.  InputError: a damaged start file."""
+    from apdl_like.outputs import read_state_vtu
+
+    path = out_dir / "decks" / "window_000_start.vtu"
+    if not path.is_file():
+        return start_field(model, run).field_C
+    _, T, _ = read_state_vtu(path)
+    if np.shape(T) != (model.n_dofs,) or not np.all(np.isfinite(T)):
+        raise InputError("no TEMP array of the spindle's vertices", file=str(path))
+    return T
 
 
 def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corrector],
