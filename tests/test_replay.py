@@ -351,16 +351,22 @@ def test_the_sources_digest_follows_the_bytes_not_the_place(tmp_path):
     assert sources_digest({"twin": b}) != digest
 
 
-def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path):
+@pytest.mark.parametrize("before", ["none", "end"])
+def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path,
+                                                                           before):
     # `--resume --snapshots every` after a `--snapshots none` batch skipped every run and
-    # left it without a single picture
+    # left it without a single picture; after an `end` batch it kept the end frame in its
+    # own field's range beside frames in the run's
     from twin.loop.batch import replay_batch
 
     run = runs_dir / "hot_9000.csv"
     fresh = replay_batch([run], tmp_path / "fresh", ["open_loop"], None, snapshots="every")
     out = tmp_path / "out"
-    replay_batch([run], out, ["open_loop"], None, snapshots="none")
-    assert not (out / "hot_9000" / "snapshots").exists()
+    replay_batch([run], out, ["open_loop"], None, snapshots=before)
+    end = out / "hot_9000" / "snapshots" / f"open_loop_t{60 * MINUTES:05d}s.png"
+    assert end.is_file() == (before == "end")
+    assert not end.is_file() or end.read_bytes() != (
+        tmp_path / "fresh" / "hot_9000" / "snapshots" / end.name).read_bytes()
     stamp = (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns
     resumed = replay_batch([run], out, ["open_loop"], None, snapshots="every", resume=True)
     assert resumed.skipped == ["hot_9000"]

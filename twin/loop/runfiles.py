@@ -299,7 +299,9 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
                   snapshots: str, duration_s: float) -> int:
     """Draw the snapshots `snapshots` asks for that the finished run folder `out_dir` lacks,
     from its field files, without solving again (--resume on a run it skips); pictures it
-    has are kept.  `duration_s`: the run's (accuracy.json), which sets its window ends.
+    has are kept, but for an `end` replay's one picture where `every` draws the others
+    (`frames_range`: the frames share the run's range, that picture spans its own).
+    `duration_s`: the run's (accuracy.json), which sets its window ends.
     Returns how many were drawn.  InputError: a field file it needs is missing (`--fields
     end` or `none`) or damaged (the caller replays the run)."""
     from twin.contract import windows_in
@@ -312,6 +314,11 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     ends = dict.fromkeys(WINDOW_S * k for k in range(1, windows_in(duration_s) + 1))
     wanted = [t for t in _window_ends(ends, snapshots)
               if not (out_dir / _snapshot_name(primary, t)).is_file()]
+    if snapshots == "every" and wanted == list(ends)[:-1]:
+        # the end frame alone: an `end` replay's picture, in its own field's range (kept,
+        # one run's frames used two ranges).  Drawn again in the run's, first: a resume
+        # stopped part-way leaves it so beside the frames it drew
+        wanted.insert(0, max(ends))
     if not wanted:
         return 0
     model = SpindleModel.load()
