@@ -351,16 +351,22 @@ def test_the_sources_digest_follows_the_bytes_not_the_place(tmp_path):
     assert sources_digest({"twin": b}) != digest
 
 
-def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path):
+@pytest.mark.parametrize("before", ["none", "end"])
+def test_resume_draws_the_snapshots_asked_for_from_the_skipped_runs_fields(runs_dir, tmp_path,
+                                                                           before):
     # `--resume --snapshots every` after a `--snapshots none` batch skipped every run and
-    # left it without a single picture
+    # left it without a single picture; after an `end` batch it kept the end frame in its
+    # own field's range beside frames in the run's
     from twin.loop.batch import replay_batch
 
     run = runs_dir / "hot_9000.csv"
     fresh = replay_batch([run], tmp_path / "fresh", ["open_loop"], None, snapshots="every")
     out = tmp_path / "out"
-    replay_batch([run], out, ["open_loop"], None, snapshots="none")
-    assert not (out / "hot_9000" / "snapshots").exists()
+    replay_batch([run], out, ["open_loop"], None, snapshots=before)
+    end = out / "hot_9000" / "snapshots" / f"open_loop_t{60 * MINUTES:05d}s.png"
+    assert end.is_file() == (before == "end")
+    assert not end.is_file() or end.read_bytes() != (
+        tmp_path / "fresh" / "hot_9000" / "snapshots" / end.name).read_bytes()
     stamp = (out / "hot_9000" / "accuracy.json").stat().st_mtime_ns
     resumed = replay_batch([run], out, ["open_loop"], None, snapshots="every", resume=True)
     assert resumed.skipped == ["hot_9000"]
@@ -1150,6 +1156,43 @@ def test_quality_json_tells_an_axial_probe_not_zeroed_at_the_start(runs_dir, rep
     assert not [f for f in quality["findings"] if f["kind"] == PROBE_NOT_ZEROED]
     whole = json.loads((replayed / "hot_9000" / "quality.json").read_text())["findings"]
     assert not [f for f in whole if f["kind"] == PROBE_NOT_ZEROED]
+
+
+def test_a_run_whose_first_thermocouple_and_probe_cells_are_empty_replays_from_its_readings(
+        runs_dir, tmp_path):
+    """A logger whose first row lacks T1 and the probe (empty cells): the replay runs every
+    method (exit 0) and quality.json tells those samples as missing before the first
+    reading, excluded, not as interpolated; the start is the spindle at rest, found from
+    T2..T5; the probe's start reading, 50 µm off zero, is its first real one, 4 s in.  The
+    missing samples held the next ones' values as if read at the start: T1 4 s warmer
+    than the others made the cold start a fitted warm one (`warm_start`)."""
+    lines = (runs_dir / "hot_9000.csv").read_text().splitlines()
+    header = next(k for k, line in enumerate(lines) if line.startswith("time_s"))
+    names = lines[header].split(",")
+    rows = [line.split(",") for line in lines[header + 1:]]
+    probe = names.index("disp_z_um")
+    for cells in rows:
+        cells[probe] = f"{float(cells[probe]) + 50.0:.4f}"
+    for name in ("T1_C", "disp_z_um"):
+        rows[0][names.index(name)] = ""
+    run = tmp_path / "late.csv"
+    run.write_text("\n".join(lines[:header + 1] + [",".join(c) for c in rows]) + "\n")
+    result = replay(run, out=tmp_path / "out", methods="open_loop,ratio,bpnn,estimator")
+    assert result.exit_code == 0, result.output
+    found = json.loads((tmp_path / "out" / "late" / "quality.json").read_text())["findings"]
+    assert [(f["column"], f["kind"], f["rows"], f["action"]) for f in found
+            if f["column"] in ("T1_C", "disp_z_um") and f["kind"] != "probe_not_zeroed"] == [
+        (name, "leading_dropout", [header + 2],
+         "held at the first reading for continuity; excluded from metrics")
+        for name in ("T1_C", "disp_z_um")]
+    # T1 at 4 s read as the first reading spread T1..T5 over 2 K: a cold start fitted warm
+    assert not [f for f in found if f["kind"] == "warm_start"], found
+    told = [f for f in found if f["kind"] == "probe_not_zeroed"]
+    assert len(told) == 1 and told[0]["rows"] == [header + 3], told
+    assert told[0]["detail"].startswith(f"reads {float(rows[1][probe]):.3g} µm at 4 s")
+    accuracy = json.loads((tmp_path / "out" / "late" / "accuracy.json").read_text())
+    for metrics in accuracy["methods"].values():
+        assert 95.0 < metrics["temperature_accuracy_pct"] <= 100.0, accuracy
 
 
 def test_the_estimator_reads_a_probe_not_zeroed_at_the_start_from_its_first_reading(

@@ -91,12 +91,23 @@ def test_the_air_and_coolant_hold_their_last_reading_through_a_gap(tmp_path, nam
         "linearly interpolated in time for continuity; excluded from metrics")
 
 
-def test_leading_dropout_held_and_flagged(tmp_path):
+@pytest.mark.parametrize("name", ["T5_C", "speed_rpm"])
+def test_the_samples_before_a_column_s_first_reading_are_invalid(tmp_path, name):
+    """A missing first reading is a missing reading: no reading precedes it to hold, none
+    to interpolate from, so it is invalid however short (it was a valid sample holding the
+    next one's value, told as "linearly interpolated"); the first reading stands in."""
     cols = warmup()
-    cols["T5_C"][:5] = np.nan
+    cols[name][:5] = np.nan
+    cols["T5_C"][100:104] = np.nan  # a gap after the first reading is still interpolated
     run = read_run(write(tmp_path, csv_text(cols)))
-    assert one(run, "dropout", "T5_C")["count"] == 5
-    np.testing.assert_allclose(run.T_C[:5, 4], cols["T5_C"][5], atol=1e-4)
+    f = one(run, "leading_dropout", name)
+    assert f["count"] == 5 and f["rows"] == [2, 3, 4, 5, 6] and f["spans_s"] == [[0.0, 4.0]]
+    word = "speed" if name == "speed_rpm" else "reading"
+    assert f["action"] == f"held at the first {word} for continuity; excluded from metrics"
+    assert run.valid[name].tolist() == [False] * 5 + [True] * 295
+    np.testing.assert_allclose(run.column(name)[:5], cols[name][5], atol=1e-4)
+    assert one(run, "dropout", "T5_C")["rows"] == [102, 103, 104, 105]
+    assert np.isnan(run.before(np.array([4.0])).T_valid_C[0, 4]) == (name == "T5_C")
 
 
 def test_time_gaps(tmp_path):

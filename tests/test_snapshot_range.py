@@ -80,6 +80,41 @@ def test_every_frame_of_a_run_and_every_resumed_frame_share_the_runs_range(
         assert (fresh / "snapshots" / name).read_bytes() == drawn[name], name
 
 
+def test_a_resume_stopped_part_way_leaves_no_frame_in_another_range(spindle_model, tmp_path,
+                                                                    monkeypatch):
+    """After an `end` batch, `--resume --snapshots every` draws that batch's end picture
+    (its own field's range) again in the run's range, and first: stopped after two
+    pictures (a Ctrl-C), the next resume draws only the frames still missing, and every
+    frame is a fresh `every` replay's."""
+    import twin.loop.snapshot as snapshot
+    from twin.loop.batch import replay_batch
+    from twin.loop.runfiles import add_snapshots
+
+    run = make_recorded_run(tmp_path / "hot_9000.csv", spindle_model)
+    replay_batch([run], tmp_path / "fresh", ["open_loop"], None, snapshots="every")
+    out = tmp_path / "out" / "hot_9000"
+    replay_batch([run], tmp_path / "out", ["open_loop"], None, snapshots="end")
+    render = snapshot.render_snapshot
+    drawn: list[str] = []
+
+    def stopped(model, T, out_png, *args, **kwargs):
+        if len(drawn) == 2:
+            raise KeyboardInterrupt
+        drawn.append(os.path.basename(out_png))
+        return render(model, T, out_png, *args, **kwargs)
+
+    monkeypatch.setattr(snapshot, "render_snapshot", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        add_snapshots(run, out, ["open_loop"], "every", 60.0 * MINUTES)
+    names = [f"open_loop_t{60 * k:05d}s.png" for k in range(1, MINUTES + 1)]
+    assert drawn == [names[-1], names[0]]
+    monkeypatch.setattr(snapshot, "render_snapshot", render)
+    assert add_snapshots(run, out, ["open_loop"], "every", 60.0 * MINUTES) == MINUTES - 2
+    for name in names:
+        assert ((out / "snapshots" / name).read_bytes()
+                == (tmp_path / "fresh" / "hot_9000" / "snapshots" / name).read_bytes()), name
+
+
 def test_one_end_picture_keeps_its_own_fields_range(spindle_model, tmp_path,
                                                     recorded_clims):
     from twin.loop.batch import replay_batch

@@ -305,3 +305,30 @@ def test_a_warm_start_is_not_told_its_speed_may_be_in_rev_per_s(tmp_path):
     found, _ = replay_open_loop(run, tmp_path / "out")
     kinds = [f["kind"] for f in found]
     assert "warm_start" in kinds and "warms_unlike_twin" not in kinds, found
+
+
+def test_resume_draws_a_warm_starts_snapshot_without_fitting_its_start_again(
+        tmp_path, spindle_model, warm_up, monkeypatch):
+    """`--resume` adding a snapshot to a finished warm-start folder took the picture's drift
+    from the start field fitted again (0.17 s a run); it reads the start the replay wrote
+    (decks/window_000_start.vtu) and draws the replay's own picture, its drift caption
+    (measured from that start) included."""
+    from twin.loop import runfiles
+    from twin.loop.batch import replay_batch
+
+    run = cut_run(tmp_path / "cut.csv", warm_up, 1500.0)
+    assert not start_field(spindle_model, run).uniform
+    fresh = tmp_path / "fresh"
+    replay_batch([str(tmp_path / "cut.csv")], fresh, ["open_loop"], None, snapshots="end")
+    out = tmp_path / "out"
+    replay_batch([str(tmp_path / "cut.csv")], out, ["open_loop"], None, snapshots="none")
+
+    def fitted_again(*_: object) -> None:
+        raise AssertionError("the start field was fitted again")
+
+    monkeypatch.setattr(runfiles, "start_field", fitted_again)
+    resumed = replay_batch([str(tmp_path / "cut.csv")], out, ["open_loop"], None,
+                           snapshots="end", resume=True)
+    assert resumed.skipped == ["cut"] and not resumed.failed, resumed.failed
+    name = "snapshots/open_loop_t00300s.png"
+    assert (out / "cut" / name).read_bytes() == (fresh / "cut" / name).read_bytes()

@@ -614,9 +614,11 @@ class EnsembleEstimator:
     def sensor_bias_K(self) -> np.ndarray | None:
         """Current mean offsets of T1..T5 from the metal at their points, K (None: not
         estimated, or nothing estimated yet)."""
-        if self._ensemble is None or self._bias is None:
-            return None
-        return self._ensemble.log_factor_mean[self._bias].copy()
+        return None if self._ensemble is None else self._bias_mean(self._ensemble)
+
+    def _bias_mean(self, ens: Ensemble) -> np.ndarray | None:
+        """`ens`'s mean offsets of T1..T5, K, a copy (None: the run estimates none)."""
+        return None if self._bias is None else ens.log_factor_mean[self._bias].copy()
 
     def correct(self, features: WindowFeatures) -> Correction:
         f = features
@@ -670,8 +672,7 @@ class EnsembleEstimator:
             (bc.H_front, bc.H_rear, bc.R_front, bc.R_rear), f.carried_previous(),
             factors=extra, state_C=ens.field_mean.copy(), band_sd=self._band_sd_used.copy(),
             readings_start_C=self._readings_C.copy() if cfg.report_readings else None,
-            sensor_offset_C=(ens.log_factor_mean[self._bias].copy()
-                             if cfg.report_readings and self._bias is not None else None),
+            sensor_offset_C=self._bias_mean(ens) if cfg.report_readings else None,
             sensor_lag_s=self._lag_of(self._start), loads_follow_rings=cfg.loads_follow_rings,
             coolant_C=bc.coolant_C if self._coolant is not None else None,
         )
@@ -784,8 +785,9 @@ class EnsembleEstimator:
         lag_anomalies = (start.ensemble.log_factor_anomalies[self._lag]
                          if self._lag is not None else None)
         # each thermocouple's offset: added to what it reads, by each member its own
-        bias = (start.ensemble.log_factor_mean[self._bias] if self._bias is not None
-                else np.zeros(read.shape[1]))
+        bias = self._bias_mean(start.ensemble)
+        if bias is None:
+            bias = np.zeros(read.shape[1])
         bias_anomalies = (start.ensemble.log_factor_anomalies[self._bias]
                           if self._bias is not None else 0.0)
         bins = np.array_split(np.arange(steps), cfg.bins_per_window)
@@ -1017,8 +1019,9 @@ class EnsembleEstimator:
             sim_C = np.asarray(sim_C, float)[-steps - 1:]
             if cfg.report_readings:  # T1..T5 were reported as readings: judge those
                 sim_C = self._window_readings(sim_t, sim_C, self._start)
-                if self._bias is not None:  # with the offsets they were reported with
-                    sim_C = sim_C + self._start.ensemble.log_factor_mean[self._bias]
+                offsets = self._bias_mean(self._start.ensemble)
+                if offsets is not None:  # with the offsets they were reported with
+                    sim_C = sim_C + offsets
             drift, drift_anom = self._drift_forecast(fc)
             var_T, var_d = self._as_reported(fc).spread_at_steps(drift_anom)
             var_T = np.vstack([var_T[:1], var_T])  # the window start: as its first step

@@ -299,7 +299,9 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
                   snapshots: str, duration_s: float) -> int:
     """Draw the snapshots `snapshots` asks for that the finished run folder `out_dir` lacks,
     from its field files, without solving again (--resume on a run it skips); pictures it
-    has are kept.  `duration_s`: the run's (accuracy.json), which sets its window ends.
+    has are kept, but for an `end` replay's one picture where `every` draws the others
+    (`frames_range`: the frames share the run's range, that picture spans its own).
+    `duration_s`: the run's (accuracy.json), which sets its window ends.
     Returns how many were drawn.  InputError: a field file it needs is missing (`--fields
     end` or `none`) or damaged (the caller replays the run)."""
     from twin.contract import windows_in
@@ -312,6 +314,11 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     ends = dict.fromkeys(WINDOW_S * k for k in range(1, windows_in(duration_s) + 1))
     wanted = [t for t in _window_ends(ends, snapshots)
               if not (out_dir / _snapshot_name(primary, t)).is_file()]
+    if snapshots == "every" and wanted == list(ends)[:-1]:
+        # the end frame alone: an `end` replay's picture, in its own field's range (kept,
+        # one run's frames used two ranges).  Drawn again in the run's, first: a resume
+        # stopped part-way leaves it so beside the frames it drew
+        wanted.insert(0, max(ends))
     if not wanted:
         return 0
     model = SpindleModel.load()
@@ -329,12 +336,29 @@ def add_snapshots(run_path: str | Path, out_dir: Path, methods: Sequence[str],
     # every frame's range is over all the window ends, drawn or kept: read them all then
     shown = {t: field_at(t) for t in (ends if snapshots == "every" else wanted)}
     clim = frames_range(model, snapshots, shown)
-    start = start_field(model, run)
+    start_C = _replayed_start(out_dir, model, run)
     for t in wanted:
         render_snapshot(model, shown[t], out_dir / _snapshot_name(primary, t),
                         title=snapshot_title(run_name(run_path), primary, t, run),
-                        T_initial_C=start.field_C, clim=clim)
+                        T_initial_C=start_C, clim=clim)
     return len(wanted)
+
+
+def _replayed_start(out_dir: Path, model: SpindleModel, run: RecordedRun) -> np.ndarray:
+    """The field the finished run folder `out_dir`'s replay started from (the zero of its
+    drift): its first deck's start state, `decks/window_000_start.vtu`, where the replay
+    wrote one (always for a warm start: its fitted field), else the run's start field,
+    which is then uniform and found without a fit.  Fitting a warm start again cost
+    --resume 0.17 s a run for a picture's drift.  InputError: a damaged start file."""
+    from apdl_like.outputs import read_state_vtu
+
+    path = out_dir / "decks" / "window_000_start.vtu"
+    if not path.is_file():
+        return start_field(model, run).field_C
+    _, T, _ = read_state_vtu(path)
+    if np.shape(T) != (model.n_dofs,) or not np.all(np.isfinite(T)):
+        raise InputError("no TEMP array of the spindle's vertices", file=str(path))
+    return T
 
 
 def _replay_methods(run: RecordedRun, model: SpindleModel, correctors: list[Corrector],

@@ -3,8 +3,8 @@
 Repaired here, in this order: duplicate timestamps (merged), spikes (robust Hampel-type
 filter; for the speed, a command, only one-sample glitches between equal neighbours),
 NaN dropouts and short time gaps (linear interpolation up to `max_gap_s`, the speed held
-at its last value; longer ones are filled for continuity but excluded from the metrics),
-noisy sensors
+at its last value; longer ones, and those before a column's first reading, are filled for
+continuity but excluded from the metrics), noisy sensors
 (centred moving average), stuck sensors (flat while the others move: excluded), dead
 thermocouples (no value in the whole run: excluded).  A
 finding is a plain JSON-serialisable dict:
@@ -292,7 +292,13 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
     the air and coolant temperatures its boundaries run at) keep their last value instead:
     a linear fill reads a value measured after the gap, and a window's loads may use only
     what was measured before it starts (DESIGN.md).  Until 2026-11-27 a coolant log with a
-    10-min gap ramped the inlet the replay ran at towards the reading after it."""
+    10-min gap ramped the inlet the replay ran at towards the reading after it.
+    The samples before a column's first reading have neither a reading to hold nor two to
+    interpolate between: they are invalid whatever their length, as a long dropout's,
+    and hold the first reading only as a finite stand-in (`leading_dropout`).  Until
+    2026-11-28 a missing first sample was a valid one, the next sample's value told as
+    "linearly interpolated" (or "held at the last reading"): a thermocouple's start
+    reading, and a probe's zero, taken from a later sample."""
     valid = np.ones(x.size, dtype=bool)
     missing = np.isnan(x)
     if not missing.any():
@@ -309,9 +315,21 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
         out[held] = x[last[held]]
     how = ("held at the last speed" if name == SPEED else "held at the last reading"
            if name in HELD_INPUTS else "linearly interpolated in time")
+    found = []
+    if missing[0]:
+        b = int(np.argmax(ok)) - 1  # the last sample before the first reading
+        valid[:b + 1] = False
+        first = "speed" if name == SPEED else "reading"
+        found.append(finding(name, "leading_dropout",
+                             f"held at the first {first} for continuity; excluded from "
+                             "metrics", rows=rows[:b + 1], spans_s=[(t[0], t[b])],
+                             detail=f"missing values before the first {first}, at "
+                                    f"{t[b + 1]:g} s"))
     short_rows, long_rows, short_spans, long_spans = [], [], [], []
     for a, b in true_runs(missing):
-        left = t[a - 1] if a > 0 else t[a]
+        if a == 0:  # before the first reading: told above
+            continue
+        left = t[a - 1]
         right = t[b + 1] if b + 1 < x.size else t[b]
         if right - left > cfg.max_gap_s:
             valid[a:b + 1] = False
@@ -320,7 +338,6 @@ def fill_dropouts(name: str, t: np.ndarray, x: np.ndarray, rows: np.ndarray,
         else:
             short_rows.append(rows[a:b + 1])
             short_spans.append((t[a], t[b]))
-    found = []
     if short_rows:
         r = np.concatenate(short_rows)
         found.append(finding(name, "dropout", how, rows=r,
