@@ -15,6 +15,7 @@ from twin.drift.features import FeatureSpec
 from twin.drift.intervals import GAIN, apply_interval, conformal_half_width, interval_rule
 from twin.drift.model import fit_drift_model
 from twin.drift.modelfile import load_drift_model, save_drift_model
+from twin.lag import first_order_lag
 
 
 def test_the_band_is_as_wide_as_the_worst_left_out_block_needs():
@@ -77,8 +78,9 @@ def test_a_speed_between_a_stop_and_the_slowest_run_is_outside_the_range():
 def test_a_stop_hotter_than_every_fitted_stop_is_outside_the_range():
     """A stop holds no input but its heat, and the speed lags fall back inside their range
     long before it is gone: a stopped row hotter than every stopped training row counts,
-    in spans of their range; a colder one does not (the room was colder), nor a running
-    row's temperatures (the speed's answer, held against the speed)."""
+    in spans of the feature's range over every training row; a colder one does not (the
+    room was colder), nor a running row's temperatures (the speed's answer, held against
+    the speed)."""
     spec = FeatureSpec(("A_C",), (20.0,), taus_min=(10.0,), groups=("rise", "speed"))
 
     def row(rise: float, krpm: float, lag: float) -> list[float]:
@@ -89,11 +91,13 @@ def test_a_stop_hotter_than_every_fitted_stop_is_outside_the_range():
     rng = OperatingRange.of(spec, train)
     assert rng.state_features == ("A_C:rise",)
     assert (rng.stopped_state_lo, rng.stopped_state_hi) == ((0.0,), (18.0,))
+    assert rng.state_span == (20.0,)
     query = np.array([row(27, 0, 1.0), row(-9, 0, 1.0), row(40, 5, 5), row(27, 0, 6.0),
                       row(18, 0, 6.0)])
     excess, worst = rng.excess(spec, query)
-    # 9 K above the hottest stop: 9/18 of the stops' span; 6 of a lag in 0–5: n² (36 − 25)/25
-    np.testing.assert_allclose(excess, [0.5, 0.0, 0.0, 0.5, 11.0 / 25.0])
+    # 9 K above the hottest stop: 9/20 of the rise's span over every training row; 6 of a
+    # lag in 0–5: n² (36 − 25)/25
+    np.testing.assert_allclose(excess, [0.45, 0.0, 0.0, 0.45, 11.0 / 25.0])
     assert [rng.named[k] for k in worst[[0, 3, 4]]] == ["A_C:rise", "A_C:rise",
                                                         "speed_krpm2:lag10min"]
     doc = json.loads(json.dumps(rng.to_json()))
@@ -102,6 +106,31 @@ def test_a_stop_hotter_than_every_fitted_stop_is_outside_the_range():
     older = OperatingRange.from_json({k: v for k, v in doc.items() if "state" not in k})
     np.testing.assert_allclose(older.excess(spec, query)[0], [0.0, 0.0, 0.0, 11.0 / 25.0,
                                                               11.0 / 25.0])
+    # one written with the state but not the unit to count it in: the same
+    unitless = OperatingRange.from_json({k: v for k, v in doc.items() if k != "state_span"})
+    np.testing.assert_allclose(unitless.excess(spec, query)[0], older.excess(spec, query)[0])
+
+
+def test_a_warm_stop_after_a_cold_rest_counts_in_the_fitted_range_not_the_rests_noise():
+    """Stand data often stop only at their start, cold: the rest's temperatures span the
+    sensors' noise (0.0002–0.03 K on the real step tests), and a warm stop later counted
+    thousands of such spans (the real data's first 4.1 h and the stop after them: 8938,
+    a band ×17878, 2.25 m wide).  Counted in the feature's span over every training row,
+    the range the model was fitted over, it is a fraction of that (×4.5 there, where the
+    speed lags alone widen the band ×4.1 as the spindle stops)."""
+    spec = FeatureSpec(("A_C",), (20.0,), taus_min=(10.0,), groups=("rise", "speed"))
+
+    def row(rise: float, krpm: float, lag: float) -> list[float]:
+        return [rise, krpm, krpm**2, lag, lag**2]
+
+    train = np.array([row(0.0, 0, 0), row(0.01, 0, 0), row(-0.005, 0, 0), row(3, 2.5, 1),
+                      row(8, 2.5, 2.5), row(10, 2.5, 2.5)])
+    rng = OperatingRange.of(spec, train)
+    assert (rng.stopped_state_lo, rng.stopped_state_hi) == ((-0.005,), (0.01,))
+    excess, worst = rng.excess(spec, np.array([row(9, 0, 0), row(12, 0, 0.5)]))
+    # 8.99 and 11.99 K above the rest, in spans of 10.005 K (the lag's 0.5 krpm less)
+    np.testing.assert_allclose(excess, [8.99 / 10.005, 11.99 / 10.005])
+    assert [rng.named[k] for k in worst] == ["A_C:rise", "A_C:rise"]
 
 
 @pytest.fixture(scope="module")
@@ -195,11 +224,46 @@ def test_a_model_file_without_the_stopped_state_keeps_its_band(fitted):
     assert {named[k] for k in furthest[excess > 0]} <= set(model.operating_range.state_features)
     w = model.interval["half_width_um"][0]
     np.testing.assert_allclose((hi - mean)[:, 0], w * (1.0 + GAIN * excess))
-    doc = {k: v for k, v in model.interval["operating_range"].items() if "state" not in k}
-    older = type(model)(model.method, model.targets, model.spec, model.params,
-                        {**model.interval, "operating_range": doc},
-                        model.metadata, model.validation)
-    older_path = save_drift_model(older, folder / "older_state.safetensors")
-    mean, lo, hi, excess, _ = load_drift_model(older_path).predict_data(hotter)
-    assert not excess.any()
-    np.testing.assert_allclose(hi - mean, w)
+    # written before the state was kept, or with the state but not the span it is counted
+    # in (between the two changes): the stops held against the speed alone
+    for name, dropped in (("older_state", lambda k: "state" in k),
+                          ("unitless_state", lambda k: k == "state_span")):
+        doc = {k: v for k, v in model.interval["operating_range"].items() if not dropped(k)}
+        older = type(model)(model.method, model.targets, model.spec, model.params,
+                            {**model.interval, "operating_range": doc},
+                            model.metadata, model.validation)
+        older_path = save_drift_model(older, folder / f"{name}.safetensors")
+        mean, lo, hi, excess, _ = load_drift_model(older_path).predict_data(hotter)
+        assert not excess.any(), name
+        np.testing.assert_allclose(hi - mean, w)
+
+
+def test_a_stop_after_a_run_that_only_rested_cold_keeps_a_band_like_the_speeds(tmp_path):
+    """Fitted on 2 min of cold rest and 2 h at 3000 rpm, a model asked about the 2-h stop
+    after them: the stop lies outside throughout (the heat stays), and the band is never
+    wider than the speed lags make it where the spindle stops (held against the rest's
+    noise, the stop counted 58453 spans of the 90-min lag, a band ×116907)."""
+    t = np.arange(0.0, 120.0 + 4 * 3600.0, 15.0)
+    speed = np.where((t >= 120.0) & (t < 120.0 + 2 * 3600.0), 3000.0, 0.0)
+    heat = (speed / 1000.0) ** 1.5
+    noise = np.random.default_rng(0).normal(0.0, 0.01, (2, t.size))
+    a = 20.0 + first_order_lag(heat, t, 900.0, between="held")
+    b = 20.0 + 0.5 * first_order_lag(heat, t, 2400.0, between="held")
+    columns = {"time_s": t, "speed_rpm": speed, "A_C": a + noise[0], "B_C": b + noise[1],
+               "drift_um": 3.0 * (a - 20.0) + 1.5 * (b - 20.0)}
+    fitted_rows = t < 120.0 + 2 * 3600.0
+    write_csv(tmp_path / "fit.csv", {k: v[fitted_rows] for k, v in columns.items()})
+    write_csv(tmp_path / "all.csv", columns)
+    model = fit_drift_model(read_drift_data([tmp_path / "fit.csv"], targets=["drift_um"]),
+                            method="ridge_dynamic", sensors="all", seed=0)
+    rng = model.operating_range
+    assert sum(speed[fitted_rows] == 0) == 8 and max(np.ptp([rng.stopped_state_lo,
+                                                             rng.stopped_state_hi], 0)) < 0.1
+    data = read_drift_data([tmp_path / "all.csv"], targets=["drift_um"])
+    mean, lo, hi, excess, furthest = model.predict_data(data)
+    stop = ~fitted_rows
+    assert np.all(excess[stop] > 0)
+    at_stop = excess[np.argmax(stop)]                 # the speed lags: 3000 rpm, n² 9 krpm²
+    assert at_stop == pytest.approx(9.0, rel=0.05) and excess.max() <= at_stop
+    assert model.outside_range(excess, furthest)["max_band_factor"] < 20.0
+

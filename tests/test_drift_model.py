@@ -393,6 +393,13 @@ def _set(*keys_value):
      "interval.operating_range", "'speed_krpm' is both an operating and a state feature"),
     (_set("interval", "operating_range", "state_features", 0, "A_C"),
      "interval.operating_range.state_features", "'A_C' is none of the model's features"),
+    (_set("interval", "operating_range", "state_span", [1.0]), "interval.operating_range",
+     "1 spans (state_span) for 12 state_features"),
+    (_set("interval", "operating_range", "state_span", 3, -0.5),
+     "interval.operating_range.state_span[3]", "greater than or equal to 0"),
+    (lambda d: [d["interval"]["operating_range"].pop(k) for k in
+                ("state_features", "stopped_state_lo", "stopped_state_hi")],
+     "interval.operating_range", "spans of a thermal state (state_span) without its features"),
     (_set("interval", "extrapolation_gain", -2.0), "interval.extrapolation_gain",
      "greater than or equal to 0"),
     (_set("targets", "drift_um"), "targets", "valid list"),

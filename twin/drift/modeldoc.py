@@ -87,6 +87,7 @@ class OperatingRange(_Fixed):
     state_features: list[str] | None = None
     stopped_state_lo: list[FiniteFloat] | None = None
     stopped_state_hi: list[FiniteFloat] | None = None
+    state_span: list[Annotated[float, Field(ge=0, allow_inf_nan=False)]] | None = None
 
     @field_validator("features")
     @classmethod
@@ -118,6 +119,9 @@ class OperatingRange(_Fixed):
         if any(v is None for v in state) and not all(v is None for v in state):
             raise ValueError("the stopped rows' thermal state needs its features and both "
                              "ends (state_features, stopped_state_lo, stopped_state_hi)")
+        if self.state_span is not None and self.state_features is None:
+            raise ValueError("spans of a thermal state (state_span) without its features "
+                             "and ends (state_features, stopped_state_lo, stopped_state_hi)")
         if self.state_features is not None and self.stopped_lo is None:
             raise ValueError("a thermal state of the stopped rows (state_features) without "
                              "their range (stopped_lo, stopped_hi)")
@@ -132,6 +136,9 @@ class OperatingRange(_Fixed):
                                            strict=True)):
                 raise ValueError("an upper end (stopped_state_hi) below its lower end "
                                  "(stopped_state_lo)")
+            if self.state_span is not None and len(self.state_span) != len(self.state_features):
+                raise ValueError(f"{len(self.state_span)} spans (state_span) for "
+                                 f"{len(self.state_features)} state_features")
             twice = set(self.features) & set(self.state_features)
             if twice:
                 raise ValueError(f"{sorted(twice)[0]!r} is both an operating and a state "
@@ -143,7 +150,8 @@ class Interval(_Fixed):
     """`interval_rule`: conformal half-widths (µm) or the posterior σ's factor, per target,
     and (files written since the band widens beyond the training range) the gain and the
     training rows' operating range (since stopped rows are held against their thermal
-    state too, with the stopped rows' range of the temperature features).
+    state too, with the stopped rows' range of the temperature features, and since then
+    with the features' span over every training row, the unit of a stop's excess).
     One model, not a union tagged by `kind`: pydantic would put the tag in the field's path
     (`interval.conformal.half_width_um`), which names no key of the file."""
 
